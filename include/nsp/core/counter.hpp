@@ -1,0 +1,36 @@
+// nsp/core/counter.hpp: density-lookup counters, the currency of efficiency (THEORY 7).
+//
+// Kernels call `counter.lookup()` once per evaluation of a medium's coefficients. With
+// NoLookupCount the call is an empty inline function and compiles to nothing.
+#pragma once
+
+#include <concepts>
+#include <cstdint>
+
+namespace nsp {
+
+/// A lookup counter: `lookup()` records one density lookup.
+template <class C>
+concept LookupCounter = requires(C& c) {
+    { c.lookup() } noexcept;
+    { C::enabled } -> std::convertible_to<bool>;
+};
+
+/// Counts nothing and costs nothing.
+struct NoLookupCount {
+    static constexpr bool enabled = false;
+    void lookup() noexcept {}
+    std::uint64_t count() const noexcept { return 0; }
+};
+
+/// Counts lookups in a plain integer (one per thread; sum them afterwards).
+struct LookupCount {
+    static constexpr bool enabled = true;
+    std::uint64_t n = 0;
+    void lookup() noexcept { ++n; }
+    std::uint64_t count() const noexcept { return n; }
+};
+
+static_assert(LookupCounter<NoLookupCount> && LookupCounter<LookupCount>);
+
+}  // namespace nsp

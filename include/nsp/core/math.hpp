@@ -1,0 +1,107 @@
+// nsp/core/math.hpp: rays, boxes, spheres and direction frames shared by every kernel.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <utility>
+
+#include <glm/geometric.hpp>
+#include <glm/vec3.hpp>
+
+namespace nsp {
+
+using Vec3 = glm::vec3;
+
+inline constexpr float kPi = 3.14159265358979323846f;
+inline constexpr float kInv4Pi = 0.07957747154594767f;
+inline constexpr float kInf = std::numeric_limits<float>::infinity();
+
+/// A ray `o + t d`; `d` is unit length wherever nsp creates one.
+struct Ray {
+    Vec3 o;
+    Vec3 d;
+    /// The point at parameter t.
+    Vec3 at(float t) const noexcept { return o + t * d; }
+};
+
+/// A parametric interval [t0, t1] along a ray.
+struct Interval {
+    float t0 = 0.f;
+    float t1 = 0.f;
+    bool empty() const noexcept { return !(t0 < t1); }
+};
+
+/// An axis-aligned box.
+struct Box {
+    Vec3 lo{0.f};
+    Vec3 hi{1.f};
+
+    /// True when p lies inside or on the boundary.
+    bool contains(const Vec3& p) const noexcept {
+        return p.x >= lo.x && p.y >= lo.y && p.z >= lo.z && p.x <= hi.x && p.y <= hi.y &&
+               p.z <= hi.z;
+    }
+
+    /// The part of [tmin, tmax] inside the box (empty interval on a miss). Axis-parallel rays
+    /// are handled without 0 * inf.
+    Interval clip(const Ray& r, float tmin, float tmax) const noexcept {
+        float t0 = tmin, t1 = tmax;
+        for (int a = 0; a < 3; ++a) {
+            if (r.d[a] == 0.f) {
+                if (r.o[a] < lo[a] || r.o[a] > hi[a]) return {0.f, 0.f};
+                continue;
+            }
+            const float inv = 1.f / r.d[a];
+            float tn = (lo[a] - r.o[a]) * inv, tf = (hi[a] - r.o[a]) * inv;
+            if (tn > tf) std::swap(tn, tf);
+            t0 = std::max(t0, tn);
+            t1 = std::min(t1, tf);
+        }
+        return {t0, t1};
+    }
+};
+
+/// Nearest t in (tmin, inf) where the ray meets the sphere, or kInf. Uses the numerically
+/// stable quadratic form (no catastrophic cancellation for small spheres far away).
+inline float intersect_sphere(const Ray& r, const Vec3& c, float radius, float tmin = 0.f) noexcept {
+    const Vec3 oc = r.o - c;
+    const float b = glm::dot(oc, r.d);
+    const Vec3 perp = oc - b * r.d;  // offset of the closest approach
+    const float disc = radius * radius - glm::dot(perp, perp);
+    if (disc < 0.f) return kInf;
+    const float c2 = glm::dot(oc, oc) - radius * radius;
+    const float q = -b - std::copysign(std::sqrt(disc), b);
+    float ta = q != 0.f ? c2 / q : 0.f, tb = q;
+    if (ta > tb) std::swap(ta, tb);
+    if (ta > tmin) return ta;
+    if (tb > tmin) return tb;
+    return kInf;
+}
+
+/// Two unit vectors that complete `n` to an orthonormal frame (Duff et al. 2017).
+inline void orthonormal_basis(const Vec3& n, Vec3& s, Vec3& t) noexcept {
+    const float sign = std::copysign(1.f, n.z);
+    const float a = -1.f / (sign + n.z);
+    const float b = n.x * n.y * a;
+    s = Vec3(1.f + sign * n.x * n.x * a, sign * b, -sign * n.x);
+    t = Vec3(b, sign + n.y * n.y * a, -n.y);
+}
+
+/// The direction with polar cosine `cos_theta` and azimuth `phi` around unit axis `n`.
+inline Vec3 direction_around(const Vec3& n, float cos_theta, float phi) noexcept {
+    Vec3 s, t;
+    orthonormal_basis(n, s, t);
+    const float sin_theta = std::sqrt(std::max(0.f, 1.f - cos_theta * cos_theta));
+    return sin_theta * std::cos(phi) * s + sin_theta * std::sin(phi) * t + cos_theta * n;
+}
+
+/// A uniformly distributed unit vector; its solid-angle density is 1 / (4 pi).
+inline Vec3 uniform_sphere(float u1, float u2) noexcept {
+    const float z = 1.f - 2.f * u1;
+    const float r = std::sqrt(std::max(0.f, 1.f - z * z));
+    const float phi = 2.f * kPi * u2;
+    return {r * std::cos(phi), r * std::sin(phi), z};
+}
+
+}  // namespace nsp

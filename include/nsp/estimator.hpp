@@ -1,0 +1,207 @@
+// nsp/estimator.hpp: path estimators for radiance through a medium (THEORY 4, 5.1, 5.2, 5.6).
+//
+// One path loop serves all four strategies; they differ only where `if constexpr` on the
+// strategy's traits says so:
+// - Unidirectional: delta tracking, emission found by hitting lights;
+// - NextEvent: light sampling with ratio-tracking transmittance at every real vertex;
+// - DirectionalMis: both, weighted by the direction pdfs alone (Novak 2014, Kutz 2017);
+// - NullScatteringMis: both, weighted by the full null-scattering path pdfs (THEORY 5.1).
+#pragma once
+
+#include <algorithm>
+#include <cstdint>
+
+#include "core/counter.hpp"
+#include "core/rng.hpp"
+#include "mis.hpp"
+#include "scene.hpp"
+#include "tracking.hpp"
+
+namespace nsp {
+
+namespace strategy {
+/// Delta tracking; lights contribute when a path hits them.
+struct Unidirectional {
+    static constexpr const char* name = "unidirectional";
+    static constexpr bool samples_lights = false, hits_lights = true, combines = false, null_pdfs = false;
+};
+/// Next-event estimation with ratio-tracking transmittance; hits count only for camera rays.
+struct NextEvent {
+    static constexpr const char* name = "ratio-nee";
+    static constexpr bool samples_lights = true, hits_lights = false, combines = false, null_pdfs = false;
+};
+/// Unidirectional + NEE weighted by direction pdfs only (THEORY 5.2).
+struct DirectionalMis {
+    static constexpr const char* name = "directional-mis";
+    static constexpr bool samples_lights = true, hits_lights = true, combines = true, null_pdfs = false;
+};
+/// Unidirectional + NEE weighted by null-scattering path pdfs (THEORY 5.1).
+struct NullScatteringMis {
+    static constexpr const char* name = "uni-nee-mis";
+    static constexpr bool samples_lights = true, hits_lights = true, combines = true, null_pdfs = true;
+};
+}  // namespace strategy
+
+/// A path strategy: which techniques it runs and whether it combines them with MIS.
+template <class T>
+concept PathStrategy = requires {
+    { T::name } -> std::convertible_to<const char*>;
+    { T::samples_lights } -> std::convertible_to<bool>;
+    { T::hits_lights } -> std::convertible_to<bool>;
+    { T::combines } -> std::convertible_to<bool>;
+    { T::null_pdfs } -> std::convertible_to<bool>;
+};
+
+/// Run-time settings of a path estimator.
+struct EstimatorOptions {
+    int max_depth = 1000;          ///< most real scattering vertices on a path (>= 0)
+    bool russian_roulette = true;  ///< roulette at real vertices from `rr_start_depth` on
+    int rr_start_depth = 3;        ///< first real vertex (1-based) at which roulette may stop a path
+    float rr_max_survival = 0.95f; ///< survival q = min(rr_max_survival, max_c |throughput_c|), in (0, 1]
+};
+
+/// How a radiance estimate ended.
+enum class Status : std::uint8_t {
+    Ok,         ///< a finite estimate
+    Aborted,    ///< a flight hit the collision limit; that flight contributed 0 (rare, biased)
+    NonFinite,  ///< the estimate was NaN or Inf and has been replaced by 0
+};
+
+/// A radiance estimate and its status.
+template <SpectralMode S>
+struct RadianceSample {
+    typename S::Spectrum value;
+    Status status = Status::Ok;
+};
+
+/// A path estimator: strategy St, MIS heuristic H (mis::None exactly for single-strategy
+/// estimators) and absorption policy A for the delta-tracked segments.
+template <PathStrategy St, mis::Heuristic H = mis::None, AbsorptionPolicy A = absorption::Weight>
+class PathEstimator {
+    static_assert(St::combines || !H::combines,
+                  "nsp::PathEstimator: a single-strategy estimator (Unidirectional, NextEvent) "
+                  "takes mis::None; a heuristic would weigh a strategy against nothing");
+    static_assert(!St::combines || H::combines,
+                  "nsp::PathEstimator: DirectionalMis and NullScatteringMis combine two strategies "
+                  "and need a combining heuristic (mis::Balance or mis::Power), not mis::None");
+
+public:
+    using Strategy = St;
+    using HeuristicType = H;
+    using Absorption = A;
+
+    /// Throws InvalidArgument on max_depth < 0, rr_start_depth < 1 or rr_max_survival outside (0, 1].
+    explicit PathEstimator(EstimatorOptions opts = {}, H heuristic = H{})
+        : opts_(opts), heuristic_(heuristic) {
+        if (opts.max_depth < 0)
+            detail::fail("EstimatorOptions max_depth = ", opts.max_depth, " is not allowed: it must be >= 0");
+        if (opts.rr_start_depth < 1)
+            detail::fail("EstimatorOptions rr_start_depth = ", opts.rr_start_depth, " is not allowed: it must be >= 1");
+        if (!(opts.rr_max_survival > 0.f && opts.rr_max_survival <= 1.f))
+            detail::fail("EstimatorOptions rr_max_survival = ", opts.rr_max_survival,
+                         " is not allowed: it must lie in (0, 1]");
+    }
+
+    const EstimatorOptions& options() const noexcept { return opts_; }
+
+    /// An estimate of the radiance arriving at `ray.o` from direction -ray.d. Never throws.
+    template <class Sc, UniformRng R, LookupCounter C>
+    RadianceSample<typename Sc::Spectral> radiance(const Sc& scene, const Ray& camera_ray,
+                                                   const typename Sc::Spectral::Wavelengths& lambda,
+                                                   R& rng, C& counter) const {
+        using Spectrum = typename Sc::Spectrum;
+        Spectrum L = Spectrum::Zero(), beta = Spectrum::Ones();
+        Status status = Status::Ok;
+        Ray ray = camera_ray;
+        // The real vertex the current ray left from, for the MIS weight of a light it hits.
+        Vec3 prev_x(0.f);
+        float prev_phase_pdf = 0.f, prev_survival = 1.f;
+        bool from_camera = true;
+
+        for (int depth = 0;;) {
+            const LightHit hit = scene.lights.intersect(ray);
+            const auto seg = track_delta<A>(scene.medium, scene.majorant, ray, hit.t, lambda, rng, counter);
+            if (seg.end == SegmentEnd::Aborted) {
+                status = Status::Aborted;
+                break;
+            }
+            beta *= seg.weight;
+            if (seg.end == SegmentEnd::Passed) {
+                if (from_camera || St::hits_lights) {
+                    float w = 1.f;
+                    if constexpr (St::combines) {
+                        if (!from_camera) {
+                            // p_nee / p_uni for this path (THEORY 5.1, 5.2, 5.6); the shared prefix cancels.
+                            float p_uni = prev_survival * prev_phase_pdf;
+                            if constexpr (St::null_pdfs) p_uni *= seg.null_pdf_product;
+                            const float p_nee = scene.lights.pdf(prev_x, hit);
+                            w = p_uni > 0.f ? heuristic_.weight(p_nee / p_uni) : 0.f;
+                        }
+                    }
+                    L += w * beta * scene.lights.emitted(hit);
+                }
+                break;
+            }
+            if (seg.end != SegmentEnd::Scattered) break;  // absorbed
+            if (++depth > opts_.max_depth) break;
+
+            const Vec3 x = ray.at(seg.t);
+            // Roulette survival is fixed before NEE: the continuing unidirectional path carries it.
+            float q = 1.f;
+            if (opts_.russian_roulette && depth >= opts_.rr_start_depth)
+                q = std::min(opts_.rr_max_survival, beta.abs().maxCoeff());
+            if constexpr (St::samples_lights) {
+                if (next_event(scene, x, ray.d, q, lambda, rng, counter, beta, L)) status = Status::Aborted;
+            }
+            if (q < 1.f) {
+                if (!(rng.uniform() < q)) break;
+                beta /= q;
+            }
+            const float u1 = rng.uniform(), u2 = rng.uniform();
+            const PhaseSample ps = scene.phase.sample(ray.d, u1, u2);
+            if (!(ps.pdf > 0.f)) break;
+            beta *= ps.value / ps.pdf;
+            prev_x = x;
+            prev_phase_pdf = ps.pdf;
+            prev_survival = q;
+            from_camera = false;
+            ray = Ray{x, ps.wi};
+        }
+        if (!all_finite(L)) return {Spectrum::Zero(), Status::NonFinite};
+        return {L, status};
+    }
+
+private:
+    /// Adds NEE's weighted contribution at real vertex x (arrived along wo) to L; returns true if
+    /// its shadow flight was aborted.
+    template <class Sc, UniformRng R, LookupCounter C>
+    bool next_event(const Sc& scene, const Vec3& x, const Vec3& wo, float survival,
+                    const typename Sc::Spectral::Wavelengths& lambda, R& rng, C& counter,
+                    const typename Sc::Spectrum& beta, typename Sc::Spectrum& L) const {
+        const float u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
+        const LightSample<typename Sc::Spectral> ls = scene.lights.sample(x, u0, u1, u2);
+        if (!(ls.pdf > 0.f)) return false;
+        const Ray shadow{x, ls.wi};
+        if (ls.occludable_by_sphere && scene.lights.sphere_blocks(shadow, ls.distance)) return false;
+        const auto tr = track_ratio<A, St::null_pdfs>(scene.medium, scene.majorant, shadow,
+                                                      ls.distance, lambda, rng, counter);
+        if (tr.end == SegmentEnd::Aborted) return true;
+        if (tr.end == SegmentEnd::Terminated) return false;
+        float w = 1.f;
+        if constexpr (St::combines) {
+            if (!ls.delta) {
+                // p_uni / p_nee for this path: q p_w [prod_j P_n(n_j)] / p_l (THEORY 5.1, 5.6).
+                float p_uni = survival * scene.phase.pdf(wo, ls.wi);
+                if constexpr (St::null_pdfs) p_uni *= tr.null_pdf_product;
+                w = heuristic_.weight(p_uni / ls.pdf);
+            }
+        }
+        L += beta * tr.transmittance * ls.radiance * (w * scene.phase.eval(wo, ls.wi) / ls.pdf);
+        return false;
+    }
+
+    EstimatorOptions opts_;
+    [[no_unique_address]] H heuristic_;
+};
+
+}  // namespace nsp

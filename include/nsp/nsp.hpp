@@ -1,0 +1,20 @@
+// nsp/nsp.hpp: the umbrella header, everything nsp offers.
+#pragma once
+
+#include "core/counter.hpp"
+#include "core/error.hpp"
+#include "core/math.hpp"
+#include "core/rng.hpp"
+#include "estimator.hpp"
+#include "light.hpp"
+#include "majorant.hpp"
+#include "media/exponential.hpp"
+#include "media/grid.hpp"
+#include "media/homogeneous.hpp"
+#include "medium.hpp"
+#include "mis.hpp"
+#include "pdf.hpp"
+#include "phase.hpp"
+#include "scene.hpp"
+#include "spectrum.hpp"
+#include "tracking.hpp"

@@ -1,0 +1,78 @@
+// nsp/pdf.hpp: independent evaluation of segment pdfs from the vertices alone (THEORY 4, 6).
+//
+// Samplers report their pdfs as running ratios (tracking.hpp). These functions recompute the
+// absolute pdf of a given set of vertices from scratch, from the majorant and the medium, so
+// tests can check that what a sampler reports is what it did, and hosts can weight paths that
+// another strategy produced.
+#pragma once
+
+#include <cmath>
+#include <span>
+
+#include "majorant.hpp"
+#include "tracking.hpp"
+
+namespace nsp {
+
+/// The majorant optical depth int_a^b mu_bar dt along `ray` (Tbar(a, b) = exp(-result)).
+template <Medium M, MajorantPolicy<M> Maj>
+double majorant_optical_depth(const Maj& majorant, const Ray& ray, float a, float b,
+                              const typename M::Spectral::Wavelengths& lambda) {
+    double tau = 0.0;
+    auto it = majorant.iterate(ray, a, b, lambda);
+    while (auto seg = it.next()) {
+        const float lo = std::max(seg->t0, a), hi = std::min(seg->t1, b);
+        if (hi > lo) tau += double(seg->sigma_maj) * (double(hi) - double(lo));
+    }
+    return tau;
+}
+
+/// The majorant mu_bar at distance t along `ray` (0 where no segment covers t).
+template <Medium M, MajorantPolicy<M> Maj>
+float majorant_at(const Maj& majorant, const Ray& ray, float t,
+                  const typename M::Spectral::Wavelengths& lambda) {
+    auto it = majorant.iterate(ray, 0.f, kInf, lambda);
+    while (auto seg = it.next())
+        if (seg->t0 <= t && t < seg->t1) return seg->sigma_maj;
+    return 0.f;
+}
+
+/// log pdf that delta tracking (policy A) from `ray.o` creates null vertices at `nulls`
+/// (increasing) and then either passes tmax (`end` = Passed) or has event `end` at `t_end`:
+/// prod_j mu_bar(n_j) Tbar(n_j-1, n_j) P_n(n_j) * [mu_bar(y) Tbar(n_m, y) P_end(y) or Tbar(n_m, tmax)].
+template <AbsorptionPolicy A, Medium M, MajorantPolicy<M> Maj>
+double delta_segment_log_pdf(const M& medium, const Maj& majorant, const Ray& ray, float tmax,
+                             const typename M::Spectral::Wavelengths& lambda,
+                             std::span<const float> nulls, SegmentEnd end, float t_end) {
+    double lp = 0.0;
+    float prev = 0.f;
+    for (const float t : nulls) {
+        const float mu = majorant_at<M>(majorant, ray, t, lambda);
+        const auto p = event_probabilities<A>(medium.coefficients(ray.at(t), lambda), mu);
+        lp += std::log(double(mu) * p.null) - majorant_optical_depth<M>(majorant, ray, prev, t, lambda);
+        prev = t;
+    }
+    if (end == SegmentEnd::Passed) return lp - majorant_optical_depth<M>(majorant, ray, prev, tmax, lambda);
+    const float mu = majorant_at<M>(majorant, ray, t_end, lambda);
+    const auto p = event_probabilities<A>(medium.coefficients(ray.at(t_end), lambda), mu);
+    const float p_end = end == SegmentEnd::Absorbed ? p.absorb : p.scatter;
+    return lp + std::log(double(mu) * p_end) - majorant_optical_depth<M>(majorant, ray, prev, t_end, lambda);
+}
+
+/// log pdf that ratio tracking from `ray.o` to tmax creates null vertices at `nulls`:
+/// prod_j mu_bar(n_j) Tbar(n_j-1, n_j) * Tbar(n_m, tmax).
+template <Medium M, MajorantPolicy<M> Maj>
+double ratio_segment_log_pdf(const M&, const Maj& majorant, const Ray& ray, float tmax,
+                             const typename M::Spectral::Wavelengths& lambda,
+                             std::span<const float> nulls) {
+    double lp = 0.0;
+    float prev = 0.f;
+    for (const float t : nulls) {
+        lp += std::log(double(majorant_at<M>(majorant, ray, t, lambda))) -
+              majorant_optical_depth<M>(majorant, ray, prev, t, lambda);
+        prev = t;
+    }
+    return lp - majorant_optical_depth<M>(majorant, ray, prev, tmax, lambda);
+}
+
+}  // namespace nsp

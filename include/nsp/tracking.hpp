@@ -1,0 +1,284 @@
+// nsp/tracking.hpp: the free-flight loop and the per-collision tracking policies (THEORY 4).
+//
+// There is one loop, `free_flight`: it walks the majorant segments of a ray, draws tentative
+// collisions with density mu_bar(t) Tbar(0, t), looks the medium up at each, and hands the
+// collision to a callback that decides absorb / scatter / null. Delta tracking and ratio
+// tracking are such callbacks; so is anything a host renderer writes.
+#pragma once
+
+#include <cmath>
+#include <concepts>
+#include <cstdint>
+#include <vector>
+
+#include "core/counter.hpp"
+#include "core/rng.hpp"
+#include "majorant.hpp"
+#include "medium.hpp"
+
+namespace nsp {
+
+// ---------------------------------------------------------------------------------------------
+// Absorption policies (THEORY 4.3, last bullet)
+
+namespace absorption {
+/// Absorption is an event with probability mu_a / mu_bar: the path ends there.
+struct Event {
+    static constexpr bool as_event = true;
+    static constexpr const char* name = "absorb-event";
+};
+/// Absorption is a weight: real collisions scatter with P_s = mu_t / mu_bar and the throughput
+/// is multiplied by the albedo mu_s / mu_t. Same mean, less variance on grey media.
+struct Weight {
+    static constexpr bool as_event = false;
+    static constexpr const char* name = "absorb-weight";
+};
+}  // namespace absorption
+
+/// An absorption policy says whether absorption is sampled as an event (`as_event`).
+template <class A>
+concept AbsorptionPolicy = requires {
+    { A::as_event } -> std::convertible_to<bool>;
+    { A::name } -> std::convertible_to<const char*>;
+};
+
+/// The probabilities of the three collision events; they sum to 1.
+struct EventProbabilities {
+    float absorb = 0.f;
+    float scatter = 0.f;
+    float null = 0.f;
+};
+
+/// The event probabilities delta tracking uses at a collision with coefficients `c` under
+/// majorant `mu_bar` > 0. One pdf serves all channels, driven by the channel means. Where the
+/// majorant does not bound the extinction the null probability is clamped at 0 and the others
+/// renormalised; the tracking weights then carry the sign (THEORY 1, 4.3).
+template <AbsorptionPolicy A, SpectralMode S>
+EventProbabilities event_probabilities(const Coefficients<S>& c, float mu_bar) noexcept {
+    const float a = std::max(0.f, sampling_scalar(c.sigma_a));
+    const float s = std::max(0.f, sampling_scalar(c.sigma_s));
+    const float n = std::max(0.f, mu_bar - a - s);
+    const float inv = 1.f / (a + s + n);  // > 0 because mu_bar > 0
+    if constexpr (A::as_event) return {a * inv, s * inv, n * inv};
+    else return {0.f, (a + s) * inv, n * inv};
+}
+
+// ---------------------------------------------------------------------------------------------
+// Recording sampled vertices (for pdf tests and debugging; compiled out by default)
+
+/// Records nothing.
+struct NoRecord {
+    static constexpr bool enabled = false;
+    void vertex(float, double) noexcept {}
+};
+
+/// Records the distances of the vertices a tracker creates and the log of the pdf with which it
+/// sampled them (majorant density, Tbar since the previous vertex and event probability).
+struct SegmentRecord {
+    static constexpr bool enabled = true;
+    std::vector<float> t;   ///< distance of each vertex the tracker created, nulls first
+    double log_pdf = 0.0;   ///< log of the product of the per-vertex pdfs, incl. the end term
+    void vertex(float tv, double log_p) {
+        t.push_back(tv);
+        log_pdf += log_p;
+    }
+};
+
+// ---------------------------------------------------------------------------------------------
+// The free-flight loop
+
+/// How a call of `free_flight` ended.
+struct FlightEnd {
+    bool stopped = false;   ///< the callback stopped at `t`; otherwise the ray passed tmax
+    bool aborted = false;   ///< gave up after `max_collisions` tentative collisions
+    float t = 0.f;          ///< the stopping distance
+    float tau_tail = 0.f;   ///< majorant optical depth from the last collision to tmax if passed
+};
+
+/// The default limit on tentative collisions in one flight. It only matters where a majorant is
+/// so loose over so long a ray that tracking would not finish; the caller sees `aborted`.
+inline constexpr std::uint32_t kDefaultMaxCollisions = 1u << 24;
+
+/// A collision callback: `cb(t, coefficients, mu_bar, tau)` returns true to go on (a null
+/// collision) or false to stop at t; `tau` is the majorant optical depth since the previous
+/// tentative collision (or the origin), so exp(-tau) is Tbar between them.
+template <class F, class S>
+concept CollisionCallback = requires(F& f, float t, const Coefficients<S>& c) {
+    { f(t, c, t, t) } -> std::same_as<bool>;
+};
+
+/// Samples tentative collisions with density mu_bar(t) Tbar(tmin, t) along `ray` over
+/// [tmin, tmax], segment by segment, and calls `on_collision` at each (THEORY 4.1). Counts one
+/// density lookup per tentative collision. Never throws.
+template <Medium M, MajorantPolicy<M> Maj, UniformRng R, LookupCounter C,
+          CollisionCallback<typename M::Spectral> F>
+FlightEnd free_flight(const M& medium, const Maj& majorant, const Ray& ray, float tmin, float tmax,
+                      const typename M::Spectral::Wavelengths& lambda, R& rng, C& counter,
+                      F&& on_collision, std::uint32_t max_collisions = kDefaultMaxCollisions) {
+    auto segments = majorant.iterate(ray, tmin, tmax, lambda);
+    float tau = 0.f;            // majorant optical depth since the last tentative collision
+    std::uint32_t collisions = 0;
+    while (auto seg = segments.next()) {
+        const float mu_bar = seg->sigma_maj;
+        if (!(mu_bar > 0.f)) continue;  // nothing to collide with on this segment
+        float t = seg->t0;
+        for (;;) {
+            // Exponential step: E = -ln(1 - u) majorant optical depths.
+            const float e = -std::log1p(-rng.uniform());
+            const float dt = e / mu_bar;
+            if (!(dt < seg->t1 - t)) {  // the step leaves the segment (also catches inf)
+                tau += mu_bar * (seg->t1 - t);
+                break;
+            }
+            t += dt;
+            tau += e;
+            if (++collisions > max_collisions) return {false, true, t, 0.f};
+            counter.lookup();
+            const auto coeff = medium.coefficients(ray.at(t), lambda);
+            const float tau_step = tau;
+            tau = 0.f;
+            if (!on_collision(t, coeff, mu_bar, tau_step)) return {true, false, t, 0.f};
+        }
+    }
+    return {false, false, tmax, tau};
+}
+
+// ---------------------------------------------------------------------------------------------
+// Tracking strategies as collision policies
+
+/// How a tracked segment ended.
+enum class SegmentEnd : std::uint8_t {
+    Passed,      ///< reached tmax (a surface, a light or the end of the medium)
+    Scattered,   ///< a real scattering collision at t
+    Absorbed,    ///< an absorption event at t (only with absorption::Event)
+    Terminated,  ///< ratio tracking: every channel's weight reached exactly 0
+    Aborted,     ///< the collision limit was reached; the estimate is discarded (weight 0)
+};
+
+/// The outcome of delta tracking one segment.
+template <SpectralMode S>
+struct DeltaTrack {
+    SegmentEnd end = SegmentEnd::Passed;
+    float t = 0.f;                     ///< distance of the real collision, or tmax
+    typename S::Spectrum weight;       ///< product of per-vertex f/p factors (1 on grey media with a bounding majorant)
+    float null_pdf_product = 1.f;      ///< prod_j P_n(n_j): the ratio p_track / p_ratio of the nulls (THEORY 5.1)
+};
+
+/// Delta (Woodcock) tracking (THEORY 4.3): at each collision choose absorb / scatter / null with
+/// the probabilities of `event_probabilities<A>`; per-channel weights are mu_x,c / (mu_bar P_x).
+template <AbsorptionPolicy A, SpectralMode S, UniformRng R, class Rec>
+struct DeltaCollision {
+    R& rng;
+    Rec& rec;
+    DeltaTrack<S> out{SegmentEnd::Passed, 0.f, S::Spectrum::Ones(), 1.f};
+
+    bool operator()(float t, const Coefficients<S>& c, float mu_bar, float tau) {
+        const EventProbabilities p = event_probabilities<A>(c, mu_bar);
+        const float u = rng.uniform();
+        float p_event;
+        if (u < p.absorb) {
+            out.end = SegmentEnd::Absorbed;
+            out.weight *= c.sigma_a / (mu_bar * p.absorb);
+            p_event = p.absorb;
+        } else if (u < p.absorb + p.scatter || !(p.null > 0.f)) {
+            // The second test keeps rounding from picking a null of probability 0.
+            out.end = SegmentEnd::Scattered;
+            out.weight *= c.sigma_s / (mu_bar * p.scatter);
+            p_event = p.scatter;
+        } else {
+            out.weight *= (mu_bar - c.sigma_t()) / (mu_bar * p.null);
+            out.null_pdf_product *= p.null;
+            if constexpr (Rec::enabled) rec.vertex(t, std::log(double(mu_bar) * p.null) - tau);
+            return true;
+        }
+        out.t = t;
+        if constexpr (Rec::enabled) rec.vertex(t, std::log(double(mu_bar) * p_event) - tau);
+        return false;
+    }
+};
+
+/// The outcome of ratio tracking one segment.
+template <SpectralMode S>
+struct RatioTrack {
+    SegmentEnd end = SegmentEnd::Passed;  ///< Passed, Terminated (weight 0) or Aborted
+    typename S::Spectrum transmittance;   ///< prod_j mu_n,c(n_j) / mu_bar(n_j): unbiased estimate of T
+    float null_pdf_product = 1.f;         ///< prod_j P_n(n_j) of delta tracking with policy A, if asked for
+};
+
+/// Ratio tracking (THEORY 4.3, P_n = 1): every collision is null and multiplies the weight by
+/// mu_n / mu_bar. With `kNullRatio` it also multiplies the P_n that delta tracking with policy A
+/// would have used at the same nulls, the factor that makes null-scattering MIS work (THEORY 5.1).
+template <AbsorptionPolicy A, bool kNullRatio, SpectralMode S, class Rec>
+struct RatioCollision {
+    Rec& rec;
+    RatioTrack<S> out{SegmentEnd::Passed, S::Spectrum::Ones(), 1.f};
+
+    bool operator()(float t, const Coefficients<S>& c, float mu_bar, float tau) {
+        out.transmittance *= (mu_bar - c.sigma_t()) / mu_bar;
+        if constexpr (kNullRatio) out.null_pdf_product *= event_probabilities<A>(c, mu_bar).null;
+        if constexpr (Rec::enabled) rec.vertex(t, std::log(double(mu_bar)) - tau);
+        if ((out.transmittance == 0.f).all()) {
+            out.end = SegmentEnd::Terminated;
+            return false;
+        }
+        return true;
+    }
+};
+
+/// Delta-tracks `ray` over [0, tmax] inside the medium. A `Passed` result means the ray reached
+/// tmax; its weight is then the transmittance weight of the nulls (1 on grey bounded media).
+template <AbsorptionPolicy A, Medium M, MajorantPolicy<M> Maj, UniformRng R, LookupCounter C,
+          class Rec = NoRecord>
+DeltaTrack<typename M::Spectral> track_delta(const M& medium, const Maj& majorant, const Ray& ray,
+                                             float tmax, const typename M::Spectral::Wavelengths& lambda,
+                                             R& rng, C& counter, Rec&& rec = Rec{}) {
+    using S = typename M::Spectral;
+    DeltaCollision<A, S, R, std::remove_reference_t<Rec>> cb{rng, rec};
+    const FlightEnd f = free_flight(medium, majorant, ray, 0.f, tmax, lambda, rng, counter, cb);
+    if (f.aborted) return {SegmentEnd::Aborted, f.t, S::Spectrum::Zero(), 1.f};
+    if (!f.stopped) {
+        cb.out.end = SegmentEnd::Passed;
+        cb.out.t = tmax;
+        if constexpr (std::remove_reference_t<Rec>::enabled) rec.log_pdf -= f.tau_tail;
+    }
+    return cb.out;
+}
+
+/// Ratio-tracks `ray` over [0, tmax]: an unbiased per-channel transmittance estimate, and with
+/// `kNullRatio` the product of delta tracking's (policy A) null probabilities at its nulls.
+template <AbsorptionPolicy A, bool kNullRatio, Medium M, MajorantPolicy<M> Maj, UniformRng R,
+          LookupCounter C, class Rec = NoRecord>
+RatioTrack<typename M::Spectral> track_ratio(const M& medium, const Maj& majorant, const Ray& ray,
+                                             float tmax, const typename M::Spectral::Wavelengths& lambda,
+                                             R& rng, C& counter, Rec&& rec = Rec{}) {
+    using S = typename M::Spectral;
+    RatioCollision<A, kNullRatio, S, std::remove_reference_t<Rec>> cb{rec};
+    const FlightEnd f = free_flight(medium, majorant, ray, 0.f, tmax, lambda, rng, counter, cb);
+    if (f.aborted) return {SegmentEnd::Aborted, S::Spectrum::Zero(), 1.f};
+    if constexpr (std::remove_reference_t<Rec>::enabled)
+        if (!f.stopped) rec.log_pdf -= f.tau_tail;
+    return cb.out;
+}
+
+/// Ratio-tracking transmittance estimate between two points (Novak et al. 2014).
+template <Medium M, MajorantPolicy<M> Maj, UniformRng R, LookupCounter C>
+typename M::Spectral::Spectrum transmittance_ratio(const M& medium, const Maj& majorant,
+                                                   const Ray& ray, float tmax,
+                                                   const typename M::Spectral::Wavelengths& lambda,
+                                                   R& rng, C& counter) {
+    return track_ratio<absorption::Event, false>(medium, majorant, ray, tmax, lambda, rng, counter)
+        .transmittance;
+}
+
+/// Delta-tracking transmittance estimate: the null weight if the ray passes tmax, else 0.
+template <Medium M, MajorantPolicy<M> Maj, UniformRng R, LookupCounter C>
+typename M::Spectral::Spectrum transmittance_delta(const M& medium, const Maj& majorant,
+                                                   const Ray& ray, float tmax,
+                                                   const typename M::Spectral::Wavelengths& lambda,
+                                                   R& rng, C& counter) {
+    const auto d = track_delta<absorption::Event>(medium, majorant, ray, tmax, lambda, rng, counter);
+    using Spec = typename M::Spectral::Spectrum;
+    return d.end == SegmentEnd::Passed ? d.weight : Spec(Spec::Zero());
+}
+
+}  // namespace nsp
