@@ -52,6 +52,29 @@ concept PathStrategy = requires {
     { T::null_pdfs } -> std::convertible_to<bool>;
 };
 
+/// MIS weight of the unidirectional technique for a path whose last segment, tracked from a real
+/// vertex with roulette survival `survival` and phase pdf `phase_pdf`, hit a light that NEE
+/// samples with solid-angle pdf `light_pdf`. `null_pdf_product` is prod_j P_n(n_j) of the
+/// segment's nulls (used by NullScatteringMis only). THEORY 5.1, 5.2, 5.6.
+template <PathStrategy St, mis::CombiningHeuristic H>
+float unidirectional_weight(const H& h, float survival, float phase_pdf, float null_pdf_product,
+                            float light_pdf) noexcept {
+    float p_uni = survival * phase_pdf;
+    if constexpr (St::null_pdfs) p_uni *= null_pdf_product;
+    return p_uni > 0.f ? h.weight(light_pdf / p_uni) : 0.f;
+}
+
+/// MIS weight of NEE for the same kind of path, sampled by the light (pdf `light_pdf` > 0) with
+/// ratio tracking, whose nulls have delta-tracking product `null_pdf_product`. For one path,
+/// unidirectional_weight + next_event_weight = 1.
+template <PathStrategy St, mis::CombiningHeuristic H>
+float next_event_weight(const H& h, float survival, float phase_pdf, float null_pdf_product,
+                        float light_pdf) noexcept {
+    float p_uni = survival * phase_pdf;
+    if constexpr (St::null_pdfs) p_uni *= null_pdf_product;
+    return h.weight(p_uni / light_pdf);
+}
+
 /// Run-time settings of a path estimator.
 struct EstimatorOptions {
     int max_depth = 1000;          ///< most real scattering vertices on a path (>= 0)
@@ -130,13 +153,10 @@ public:
                 if (from_camera || St::hits_lights) {
                     float w = 1.f;
                     if constexpr (St::combines) {
-                        if (!from_camera) {
-                            // p_nee / p_uni for this path (THEORY 5.1, 5.2, 5.6); the shared prefix cancels.
-                            float p_uni = prev_survival * prev_phase_pdf;
-                            if constexpr (St::null_pdfs) p_uni *= seg.null_pdf_product;
-                            const float p_nee = scene.lights.pdf(prev_x, hit);
-                            w = p_uni > 0.f ? heuristic_.weight(p_nee / p_uni) : 0.f;
-                        }
+                        if (!from_camera)  // the shared prefix of the two pdfs cancels
+                            w = unidirectional_weight<St>(heuristic_, prev_survival, prev_phase_pdf,
+                                                          seg.null_pdf_product,
+                                                          scene.lights.pdf(prev_x, hit));
                     }
                     L += w * beta * scene.lights.emitted(hit);
                 }
@@ -189,12 +209,9 @@ private:
         if (tr.end == SegmentEnd::Terminated) return false;
         float w = 1.f;
         if constexpr (St::combines) {
-            if (!ls.delta) {
-                // p_uni / p_nee for this path: q p_w [prod_j P_n(n_j)] / p_l (THEORY 5.1, 5.6).
-                float p_uni = survival * scene.phase.pdf(wo, ls.wi);
-                if constexpr (St::null_pdfs) p_uni *= tr.null_pdf_product;
-                w = heuristic_.weight(p_uni / ls.pdf);
-            }
+            if (!ls.delta)  // a point light cannot be hit: NEE keeps weight 1
+                w = next_event_weight<St>(heuristic_, survival, scene.phase.pdf(wo, ls.wi),
+                                          tr.null_pdf_product, ls.pdf);
         }
         L += beta * tr.transmittance * ls.radiance * (w * scene.phase.eval(wo, ls.wi) / ls.pdf);
         return false;

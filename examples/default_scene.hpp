@@ -1,0 +1,112 @@
+// examples/default_scene.hpp: the default scene of the example renderer, shared with the tests.
+//
+// A procedural, bunny-like cloud (a few soft blobs with deterministic noise) on a dense grid in
+// the box [-1, 1]^3, with a forward-scattering Henyey-Greenstein phase function, lit in one of
+// two set-ups modelled on the paper's bunny scene:
+//   A: a small, bright sphere light beside the cloud: NEE finds it, unidirectional rarely hits it;
+//   B: a large, dim sphere light behind the cloud: phase sampling finds it, light sampling wastes
+//      samples where the forward-peaked phase function is small.
+// Nothing is downloaded; the grid is generated in a few milliseconds.
+#pragma once
+
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <string_view>
+#include <vector>
+
+#include <nsp/nsp.hpp>
+
+namespace nsp_examples {
+
+/// The two light set-ups of the default scene.
+enum class LightSetup { A, B };
+
+inline const char* name(LightSetup s) { return s == LightSetup::A ? "A" : "B"; }
+
+/// Camera placement shared by the renderer and the tests: at `eye`, looking at the origin.
+inline constexpr float kEye[3] = {0.f, 0.f, -4.f};
+inline constexpr float kFovY = 40.f;  ///< vertical field of view in degrees
+
+/// Grid resolution of the default cloud along each axis.
+inline constexpr int kGridRes = 64;
+
+/// Deterministic value noise in [0, 1] (hash of the lattice point, trilinear, smoothstepped).
+inline float value_noise(float x, float y, float z) {
+    auto hash = [](int i, int j, int k) {
+        std::uint32_t h = std::uint32_t(i) * 73856093u ^ std::uint32_t(j) * 19349663u ^ std::uint32_t(k) * 83492791u;
+        h ^= h >> 13; h *= 0x5bd1e995u; h ^= h >> 15;
+        return float(h & 0xffffffu) / float(0xffffff);
+    };
+    const int i = int(std::floor(x)), j = int(std::floor(y)), k = int(std::floor(z));
+    auto s = [](float t) { return t * t * (3.f - 2.f * t); };
+    const float fx = s(x - float(i)), fy = s(y - float(j)), fz = s(z - float(k));
+    float v = 0.f;
+    for (int c = 0; c < 8; ++c) {
+        const int dx = c & 1, dy = (c >> 1) & 1, dz = (c >> 2) & 1;
+        v += hash(i + dx, j + dy, k + dz) * (dx ? fx : 1.f - fx) * (dy ? fy : 1.f - fy) * (dz ? fz : 1.f - fz);
+    }
+    return v;
+}
+
+/// The cloud's densities in [0, 1] on a kGridRes^3 grid over [-1, 1]^3 (x fastest).
+inline std::vector<float> default_cloud_density() {
+    struct Blob { float x, y, z, r; };
+    // Body, head and two ears: a rough rabbit silhouette.
+    constexpr std::array<Blob, 4> blobs{{{0.f, -0.3f, 0.f, 0.6f}, {0.15f, 0.25f, 0.f, 0.35f},
+                                         {0.05f, 0.7f, 0.f, 0.14f}, {0.3f, 0.68f, 0.f, 0.14f}}};
+    std::vector<float> d(std::size_t(kGridRes) * kGridRes * kGridRes);
+    for (int z = 0; z < kGridRes; ++z)
+        for (int y = 0; y < kGridRes; ++y)
+            for (int x = 0; x < kGridRes; ++x) {
+                const float px = -1.f + 2.f * (float(x) + 0.5f) / kGridRes;
+                const float py = -1.f + 2.f * (float(y) + 0.5f) / kGridRes;
+                const float pz = -1.f + 2.f * (float(z) + 0.5f) / kGridRes;
+                float shape = 0.f;
+                for (const Blob& b : blobs) {
+                    const float r = std::sqrt((px - b.x) * (px - b.x) + (py - b.y) * (py - b.y) + (pz - b.z) * (pz - b.z));
+                    shape = std::max(shape, 1.f - r / b.r);
+                }
+                const float n = 0.6f * value_noise(4.f * px + 10.f, 4.f * py, 4.f * pz) +
+                                0.4f * value_noise(9.f * px, 9.f * py + 5.f, 9.f * pz);
+                const float v = std::clamp(3.f * shape - 0.6f * n, 0.f, 1.f);
+                d[std::size_t(x) + std::size_t(kGridRes) * (std::size_t(y) + std::size_t(kGridRes) * std::size_t(z))] = v;
+            }
+    return d;
+}
+
+/// Default medium coefficients per unit density: extinction 20, albedo 0.9 (grey).
+inline constexpr float kSigmaS = 18.f, kSigmaA = 2.f;
+/// Henyey-Greenstein asymmetry of the default scene.
+inline constexpr float kPhaseG = 0.85f;
+
+/// The lights of set-up A or B.
+template <nsp::SpectralMode S>
+nsp::Lights<S> default_lights(LightSetup setup) {
+    using Spec = typename S::Spectrum;
+    nsp::Lights<S> lights;
+    if (setup == LightSetup::A)
+        lights.set(nsp::SphereLight<S>{nsp::Vec3(1.6f, 1.2f, 0.4f), 0.05f, Spec::Constant(2000.f)});
+    else
+        lights.set(nsp::SphereLight<S>{nsp::Vec3(0.f, 0.3f, 4.5f), 2.5f, Spec::Constant(2.f)});
+    return lights;
+}
+
+/// The default scene: the cloud with the tightest global majorant, HG phase, set-up lights.
+template <nsp::SpectralMode S>
+auto make_default_scene(LightSetup setup) {
+    using Spec = typename S::Spectrum;
+    nsp::DenseGridMedium<S> medium(nsp::Box{nsp::Vec3(-1.f), nsp::Vec3(1.f)}, {kGridRes, kGridRes, kGridRes},
+                                   default_cloud_density(), Spec::Constant(kSigmaA), Spec::Constant(kSigmaS));
+    return nsp::make_scene(std::move(medium), nsp::HenyeyGreensteinPhase(kPhaseG), default_lights<S>(setup));
+}
+
+/// The camera ray through normalised image coordinates (u, v) in [0, 1]^2, v up, square pixels
+/// for an image of aspect = width / height.
+inline nsp::Ray camera_ray(float u, float v, float aspect) {
+    const float tan_half = std::tan(0.5f * kFovY * nsp::kPi / 180.f);
+    const nsp::Vec3 d((2.f * u - 1.f) * tan_half * aspect, (2.f * v - 1.f) * tan_half, 1.f);
+    return {nsp::Vec3(kEye[0], kEye[1], kEye[2]), glm::normalize(d)};
+}
+
+}  // namespace nsp_examples
