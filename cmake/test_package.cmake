@@ -1,0 +1,28 @@
+# ctest script: install nsp from the build tree into a scratch prefix, then build and run the
+# consumer project against it with find_package, and again with add_subdirectory.
+# Inputs: NSP_SOURCE_DIR, NSP_BINARY_DIR, WORK_DIR, GENERATOR.
+foreach(v NSP_SOURCE_DIR NSP_BINARY_DIR WORK_DIR)
+    if(NOT DEFINED ${v})
+        message(FATAL_ERROR "test_package.cmake needs -D${v}=...")
+    endif()
+endforeach()
+file(REMOVE_RECURSE ${WORK_DIR})
+
+function(run)
+    execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE out)
+    if(NOT rc EQUAL 0)
+        message(FATAL_ERROR "failed (${rc}): ${ARGN}\n${out}")
+    endif()
+    message(STATUS "${out}")
+endfunction()
+
+run(${CMAKE_COMMAND} --install ${NSP_BINARY_DIR} --prefix ${WORK_DIR}/prefix)
+run(${CMAKE_COMMAND} -S ${NSP_SOURCE_DIR}/cmake/consumer -B ${WORK_DIR}/installed -G ${GENERATOR}
+    -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH=${WORK_DIR}/prefix)
+run(${CMAKE_COMMAND} --build ${WORK_DIR}/installed)
+run(${WORK_DIR}/installed/consumer)
+
+run(${CMAKE_COMMAND} -S ${NSP_SOURCE_DIR}/cmake/consumer -B ${WORK_DIR}/subdir -G ${GENERATOR}
+    -DCMAKE_BUILD_TYPE=Release -DNSP_SOURCE_DIR=${NSP_SOURCE_DIR})
+run(${CMAKE_COMMAND} --build ${WORK_DIR}/subdir)
+run(${WORK_DIR}/subdir/consumer)
