@@ -1,0 +1,119 @@
+// examples/type_list.hpp: a minimal type-list toolkit (the part of Boost.Mp11 the examples use).
+//
+// `product` builds the Cartesian product of policy lists, `filter` keeps the valid combinations,
+// and `with_index` turns a run-time index into a compile-time type once, at the edge (STYLE
+// rule 2): everything the callback does afterwards is monomorphic.
+#pragma once
+
+#include <cstddef>
+#include <tuple>
+#include <type_traits>
+#include <utility>
+
+namespace nsp_examples::tl {
+
+/// A list of types.
+template <class... Ts>
+struct list {};
+
+/// The number of types in list L.
+template <class L>
+struct size_impl;
+template <class... Ts>
+struct size_impl<list<Ts...>> : std::integral_constant<std::size_t, sizeof...(Ts)> {};
+template <class L>
+inline constexpr std::size_t size = size_impl<L>::value;
+
+/// The I-th type of list L.
+template <class L, std::size_t I>
+struct at_impl;
+template <class... Ts, std::size_t I>
+struct at_impl<list<Ts...>, I> {
+    using type = std::tuple_element_t<I, std::tuple<Ts...>>;
+};
+template <class L, std::size_t I>
+using at = typename at_impl<L, I>::type;
+
+/// The concatenation of lists Ls.
+template <class... Ls>
+struct concat_impl {
+    using type = list<>;
+};
+template <class... Ts>
+struct concat_impl<list<Ts...>> {
+    using type = list<Ts...>;
+};
+template <class... As, class... Bs, class... Rest>
+struct concat_impl<list<As...>, list<Bs...>, Rest...> {
+    using type = typename concat_impl<list<As..., Bs...>, Rest...>::type;
+};
+template <class... Ls>
+using concat = typename concat_impl<Ls...>::type;
+
+/// list<T, Us...> for every list<Us...> in the list of lists Ls.
+template <class T, class Ls>
+struct prepend_each_impl;
+template <class T, class... Ls>
+struct prepend_each_impl<T, list<Ls...>> {
+    template <class L>
+    struct one;
+    template <class... Us>
+    struct one<list<Us...>> {
+        using type = list<T, Us...>;
+    };
+    using type = list<typename one<Ls>::type...>;
+};
+
+/// The Cartesian product of lists Ls: a list of list<T1, T2, ...>, first list varying slowest.
+template <class... Ls>
+struct product_impl {
+    using type = list<list<>>;
+};
+template <class... Ts, class... Rest>
+struct product_impl<list<Ts...>, Rest...> {
+    using tail = typename product_impl<Rest...>::type;
+    using type = concat<typename prepend_each_impl<Ts, tail>::type...>;
+};
+template <class... Ls>
+using product = typename product_impl<Ls...>::type;
+
+/// F<T> for every T of list L.
+template <template <class> class F, class L>
+struct transform_impl;
+template <template <class> class F, class... Ts>
+struct transform_impl<F, list<Ts...>> {
+    using type = list<F<Ts>...>;
+};
+template <template <class> class F, class L>
+using transform = typename transform_impl<F, L>::type;
+
+/// The types T of list L for which Pred<T>::value is true, in order.
+template <template <class> class Pred, class L>
+struct filter_impl;
+template <template <class> class Pred, class... Ts>
+struct filter_impl<Pred, list<Ts...>> {
+    using type = concat<std::conditional_t<Pred<Ts>::value, list<Ts>, list<>>...>;
+};
+template <template <class> class Pred, class L>
+using filter = typename filter_impl<Pred, L>::type;
+
+/// Calls f(std::type_identity<T>{}) for every T of list L, in order.
+template <class L, class F>
+void for_each(F&& f) {
+    [&]<class... Ts>(list<Ts...>) { (f(std::type_identity<Ts>{}), ...); }(L{});
+}
+
+/// Calls f(std::type_identity<at<L, i>>{}) for the run-time index i; returns false (and calls
+/// nothing) when i is out of range. This is the one place a run-time choice becomes a type.
+template <class L, class F>
+bool with_index(std::size_t i, F&& f) {
+    return [&]<std::size_t... Is>(std::index_sequence<Is...>) {
+        return ((i == Is && (f(std::type_identity<at<L, Is>>{}), true)) || ...);
+    }(std::make_index_sequence<size<L>>{});
+}
+
+static_assert(size<product<list<int, char>, list<float, double, long>>> == 6);
+static_assert(std::is_same_v<at<product<list<int, char>, list<float, double>>, 1>, list<int, double>>);
+static_assert(std::is_same_v<filter<std::is_integral, list<int, float, char>>, list<int, char>>);
+
+}  // namespace nsp_examples::tl
