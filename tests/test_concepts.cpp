@@ -1,0 +1,90 @@
+// tests/test_concepts.cpp: every model satisfies its concept, at compile time (STYLE rule 1),
+// policies are small trivially copyable values (rule 5), and counting nothing costs nothing.
+#include <type_traits>
+
+#include "common.hpp"
+
+namespace {
+
+using namespace nsp;
+
+// Spectral modes and media.
+static_assert(SpectralMode<Mono> && SpectralMode<Rgb>);
+static_assert(!SpectralMode<int>);
+static_assert(Medium<HomogeneousMedium<Mono>> && Medium<HomogeneousMedium<Rgb>>);
+static_assert(Medium<DenseGridMedium<Mono>> && Medium<DenseGridMedium<Rgb>>);
+static_assert(Medium<ExponentialMedium<Mono>> && Medium<ExponentialMedium<Rgb>>);
+static_assert(!Medium<int> && !Medium<Box>);
+
+// Majorants.
+static_assert(MajorantIterator<SingleSegmentIterator>);
+static_assert(MajorantPolicy<GlobalMajorant<HomogeneousMedium<Mono>>, HomogeneousMedium<Mono>>);
+static_assert(MajorantPolicy<GlobalMajorant<HomogeneousMedium<Rgb>>, HomogeneousMedium<Rgb>>);
+static_assert(MajorantPolicy<GlobalMajorant<DenseGridMedium<Mono>>, DenseGridMedium<Mono>>);
+static_assert(MajorantPolicy<GlobalMajorant<DenseGridMedium<Rgb>>, DenseGridMedium<Rgb>>);
+static_assert(MajorantPolicy<GlobalMajorant<ExponentialMedium<Mono>>, ExponentialMedium<Mono>>);
+static_assert(MajorantPolicy<GlobalMajorant<ExponentialMedium<Rgb>>, ExponentialMedium<Rgb>>);
+static_assert(GlobalMajorant<HomogeneousMedium<Mono>>::bounds_density);
+
+// Phase functions, RNG, counters, heuristics, policies.
+static_assert(PhaseFunction<IsotropicPhase> && PhaseFunction<HenyeyGreensteinPhase>);
+static_assert(!PhaseFunction<int>);
+static_assert(UniformRng<Pcg32> && !UniformRng<int>);
+static_assert(LookupCounter<NoLookupCount> && LookupCounter<LookupCount>);
+static_assert(!LookupCounter<int>);
+static_assert(mis::CombiningHeuristic<mis::Balance> && mis::CombiningHeuristic<mis::Power>);
+static_assert(!mis::CombiningHeuristic<mis::None>);
+static_assert(mis::Heuristic<mis::None> && mis::Heuristic<mis::Balance> && mis::Heuristic<mis::Power>);
+static_assert(AbsorptionPolicy<absorption::Event> && AbsorptionPolicy<absorption::Weight>);
+static_assert(PathStrategy<strategy::Unidirectional> && PathStrategy<strategy::NextEvent> &&
+              PathStrategy<strategy::DirectionalMis> && PathStrategy<strategy::NullScatteringMis>);
+
+// The tracking callbacks are collision callbacks.
+static_assert(CollisionCallback<DeltaCollision<absorption::Event, Rgb, Pcg32, NoRecord>, Rgb>);
+static_assert(CollisionCallback<RatioCollision<absorption::Weight, true, Mono, SegmentRecord>, Mono>);
+
+// NoLookupCount is stateless: a kernel instantiated with it carries no counter at all.
+static_assert(std::is_empty_v<NoLookupCount>);
+static_assert(!NoLookupCount::enabled && LookupCount::enabled);
+static_assert(std::is_empty_v<NoRecord> && !NoRecord::enabled);
+
+// Policies are small, trivially copyable values (STYLE rule 5). (Media hold Eigen arrays,
+// which are copyable but not trivially, so they are not listed.)
+static_assert(std::is_trivially_copyable_v<GlobalMajorant<DenseGridMedium<Rgb>>>);
+static_assert(std::is_trivially_copyable_v<IsotropicPhase> &&
+              std::is_trivially_copyable_v<HenyeyGreensteinPhase>);
+static_assert(std::is_trivially_copyable_v<mis::Power> && std::is_empty_v<mis::Balance>);
+static_assert(std::is_trivially_copyable_v<Pcg32>);
+// A heuristic without state adds nothing to an estimator ([[no_unique_address]]).
+static_assert(sizeof(PathEstimator<strategy::Unidirectional>) == sizeof(EstimatorOptions));
+
+TEST_CASE("NoLookupCount records nothing, LookupCount counts each lookup") {
+    NoLookupCount none;
+    LookupCount some;
+    for (int i = 0; i < 7; ++i) {
+        none.lookup();
+        some.lookup();
+    }
+    CHECK(none.count() == 0);
+    CHECK(some.count() == 7);
+}
+
+TEST_CASE("Pcg32 gives floats in [0, 1), deterministic per seed, different per stream") {
+    Pcg32 a(42, 1), b(42, 1), c(42, 2);
+    bool differs = false;
+    double sum = 0.0;
+    constexpr int n = 100000;
+    for (int i = 0; i < n; ++i) {
+        const float x = a.uniform();
+        REQUIRE(x >= 0.f);
+        REQUIRE(x < 1.f);
+        CHECK(x == b.uniform());
+        differs |= x != c.uniform();
+        sum += x;
+    }
+    CHECK(differs);
+    // Mean of U[0,1) is 1/2 with SE sqrt(1/12/n) = 9.1e-4; tolerance 5 SE.
+    CHECK(std::abs(sum / n - 0.5) < 5.0 * std::sqrt(1.0 / 12.0 / n));
+}
+
+}  // namespace

@@ -1,0 +1,100 @@
+// tests/test_default_scene.cpp: every estimator agrees on the mean radiance of the default scene
+// (examples/default_scene.hpp, light set-ups A and B, Mono) over a fixed 16 x 16 grid of camera
+// rays. The estimators differ wildly in variance (the paper's point, THEORY 7), not in mean.
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include "common.hpp"
+#include "default_scene.hpp"
+
+namespace {
+
+using namespace nsp_test;
+using nsp_examples::LightSetup;
+
+// k = 5 combined standard errors for each pair of independent runs.
+constexpr double kSigmas = 5.0;
+constexpr int kPixels = 16;
+
+struct Result {
+    std::string name;
+    Stat stat;  ///< one sample = the mean radiance of one pass over the 16 x 16 pixels
+};
+
+/// Mean image radiance of `passes` independent passes over the pixel grid, one path per pixel
+/// and pass. Each pass is one sample of the image mean, so the SE needs no stratification care.
+template <class E, class Sc>
+Result image_mean(const Sc& scene, int passes, std::uint64_t stream) {
+    const E est;
+    Result r{estimator_name<E>(), {}};
+    Pcg32 rng(2019, stream);
+    NoLookupCount none;
+    int not_ok = 0;
+    for (int p = 0; p < passes; ++p) {
+        double sum = 0.0;
+        for (int y = 0; y < kPixels; ++y)
+            for (int x = 0; x < kPixels; ++x) {
+                const Ray ray = nsp_examples::camera_ray((float(x) + 0.5f) / kPixels, (float(y) + 0.5f) / kPixels, 1.f);
+                const auto l = est.radiance(scene, ray, Mono::Wavelengths{}, rng, none);
+                not_ok += l.status != Status::Ok;
+                sum += double(l.value[0]);
+            }
+        r.stat.add(sum / (kPixels * kPixels));
+    }
+    CHECK(not_ok == 0);
+    return r;
+}
+
+/// Runs every estimator of the type list `Estimators` on `scene` and checks that each pair of
+/// means agrees within kSigmas combined standard errors.
+template <class Estimators, class Sc>
+void check_agreement(const Sc& scene, int passes, const std::string& setup_name) {
+    std::vector<Result> results;
+    std::uint64_t stream = 1;  // independent random streams, so the SEs of a pair combine
+    std::apply([&](auto... est) { (results.push_back(image_mean<decltype(est)>(scene, passes, stream++)), ...); },
+               Estimators{});
+    for (const Result& r : results) {
+        MESSAGE("set-up " << setup_name << ": " << r.name << " mean " << r.stat.mean << ", SE " << r.stat.se());
+        CHECK(r.stat.mean > 0.0);
+    }
+    for (std::size_t i = 0; i < results.size(); ++i)
+        for (std::size_t j = i + 1; j < results.size(); ++j) {
+            const Stat &a = results[i].stat, &b = results[j].stat;
+            CAPTURE(setup_name);
+            CAPTURE(results[i].name);
+            CAPTURE(results[j].name);
+            CAPTURE(a.mean);
+            CAPTURE(b.mean);
+            const double se = std::sqrt(a.se() * a.se() + b.se() * b.se());
+            CAPTURE(se);
+            CHECK(std::abs(a.mean - b.mean) <= kSigmas * se);
+        }
+}
+
+/// The estimators that sample lights (all but Unidirectional), with both absorption policies.
+template <AbsorptionPolicy A>
+using LightSamplingWith = std::tuple<PathEstimator<strategy::NextEvent, mis::None, A>,
+                                     PathEstimator<strategy::DirectionalMis, mis::Balance, A>,
+                                     PathEstimator<strategy::DirectionalMis, mis::Power, A>,
+                                     PathEstimator<strategy::NullScatteringMis, mis::Balance, A>,
+                                     PathEstimator<strategy::NullScatteringMis, mis::Power, A>>;
+using LightSampling = decltype(std::tuple_cat(LightSamplingWith<absorption::Event>{},
+                                              LightSamplingWith<absorption::Weight>{}));
+
+TEST_CASE("default scene, set-up A (small bright light): all light-sampling estimators agree") {
+    // 2048 passes: NEE contributions from vertices near the light are heavy-tailed (up to ~1e3 x
+    // the mean), so the SE needs many samples to be trustworthy; relative SE ~8 %.
+    // Unidirectional is left out here: it reaches the 0.05-radius light about 3 times in 2048
+    // passes (measured: one hit, mean = SE), so its mean is not normal and a k-SE test is
+    // meaningless (it would need ~1e5 passes; the paper's LTUV for it is 10.3 B). Set-up B below
+    // tests it sharply.
+    check_agreement<LightSampling>(nsp_examples::make_default_scene<Mono>(LightSetup::A), 2048, "A");
+}
+
+TEST_CASE("default scene, set-up B (large dim light): every estimator agrees") {
+    // 512 passes: relative SE 5e-4 (1.6e-3 for ratio NEE), so a 0.3 % bias in any estimator fails.
+    check_agreement<AllEstimators>(nsp_examples::make_default_scene<Mono>(LightSetup::B), 512, "B");
+}
+
+}  // namespace
