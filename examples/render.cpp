@@ -46,7 +46,7 @@ using namespace nsp_examples;
 // ---------------------------------------------------------------------------------------------
 // Command line
 
-constexpr int kDefaultWidth = 128, kDefaultHeight = 128, kDefaultSpp = 128;
+constexpr int kDefaultWidth = 128, kDefaultHeight = 128, kDefaultSpp = 512;
 
 /// The estimators of the default run: every estimator, both MIS heuristics, both absorption
 /// policies (THEORY 4 asks to measure both), in the Mono mode.
@@ -73,7 +73,7 @@ efficiency table per light set-up (LTUV = density lookups per sample x variance 
 
 usage: nsp_render [flags]
 
-  --spp N            samples per pixel, N >= 2 (default 128); the variance per sample is
+  --spp N            samples per pixel, N >= 2 (default 512); the variance per sample is
                      estimated from the N samples of each pixel
   --res WxH          image size in pixels (default 128x128); also --width W, --height H
   --threads N        worker threads (default: hardware concurrency)
