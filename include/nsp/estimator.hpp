@@ -52,6 +52,15 @@ concept PathStrategy = requires {
     { T::null_pdfs } -> std::convertible_to<bool>;
 };
 
+/// The unidirectional strategy's pdf of a light path segment relative to the shared prefix:
+/// q p_w, times prod_j P_n(n_j) when the strategy uses null-scattering pdfs (THEORY 5.1, 5.6).
+/// Both weights below use it, so the two sides of one path cannot disagree.
+template <PathStrategy St>
+float unidirectional_pdf(float survival, float phase_pdf, float null_pdf_product) noexcept {
+    if constexpr (St::null_pdfs) return survival * phase_pdf * null_pdf_product;
+    else return survival * phase_pdf;
+}
+
 /// MIS weight of the unidirectional technique for a path whose last segment, tracked from a real
 /// vertex with roulette survival `survival` and phase pdf `phase_pdf`, hit a light that NEE
 /// samples with solid-angle pdf `light_pdf`. `null_pdf_product` is prod_j P_n(n_j) of the
@@ -59,8 +68,7 @@ concept PathStrategy = requires {
 template <PathStrategy St, mis::CombiningHeuristic H>
 float unidirectional_weight(const H& h, float survival, float phase_pdf, float null_pdf_product,
                             float light_pdf) noexcept {
-    float p_uni = survival * phase_pdf;
-    if constexpr (St::null_pdfs) p_uni *= null_pdf_product;
+    const float p_uni = unidirectional_pdf<St>(survival, phase_pdf, null_pdf_product);
     return p_uni > 0.f ? h.weight(light_pdf / p_uni) : 0.f;
 }
 
@@ -70,9 +78,7 @@ float unidirectional_weight(const H& h, float survival, float phase_pdf, float n
 template <PathStrategy St, mis::CombiningHeuristic H>
 float next_event_weight(const H& h, float survival, float phase_pdf, float null_pdf_product,
                         float light_pdf) noexcept {
-    float p_uni = survival * phase_pdf;
-    if constexpr (St::null_pdfs) p_uni *= null_pdf_product;
-    return h.weight(p_uni / light_pdf);
+    return h.weight(unidirectional_pdf<St>(survival, phase_pdf, null_pdf_product) / light_pdf);
 }
 
 /// Run-time settings of a path estimator.
