@@ -51,11 +51,7 @@ void BM_Radiance(benchmark::State& state, LightSetup setup) {
         benchmark::DoNotOptimize(r);
         i = (i + 1) & kSetMask;
     }
-    if constexpr (C::enabled) {
-        const double n = double(counter.count());
-        state.counters["lookups/sample"] = benchmark::Counter(n, benchmark::Counter::kAvgIterations);
-        state.counters["lookups/s"] = benchmark::Counter(n, benchmark::Counter::kIsRate);
-    }
+    report_lookups(state, counter, "lookups/sample");
 }
 
 template <class K, class A, class S, class C = nsp::LookupCount>

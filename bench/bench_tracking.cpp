@@ -139,11 +139,7 @@ void BM_Track(benchmark::State& state) {
         benchmark::DoNotOptimize(r);
         i = (i + 1) & kSetMask;
     }
-    if constexpr (C::enabled) {
-        const double n = double(counter.count());
-        state.counters["lookups/call"] = benchmark::Counter(n, benchmark::Counter::kAvgIterations);
-        state.counters["lookups/s"] = benchmark::Counter(n, benchmark::Counter::kIsRate);
-    }
+    report_lookups(state, counter, "lookups/call");
 }
 
 BENCHMARK_TEMPLATE(BM_Track, DeltaEvent, Mono)->MinTime(kMinTime);

@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <vector>
 
+#include <benchmark/benchmark.h>
 #include <default_scene.hpp>
 #include <nsp/nsp.hpp>
 
@@ -130,6 +131,17 @@ inline const std::vector<nsp::Ray>& camera_rays() {
         return r;
     }();
     return rays;
+}
+
+/// Reports a counted run's lookups as two counters: per iteration (named `per_iteration`, e.g.
+/// "lookups/call") and per second. Does nothing with NoLookupCount.
+template <nsp::LookupCounter C>
+void report_lookups(benchmark::State& state, const C& counter, const char* per_iteration) {
+    if constexpr (C::enabled) {
+        const double n = double(counter.count());
+        state.counters[per_iteration] = benchmark::Counter(n, benchmark::Counter::kAvgIterations);
+        state.counters["lookups/s"] = benchmark::Counter(n, benchmark::Counter::kIsRate);
+    }
 }
 
 }  // namespace nsp_bench
