@@ -84,6 +84,7 @@ public:
     typename Spectral::Spectrum extinction_bound(const typename Spectral::Wavelengths& l) const {
         return m_->extinction_bound(l);
     }
+    float max_extinction() const noexcept { return m_->max_extinction(); }
 
 private:
     const M* m_;

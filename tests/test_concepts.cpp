@@ -17,7 +17,7 @@ static_assert(Medium<ExponentialMedium<Mono>> && Medium<ExponentialMedium<Rgb>>)
 static_assert(!Medium<int> && !Medium<Box>);
 
 // Majorants.
-static_assert(MajorantIterator<SingleSegmentIterator>);
+static_assert(MajorantIterator<SingleSegmentIterator<>> && MajorantIterator<SingleSegmentIterator<Rgb::Spectrum>>);
 static_assert(MajorantPolicy<GlobalMajorant<HomogeneousMedium<Mono>>, HomogeneousMedium<Mono>>);
 static_assert(MajorantPolicy<GlobalMajorant<HomogeneousMedium<Rgb>>, HomogeneousMedium<Rgb>>);
 static_assert(MajorantPolicy<GlobalMajorant<DenseGridMedium<Mono>>, DenseGridMedium<Mono>>);

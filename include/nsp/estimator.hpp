@@ -138,6 +138,9 @@ public:
     RadianceSample<typename Sc::Spectral> radiance(const Sc& scene, const Ray& camera_ray,
                                                    const typename Sc::Spectral::Wavelengths& lambda,
                                                    R& rng, C& counter) const {
+        static_assert(!is_per_channel_majorant_v<typename Sc::MajorantType, typename Sc::MediumType>,
+                      "nsp::PathEstimator drives every channel with one pdf and needs a grey majorant "
+                      "(GlobalMajorant); per-channel majorants go with nsp::SpectralPathEstimator");
         using Spectrum = typename Sc::Spectrum;
         Spectrum L = Spectrum::Zero(), beta = Spectrum::Ones();
         Status status = Status::Ok;
@@ -164,7 +167,7 @@ public:
                                                           seg.null_pdf_product,
                                                           scene.lights.pdf(prev_x, hit));
                     }
-                    L += w * beta * scene.lights.emitted(hit);
+                    L += w * beta * scene.lights.emitted(hit, lambda);
                 }
                 break;
             }
@@ -205,7 +208,7 @@ private:
                     const typename Sc::Spectral::Wavelengths& lambda, R& rng, C& counter,
                     const typename Sc::Spectrum& beta, typename Sc::Spectrum& L) const {
         const float u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
-        const LightSample<typename Sc::Spectral> ls = scene.lights.sample(x, u0, u1, u2);
+        const LightSample<typename Sc::Spectral> ls = scene.lights.sample(x, u0, u1, u2, lambda);
         if (!(ls.pdf > 0.f)) return false;
         const Ray shadow{x, ls.wi};
         if (ls.occludable_by_sphere && scene.lights.sphere_blocks(shadow, ls.distance)) return false;

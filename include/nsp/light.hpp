@@ -17,7 +17,7 @@ namespace nsp {
 template <SpectralMode S>
 struct PointLight {
     Vec3 position;
-    typename S::Spectrum intensity;
+    typename S::Coefficient intensity;
 };
 
 /// A sphere emitting radiance `radiance` from its surface, outward. Opaque: it blocks light.
@@ -25,13 +25,13 @@ template <SpectralMode S>
 struct SphereLight {
     Vec3 center;
     float radius;
-    typename S::Spectrum radiance;
+    typename S::Coefficient radiance;
 };
 
 /// Constant radiance arriving from every direction at infinity.
 template <SpectralMode S>
 struct EnvironmentLight {
-    typename S::Spectrum radiance;
+    typename S::Coefficient radiance;
 };
 
 /// What a ray meets first among the lights.
@@ -94,10 +94,10 @@ public:
         return {t, t < kInf};
     }
 
-    /// Radiance a ray receives at `hit`: the sphere's, the environment's, or zero.
-    Spectrum emitted(const LightHit& hit) const noexcept {
-        if (hit.sphere) return sphere_->radiance;
-        if (env_) return env_->radiance;
+    /// Radiance a ray receives at `hit` at wavelengths l: the sphere's, the environment's, or zero.
+    Spectrum emitted(const LightHit& hit, const typename S::Wavelengths& l = {}) const noexcept {
+        if (hit.sphere) return S::sample(sphere_->radiance, l);
+        if (env_) return S::sample(env_->radiance, l);
         return Spectrum::Zero();
     }
 
@@ -111,8 +111,9 @@ public:
 
     /// Chooses a light uniformly with u0 and samples a direction toward it with (u1, u2):
     /// uniform in the cone the sphere subtends, uniform on the sphere of directions for the
-    /// environment. Returns pdf 0 when there is no light.
-    LightSample<S> sample(const Vec3& x, float u0, float u1, float u2) const noexcept {
+    /// environment; radiance at wavelengths l. Returns pdf 0 when there is no light.
+    LightSample<S> sample(const Vec3& x, float u0, float u1, float u2,
+                          const typename S::Wavelengths& l = {}) const noexcept {
         LightSample<S> s{Vec3(0.f, 0.f, 1.f), kInf, Spectrum::Zero(), 0.f, false, false};
         const int n = count();
         if (n == 0) return s;
@@ -124,7 +125,7 @@ public:
             if (!(d2 > 0.f)) return s;
             s.distance = std::sqrt(d2);
             s.wi = d / s.distance;
-            s.radiance = point_->intensity / d2;
+            s.radiance = S::sample(point_->intensity, l) / d2;
             s.pdf = sel;
             s.delta = true;
             s.occludable_by_sphere = sphere_.has_value();
@@ -144,12 +145,12 @@ public:
             if (!(t < kInf))  // grazing: the tangent distance
                 t = d * cos_theta - std::sqrt(std::max(0.f, r * r - d * d * (1.f - cos_theta * cos_theta)));
             s.distance = t;
-            s.radiance = sphere_->radiance;
+            s.radiance = S::sample(sphere_->radiance, l);
             s.pdf = sel / (2.f * kPi * one_minus_cos);
             return s;
         }
         s.wi = uniform_sphere(u1, u2);
-        s.radiance = env_->radiance;
+        s.radiance = S::sample(env_->radiance, l);
         s.pdf = sel * kInv4Pi;
         s.occludable_by_sphere = sphere_.has_value();
         return s;

@@ -1,11 +1,14 @@
 // nsp/nsp.hpp: the umbrella header, everything nsp offers.
 #pragma once
 
+#include "channel_tracking.hpp"
+#include "color.hpp"
 #include "core/counter.hpp"
 #include "core/error.hpp"
 #include "core/math.hpp"
 #include "core/rng.hpp"
 #include "estimator.hpp"
+#include "estimators/spectral.hpp"
 #include "light.hpp"
 #include "majorant.hpp"
 #include "media/exponential.hpp"
@@ -13,6 +16,7 @@
 #include "media/homogeneous.hpp"
 #include "medium.hpp"
 #include "mis.hpp"
+#include "path_pdf.hpp"
 #include "pdf.hpp"
 #include "phase.hpp"
 #include "scene.hpp"

@@ -16,6 +16,7 @@ namespace nsp {
 template <Medium M, MajorantPolicy<M> Maj, PhaseFunction P>
 struct Scene {
     using MediumType = M;
+    using MajorantType = Maj;
     using Spectral = typename M::Spectral;
     using Spectrum = typename Spectral::Spectrum;
 

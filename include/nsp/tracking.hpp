@@ -10,6 +10,7 @@
 #include <concepts>
 #include <cstdint>
 #include <limits>
+#include <type_traits>
 #include <vector>
 
 #include "core/counter.hpp"
@@ -88,12 +89,14 @@ struct SegmentRecord {
 // ---------------------------------------------------------------------------------------------
 // The free-flight loop
 
-/// How a call of `free_flight` ended.
+/// How a call of `free_flight` ended. V is the majorant's value type (float, or a Spectrum for a
+/// per-channel majorant).
+template <class V = float>
 struct FlightEnd {
     bool stopped = false;   ///< the callback stopped at `t`; otherwise the ray passed tmax
     bool aborted = false;   ///< gave up after `max_collisions` tentative collisions
     float t = 0.f;          ///< the stopping distance
-    float tau_tail = 0.f;   ///< majorant optical depth from the last collision to tmax if passed
+    V tau_tail{};           ///< majorant optical depth from the last collision to tmax if passed
 };
 
 /// The default limit on tentative collisions in one flight. It only matters where a majorant is
@@ -102,26 +105,42 @@ inline constexpr std::uint32_t kDefaultMaxCollisions = 1u << 24;
 
 /// A collision callback: `cb(t, coefficients, mu_bar, tau)` returns true to go on (a null
 /// collision) or false to stop at t; `tau` is the majorant optical depth since the previous
-/// tentative collision (or the origin), so exp(-tau) is Tbar between them.
-template <class F, class S>
-concept CollisionCallback = requires(F& f, float t, const Coefficients<S>& c) {
-    { f(t, c, t, t) } -> std::same_as<bool>;
+/// tentative collision (or the origin), so exp(-tau) is Tbar between them. mu_bar and tau are
+/// floats for a grey majorant and Spectra (one per channel) for a per-channel one.
+template <class F, class S, class V = float>
+concept CollisionCallback = requires(F& f, float t, const Coefficients<S>& c, const V& v) {
+    { f(t, c, v, v) } -> std::same_as<bool>;
 };
 
 /// Samples tentative collisions with density mu_bar(t) Tbar(tmin, t) along `ray` over
-/// [tmin, tmax], segment by segment, and calls `on_collision` at each (THEORY 4.1). Counts one
-/// density lookup per tentative collision. Never throws.
-template <Medium M, MajorantPolicy<M> Maj, UniformRng R, LookupCounter C,
-          CollisionCallback<typename M::Spectral> F>
-FlightEnd free_flight(const M& medium, const Maj& majorant, const Ray& ray, float tmin, float tmax,
-                      const typename M::Spectral::Wavelengths& lambda, R& rng, C& counter,
-                      F&& on_collision, std::uint32_t max_collisions = kDefaultMaxCollisions) {
+/// [tmin, tmax], segment by segment, and calls `on_collision` at each (THEORY 4.1). With a
+/// per-channel majorant, `channel` is the sampling channel c*: distances are drawn with its
+/// majorant and every channel's optical depth is accumulated over the same stretches (THEORY
+/// 5.3). Counts one density lookup per tentative collision. Never throws.
+template <Medium M, MajorantPolicy<M> Maj, UniformRng R, LookupCounter C, class F>
+    requires CollisionCallback<F, typename M::Spectral, MajorantValue<Maj, M>>
+FlightEnd<MajorantValue<Maj, M>> free_flight(const M& medium, const Maj& majorant, const Ray& ray, float tmin,
+                                             float tmax, const typename M::Spectral::Wavelengths& lambda, R& rng,
+                                             C& counter, F&& on_collision,
+                                             std::uint32_t max_collisions = kDefaultMaxCollisions,
+                                             int channel = 0) {
+    using V = MajorantValue<Maj, M>;
+    constexpr bool grey = std::is_same_v<V, float>;
     auto segments = majorant.iterate(ray, tmin, tmax, lambda);
-    float tau = 0.f;            // majorant optical depth since the last tentative collision
+    V tau{};                    // majorant optical depth since the last tentative collision
+    if constexpr (!grey) tau.setZero();
+    // Adds the optical depth of a stretch of `len` on a segment (per channel: 0 * inf stays 0).
+    auto add_depth = [&](const V& mu, float len) {
+        if constexpr (grey) tau += mu * len;
+        else tau += (mu > 0.f).select(mu * len, 0.f);
+    };
     std::uint32_t collisions = 0;
     while (auto seg = segments.next()) {
-        const float mu_bar = seg->sigma_maj;
-        if (!(mu_bar > 0.f)) continue;  // nothing to collide with on this segment
+        const float mu_bar = channel_of(seg->sigma_maj, channel);
+        if (!(mu_bar > 0.f)) {  // nothing to collide with on this segment
+            if constexpr (!grey) add_depth(seg->sigma_maj, seg->t1 - seg->t0);
+            continue;
+        }
         float t = seg->t0;
         for (;;) {
             // Exponential step: E = -ln(1 - u) majorant optical depths. logf, not log1pf: 1 - u is
@@ -130,17 +149,19 @@ FlightEnd free_flight(const M& medium, const Maj& majorant, const Ray& ray, floa
             const float e = -std::log(1.f - rng.uniform());
             const float dt = e / mu_bar;
             if (!(dt < seg->t1 - t)) {  // the step leaves the segment (also catches inf)
-                tau += mu_bar * (seg->t1 - t);
+                add_depth(seg->sigma_maj, seg->t1 - t);
                 break;
             }
             t += dt;
-            tau += e;
-            if (++collisions > max_collisions) return {false, true, t, 0.f};
+            if constexpr (grey) tau += e;
+            else add_depth(seg->sigma_maj, dt);
+            if (++collisions > max_collisions) return {false, true, t, V{}};
             counter.lookup();
             const auto coeff = medium.coefficients(ray.at(t), lambda);
-            const float tau_step = tau;
-            tau = 0.f;
-            if (!on_collision(t, coeff, mu_bar, tau_step)) return {true, false, t, 0.f};
+            const V tau_step = tau;
+            if constexpr (grey) tau = 0.f;
+            else tau.setZero();
+            if (!on_collision(t, coeff, seg->sigma_maj, tau_step)) return {true, false, t, V{}};
         }
     }
     return {false, false, tmax, tau};
@@ -241,7 +262,7 @@ DeltaTrack<typename M::Spectral> track_delta(const M& medium, const Maj& majoran
                                              R& rng, C& counter, Rec&& rec = Rec{}) {
     using S = typename M::Spectral;
     DeltaCollision<A, S, R, std::remove_reference_t<Rec>> cb{rng, rec};
-    const FlightEnd f = free_flight(medium, majorant, ray, 0.f, tmax, lambda, rng, counter, cb);
+    const auto f = free_flight(medium, majorant, ray, 0.f, tmax, lambda, rng, counter, cb);
     if (f.aborted) return {SegmentEnd::Aborted, f.t, S::Spectrum::Zero(), 1.f};
     if (!f.stopped) {
         cb.out.end = SegmentEnd::Passed;
@@ -260,7 +281,7 @@ RatioTrack<typename M::Spectral> track_ratio(const M& medium, const Maj& majoran
                                              R& rng, C& counter, Rec&& rec = Rec{}) {
     using S = typename M::Spectral;
     RatioCollision<A, kNullRatio, S, std::remove_reference_t<Rec>> cb{rec};
-    const FlightEnd f = free_flight(medium, majorant, ray, 0.f, tmax, lambda, rng, counter, cb);
+    const auto f = free_flight(medium, majorant, ray, 0.f, tmax, lambda, rng, counter, cb);
     if (f.aborted) return {SegmentEnd::Aborted, S::Spectrum::Zero(), 1.f};
     if constexpr (std::remove_reference_t<Rec>::enabled)
         if (!f.stopped) rec.log_pdf -= f.tau_tail;

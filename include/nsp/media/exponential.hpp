@@ -17,11 +17,12 @@ class ExponentialMedium {
 public:
     using Spectral = S;
     using Spectrum = typename S::Spectrum;
+    using Coefficient = typename S::Coefficient;  ///< how coefficients are given (a tabulated spectrum in Hero mode)
 
     /// Throws InvalidArgument on non-finite or negative d0 or scales, non-finite k, a zero axis or
     /// an empty box. `axis` is normalised.
     ExponentialMedium(const Box& bounds, const Vec3& axis, float d0, float k,
-                      const Spectrum& sigma_a_scale, const Spectrum& sigma_s_scale)
+                      const Coefficient& sigma_a_scale, const Coefficient& sigma_s_scale)
         : bounds_(bounds), d0_(d0), k_(k), sigma_a_(sigma_a_scale), sigma_s_(sigma_s_scale) {
         detail::require_box(bounds, "ExponentialMedium bounds");
         detail::require_finite_nonnegative(d0, "ExponentialMedium d0");
@@ -55,17 +56,23 @@ public:
         return d0_ * std::exp(k_ * glm::dot(p - bounds_.lo, axis_));
     }
 
-    Coefficients<S> coefficients(const Vec3& p, const typename S::Wavelengths&) const noexcept {
+    Coefficients<S> coefficients(const Vec3& p, const typename S::Wavelengths& l) const noexcept {
         const float d = density(p);
-        return {sigma_a_ * d, sigma_s_ * d};
+        return {S::sample(sigma_a_, l) * d, S::sample(sigma_s_, l) * d};
     }
 
-    Spectrum extinction_bound(const typename S::Wavelengths&) const noexcept {
-        return (sigma_a_ + sigma_s_) * max_density_;
+    Spectrum extinction_bound(const typename S::Wavelengths& l) const noexcept {
+        return (S::sample(sigma_a_, l) + S::sample(sigma_s_, l)) * max_density_;
     }
 
-    /// The exact optical depth int mu_t dt over [t0, t1] of `ray` clipped to the box, in double.
-    Spectrum optical_depth(const Ray& ray, float t0, float t1) const noexcept {
+    float max_extinction() const noexcept { return max_value(sigma_a_ + sigma_s_) * max_density_; }
+
+    /// The per-channel extinction bound as a coefficient (what ChannelMajorant stores).
+    Coefficient extinction_bound_coefficient() const { return scale<Coefficient>(sigma_a_ + sigma_s_, max_density_); }
+
+    /// The exact optical depth int mu_t dt over [t0, t1] of `ray` clipped to the box at
+    /// wavelengths l, in double.
+    Spectrum optical_depth(const Ray& ray, float t0, float t1, const typename S::Wavelengths& l = {}) const noexcept {
         const Interval in = bounds_.clip(ray, t0, t1);
         if (in.empty()) return Spectrum::Zero();
         const double s0 = glm::dot(ray.o - bounds_.lo, axis_);
@@ -76,14 +83,14 @@ public:
         // int_{t0}^{t1} e^{k(s0 + b t)} dt = e^{a0} * (e^{kb len} - 1) / kb, via expm1 for small kb.
         const double integral = std::abs(kb * len) < 1e-12 ? std::exp(a0) * len
                                                             : std::exp(a0) * std::expm1(kb * len) / kb;
-        return (sigma_a_ + sigma_s_) * float(double(d0_) * integral);
+        return (S::sample(sigma_a_, l) + S::sample(sigma_s_, l)) * float(double(d0_) * integral);
     }
 
 private:
     Box bounds_;
     Vec3 axis_{1.f, 0.f, 0.f};
     float d0_, k_;
-    Spectrum sigma_a_, sigma_s_;
+    Coefficient sigma_a_, sigma_s_;
     float max_density_ = 0.f;
 };
 

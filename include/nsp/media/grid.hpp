@@ -20,11 +20,12 @@ class DenseGridMedium {
 public:
     using Spectral = S;
     using Spectrum = typename S::Spectrum;
+    using Coefficient = typename S::Coefficient;  ///< how coefficients are given (a tabulated spectrum in Hero mode)
 
     /// Throws InvalidArgument on an empty grid, a size that does not match `resolution`, a
     /// negative or non-finite density or scale, or an empty box.
     DenseGridMedium(const Box& bounds, std::array<int, 3> resolution, std::vector<float> density,
-                    const Spectrum& sigma_a_scale, const Spectrum& sigma_s_scale)
+                    const Coefficient& sigma_a_scale, const Coefficient& sigma_s_scale)
         : bounds_(bounds), res_(resolution), density_(std::move(density)),
           sigma_a_(sigma_a_scale), sigma_s_(sigma_s_scale) {
         detail::require_box(bounds, "DenseGridMedium bounds");
@@ -86,21 +87,26 @@ public:
     }
 
     /// One density lookup, scaled per channel.
-    Coefficients<S> coefficients(const Vec3& p, const typename S::Wavelengths&) const noexcept {
+    Coefficients<S> coefficients(const Vec3& p, const typename S::Wavelengths& l) const noexcept {
         const float d = density(p);
-        return {sigma_a_ * d, sigma_s_ * d};
+        return {S::sample(sigma_a_, l) * d, S::sample(sigma_s_, l) * d};
     }
 
     /// max density times the extinction scale: trilinear weights are convex, so this bounds mu_t.
-    Spectrum extinction_bound(const typename S::Wavelengths&) const noexcept {
-        return (sigma_a_ + sigma_s_) * max_density_;
+    Spectrum extinction_bound(const typename S::Wavelengths& l) const noexcept {
+        return (S::sample(sigma_a_, l) + S::sample(sigma_s_, l)) * max_density_;
     }
+
+    float max_extinction() const noexcept { return max_value(sigma_a_ + sigma_s_) * max_density_; }
+
+    /// The per-channel extinction bound as a coefficient (what ChannelMajorant stores).
+    Coefficient extinction_bound_coefficient() const { return scale<Coefficient>(sigma_a_ + sigma_s_, max_density_); }
 
 private:
     Box bounds_;
     std::array<int, 3> res_;
     std::vector<float> density_;
-    Spectrum sigma_a_, sigma_s_;
+    Coefficient sigma_a_, sigma_s_;
     float max_density_ = 0.f;
     Vec3 inv_extent_{1.f};
 };

@@ -1,0 +1,186 @@
+// nsp/path_pdf.hpp: the per-channel path-pdf state behind spectral MIS (THEORY 5.1, 5.3, 5.6).
+//
+// A path is sampled with one channel c* (chosen with probability q_c*), and every channel c keeps
+// its own contribution f_c and its own path pdf p_c of the same vertices. nsp never stores
+// absolute path pdfs (they underflow): the state holds f_c / K and p_c / K for one common
+// normaliser K, rescaled after every vertex so that the largest pdf is 1 (STYLE rule 7: O(C)
+// numbers per technique, no C x C matrix). Every estimate is a ratio in which K cancels:
+//
+//     estimate_lambda = f_lambda / sum_c q_c (p_uni,c + p_nee,c)          (THEORY 5.3 with 5.1)
+//
+// The channel policies below decide what the pdfs are (each channel's own tracking, or one shared
+// pdf) and which channels share a denominator. Equiangular sampling, emissive media and
+// volumetric BDPT (ROADMAP 4, 6) add techniques to the same sum.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <concepts>
+
+#include "core/error.hpp"
+#include "spectrum.hpp"
+
+namespace nsp {
+
+// ---------------------------------------------------------------------------------------------
+// Channel policies (the tracking axis over channels)
+
+namespace channels {
+/// Independent tracking: one channel per path, tracked with its own majorant and event
+/// probabilities; the other channels are estimated as zero and the chosen one is divided by its
+/// selection probability (unbiased, colour noise).
+struct Independent {
+    static constexpr const char* name = "independent";
+    static constexpr bool own_pdfs = true;           ///< each channel has its own tracking pdf
+    static constexpr bool mis_over_channels = false; ///< channel c's estimate uses c's pdf alone
+    static constexpr bool throughput_weighted = false;
+};
+/// Spectral tracking (Kutz et al. 2017), maximum variant: one grey majorant bounding every
+/// channel, event probabilities from the channel maxima of mu_a, mu_s, mu_n; one pdf for all
+/// channels, per-channel weights mu_x,c / (mu_bar P_x).
+struct SpectralTrackingMax {
+    static constexpr const char* name = "spectral-tracking-max";
+    static constexpr bool own_pdfs = false;
+    static constexpr bool mis_over_channels = true;  ///< one shared pdf: the sum is that pdf
+    static constexpr bool throughput_weighted = false;
+};
+/// Spectral tracking, history-aware average variant: probabilities from sum_c |w_c| mu_x,c with
+/// w the current path throughput.
+struct SpectralTrackingAverage {
+    static constexpr const char* name = "spectral-tracking-avg";
+    static constexpr bool own_pdfs = false;
+    static constexpr bool mis_over_channels = true;
+    static constexpr bool throughput_weighted = true;
+};
+/// Spectral MIS (THEORY 5.3): each channel its own majorant and event probabilities, the channel
+/// chosen per path, one-sample balance heuristic over channels.
+struct SpectralMis {
+    static constexpr const char* name = "spectral-mis";
+    static constexpr bool own_pdfs = true;
+    static constexpr bool mis_over_channels = true;
+    static constexpr bool throughput_weighted = false;
+};
+}  // namespace channels
+
+/// A channel policy says whether each channel has its own tracking pdf (`own_pdfs`: its own
+/// majorant and event probabilities) or all share one, whether one channel's estimate combines
+/// every channel's pdf (`mis_over_channels`), and whether shared event probabilities weigh the
+/// channels by the path throughput (`throughput_weighted`).
+template <class P>
+concept ChannelPolicy = requires {
+    { P::name } -> std::convertible_to<const char*>;
+    { P::own_pdfs } -> std::convertible_to<bool>;
+    { P::mis_over_channels } -> std::convertible_to<bool>;
+    { P::throughput_weighted } -> std::convertible_to<bool>;
+} && (P::own_pdfs || P::mis_over_channels);  // a shared pdf is one technique: nothing to keep apart
+
+static_assert(ChannelPolicy<channels::Independent> && ChannelPolicy<channels::SpectralTrackingMax> &&
+              ChannelPolicy<channels::SpectralTrackingAverage> && ChannelPolicy<channels::SpectralMis>);
+
+// ---------------------------------------------------------------------------------------------
+// Channel selection
+
+/// The probabilities q_c with which a path's sampling channel is chosen (THEORY 5.3). They are
+/// fixed before the path is sampled and may be non-uniform, e.g. proportional to luminance or to
+/// a per-pixel estimate of each channel's contribution.
+template <SpectralMode S>
+class ChannelSelection {
+public:
+    using Spectrum = typename S::Spectrum;
+
+    /// Uniform selection, q_c = 1 / C.
+    ChannelSelection() : q_(Spectrum::Constant(1.f / float(S::channels))) { build_cdf(); }
+
+    /// Selection proportional to `weights`. Throws InvalidArgument unless every weight is finite
+    /// and > 0: a channel that is never chosen would not be estimated at all by independent
+    /// tracking, and spectral MIS would estimate it from the other channels' pdfs alone.
+    explicit ChannelSelection(const Spectrum& weights) {
+        for (int c = 0; c < S::channels; ++c)
+            if (!std::isfinite(weights[c]) || !(weights[c] > 0.f))
+                detail::fail("ChannelSelection weight[", c, "] = ", weights[c],
+                             " is not allowed: every channel needs a finite weight > 0");
+        q_ = weights / weights.sum();
+        build_cdf();
+    }
+
+    /// The probabilities q_c (summing to 1).
+    const Spectrum& probabilities() const noexcept { return q_; }
+
+    /// The channel chosen by u in [0, 1).
+    int sample(float u) const noexcept {
+        for (int c = 0; c + 1 < S::channels; ++c)
+            if (u < cdf_[c]) return c;
+        return S::channels - 1;
+    }
+
+private:
+    void build_cdf() {
+        float acc = 0.f;
+        for (int c = 0; c < S::channels; ++c) cdf_[c] = (acc += q_[c]);
+        cdf_[S::channels - 1] = 1.f;
+    }
+
+    Spectrum q_;
+    Spectrum cdf_;
+};
+
+// ---------------------------------------------------------------------------------------------
+// The state
+
+/// What a path carries per channel, all relative to one normaliser K (see the file comment):
+/// `f` = f_c / K, `uni` = p_c / K of the path as sampled so far by unidirectional tracking with
+/// channel c, and `nee` = the pdf / K with which next-event estimation from the last real vertex
+/// would have produced the current segment's nulls (ratio tracking with channel c's majorant),
+/// without the light pdf, which is only known where the segment ends (THEORY 5.1).
+template <SpectralMode S>
+struct ChannelPathState {
+    using Spectrum = typename S::Spectrum;
+    Spectrum f = Spectrum::Ones();
+    Spectrum uni = Spectrum::Ones();
+    Spectrum nee = Spectrum::Zero();
+
+    /// Rescales f, uni and nee by one factor: by the sampling channel's pdf `uni[c]` when only
+    /// that channel is ever estimated (independent tracking), else so that the largest pdf is 1.
+    /// Returns false if there is no positive finite pdf left to scale by (the path is dead).
+    template <ChannelPolicy CP>
+    bool renormalize(int c) noexcept {
+        const float k = CP::mis_over_channels ? std::max(uni.maxCoeff(), nee.maxCoeff()) : uni[c];
+        if (!(k > 0.f) || !std::isfinite(k)) return false;
+        f /= k;
+        uni /= k;
+        nee /= k;
+        return true;
+    }
+};
+
+/// The one-sample estimate of every channel from contributions `f` and the summed technique pdfs
+/// `pdf` of each channel (same normaliser; sampling channel c, selection probabilities q):
+/// f_lambda / sum_c q_c pdf_c with MIS over channels, else f_c / (q_c pdf_c) for c alone and 0
+/// for the others. A zero denominator gives 0 (nothing was sampled there). Never NaN from 0/0.
+template <ChannelPolicy CP, class Spec>
+Spec channel_estimate(const Spec& f, const Spec& pdf, const Spec& q, int c) noexcept {
+    if constexpr (CP::mis_over_channels) {
+        const float d = (q * pdf).sum();
+        return d > 0.f ? Spec(f / d) : Spec(Spec::Zero());
+    } else {
+        Spec out = Spec::Zero();
+        const float d = q[c] * pdf[c];
+        if (d > 0.f) out[c] = f[c] / d;
+        return out;
+    }
+}
+
+/// The throughput f / p the path carries, for Russian roulette: with MIS over channels the
+/// estimate above; for independent tracking f_c / p_c of the sampling channel alone (without
+/// 1 / q_c, which is not part of the path's attenuation).
+template <ChannelPolicy CP, class Spec>
+Spec channel_throughput(const Spec& f, const Spec& pdf, const Spec& q, int c) noexcept {
+    if constexpr (CP::mis_over_channels) return channel_estimate<CP>(f, pdf, q, c);
+    else {
+        Spec out = Spec::Zero();
+        if (pdf[c] > 0.f) out[c] = f[c] / pdf[c];
+        return out;
+    }
+}
+
+}  // namespace nsp
