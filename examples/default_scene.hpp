@@ -91,27 +91,71 @@ inline constexpr float kPhaseG = 0.9f;
 /// The lights of set-up A or B.
 template <nsp::SpectralMode S>
 nsp::Lights<S> default_lights(LightSetup setup) {
-    using Spec = typename S::Spectrum;
     nsp::Lights<S> lights;
     if (setup == LightSetup::A)  // above and in front of the cloud, out of view; subtends ~0.005 sr
-        lights.set(nsp::SphereLight<S>{nsp::Vec3(0.8f, 2.2f, -0.6f), 0.1f, Spec::Constant(8000.f)});
+        lights.set(nsp::SphereLight<S>{nsp::Vec3(0.8f, 2.2f, -0.6f), 0.1f, nsp::constant_coefficient<S>(8000.f)});
     else  // behind the cloud, seen as a disc around it; a cone of half-angle ~44 deg at the cloud
-        lights.set(nsp::SphereLight<S>{nsp::Vec3(0.f, 0.f, 4.f), 2.8f, Spec::Constant(1.f)});
+        lights.set(nsp::SphereLight<S>{nsp::Vec3(0.f, 0.f, 4.f), 2.8f, nsp::constant_coefficient<S>(1.f)});
     return lights;
 }
 
 /// The default medium: the cloud on a kGridRes^3 grid over [-1, 1]^3 with kSigmaA and kSigmaS.
 template <nsp::SpectralMode S>
 nsp::DenseGridMedium<S> make_default_medium() {
-    using Spec = typename S::Spectrum;
     return {nsp::Box{nsp::Vec3(-1.f), nsp::Vec3(1.f)}, {kGridRes, kGridRes, kGridRes},
-            default_cloud_density(), Spec::Constant(kSigmaA), Spec::Constant(kSigmaS)};
+            default_cloud_density(), nsp::constant_coefficient<S>(kSigmaA), nsp::constant_coefficient<S>(kSigmaS)};
 }
 
 /// The default scene: the cloud with the tightest global majorant, HG phase, set-up lights.
 template <nsp::SpectralMode S>
 auto make_default_scene(LightSetup setup) {
     return nsp::make_scene(make_default_medium<S>(), nsp::HenyeyGreensteinPhase(kPhaseG), default_lights<S>(setup));
+}
+
+// ---------------------------------------------------------------------------------------------
+// The chromatic scene (THEORY 7, the paper's chromatic smoke): the same cloud, extinction scales
+// 1 : 4 : 16 (R : G : B) per unit density and albedo 0.95 in every channel.
+
+/// The chromatic cloud's extinction per unit density in R, G and B: G equals the grey cloud's.
+inline constexpr float kChromaticExtinction[3] = {5.f, 20.f, 80.f};
+/// The chromatic cloud's single-scattering albedo (every channel).
+inline constexpr float kChromaticAlbedo = 0.95f;
+
+/// The two light set-ups of the chromatic scene, modelled on the paper's two smoke scenes.
+enum class ChromaticSetup {
+    Env,    ///< 1: a constant white environment; phase sampling finds it (unidirectional paths dominate)
+    Small,  ///< 2: set-up A's small bright sphere light above the cloud; NEE matters
+};
+
+inline const char* name(ChromaticSetup s) { return s == ChromaticSetup::Env ? "C1" : "C2"; }
+
+/// The chromatic extinction as a coefficient of mode S. In Hero mode a piecewise-linear spectrum
+/// through the RGB values at 610 (R), 550 (G) and 465 nm (B), flat beyond.
+template <nsp::SpectralMode S>
+typename S::Coefficient chromatic_extinction() {
+    const float* k = kChromaticExtinction;
+    if constexpr (nsp::is_hero_v<S>) return nsp::TabulatedSpectrum::from_points({465.f, 550.f, 610.f}, {k[2], k[1], k[0]});
+    else if constexpr (S::channels == 3) return typename S::Spectrum(k[0], k[1], k[2]);
+    else return S::Spectrum::Constant(k[1]);  // Mono: the green channel
+}
+
+/// The chromatic cloud: the default density grid with the chromatic extinction and albedo.
+template <nsp::SpectralMode S>
+nsp::DenseGridMedium<S> make_chromatic_medium() {
+    const auto ext = chromatic_extinction<S>();
+    return {nsp::Box{nsp::Vec3(-1.f), nsp::Vec3(1.f)}, {kGridRes, kGridRes, kGridRes}, default_cloud_density(),
+            nsp::scale(ext, 1.f - kChromaticAlbedo), nsp::scale(ext, kChromaticAlbedo)};
+}
+
+/// The lights of chromatic set-up 1 or 2 (white: every channel or wavelength the same).
+template <nsp::SpectralMode S>
+nsp::Lights<S> chromatic_lights(ChromaticSetup setup) {
+    nsp::Lights<S> lights;
+    if (setup == ChromaticSetup::Env)
+        lights.set(nsp::EnvironmentLight<S>{nsp::constant_coefficient<S>(1.f)});
+    else
+        lights.set(nsp::SphereLight<S>{nsp::Vec3(0.8f, 2.2f, -0.6f), 0.1f, nsp::constant_coefficient<S>(8000.f)});
+    return lights;
 }
 
 /// The camera ray through normalised image coordinates (u, v) in [0, 1]^2, v up, square pixels

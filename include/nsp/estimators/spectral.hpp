@@ -22,17 +22,25 @@
 namespace nsp {
 
 /// A path estimator over channels: channel policy CP, strategy St (Unidirectional, NextEvent or
-/// NullScatteringMis; the MIS weights are the one-sample balance heuristic over channels and
+/// NullScatteringMis), heuristic H (mis::None for a single strategy, mis::Balance for
+/// NullScatteringMis: the weights are the one-sample balance heuristic over channels and
 /// techniques) and absorption policy A.
-template <ChannelPolicy CP, PathStrategy St, AbsorptionPolicy A = absorption::Weight>
+template <ChannelPolicy CP, PathStrategy St, mis::Heuristic H = mis::None, AbsorptionPolicy A = absorption::Weight>
 class SpectralPathEstimator {
     static_assert(St::null_pdfs || !St::combines,
                   "nsp::SpectralPathEstimator: DirectionalMis weighs by direction pdfs alone and has no "
                   "per-channel path pdfs to combine; use strategy::NullScatteringMis");
+    static_assert(St::combines || !H::combines,
+                  "nsp::SpectralPathEstimator: a single-strategy estimator (Unidirectional, NextEvent) "
+                  "takes mis::None; a heuristic would weigh a strategy against nothing");
+    static_assert(!St::combines || std::is_same_v<H, mis::Balance>,
+                  "nsp::SpectralPathEstimator: NullScatteringMis over channels is the one-sample balance "
+                  "heuristic (THEORY 5.3); pass mis::Balance");
 
 public:
     using Channels = CP;
     using Strategy = St;
+    using HeuristicType = H;
     using Absorption = A;
 
     /// Throws InvalidArgument on the option values PathEstimator rejects.
