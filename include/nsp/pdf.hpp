@@ -14,26 +14,29 @@
 
 namespace nsp {
 
-/// The majorant optical depth int_a^b mu_bar dt along `ray` (Tbar(a, b) = exp(-result)).
+/// The majorant optical depth int_a^b mu_bar dt along `ray` (Tbar(a, b) = exp(-result)), of
+/// channel `c` for a per-channel majorant.
 template <Medium M, MajorantPolicy<M> Maj>
 double majorant_optical_depth(const Maj& majorant, const Ray& ray, float a, float b,
-                              const typename M::Spectral::Wavelengths& lambda) {
+                              const typename M::Spectral::Wavelengths& lambda, int c = 0) {
     double tau = 0.0;
     auto it = majorant.iterate(ray, a, b, lambda);
     while (auto seg = it.next()) {
         const float lo = std::max(seg->t0, a), hi = std::min(seg->t1, b);
-        if (hi > lo) tau += double(seg->sigma_maj) * (double(hi) - double(lo));
+        const double mu = channel_of(seg->sigma_maj, c);
+        if (hi > lo && mu > 0.0) tau += mu * (double(hi) - double(lo));
     }
     return tau;
 }
 
-/// The majorant mu_bar at distance t along `ray` (0 where no segment covers t).
+/// The majorant mu_bar at distance t along `ray` (0 where no segment covers t), of channel `c`
+/// for a per-channel majorant.
 template <Medium M, MajorantPolicy<M> Maj>
 float majorant_at(const Maj& majorant, const Ray& ray, float t,
-                  const typename M::Spectral::Wavelengths& lambda) {
+                  const typename M::Spectral::Wavelengths& lambda, int c = 0) {
     auto it = majorant.iterate(ray, 0.f, kInf, lambda);
     while (auto seg = it.next())
-        if (seg->t0 <= t && t < seg->t1) return seg->sigma_maj;
+        if (seg->t0 <= t && t < seg->t1) return channel_of(seg->sigma_maj, c);
     return 0.f;
 }
 
@@ -73,6 +76,61 @@ double ratio_segment_log_pdf(const M&, const Maj& majorant, const Ray& ray, floa
         prev = t;
     }
     return lp - majorant_optical_depth<M>(majorant, ray, prev, tmax, lambda);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Per-channel pdfs (THEORY 5.3), evaluated from the vertices in double, independently of the
+// samplers in channel_tracking.hpp
+
+/// Channel c's probability of event `end` (Absorbed, Scattered, or Passed for a null) at a
+/// collision with coefficients k under channel c's majorant mu > 0, when channel c is tracked
+/// with its own event probabilities of policy A (negative nulls clamped at 0, THEORY 4).
+template <AbsorptionPolicy A, SpectralMode S>
+double channel_event_probability(const Coefficients<S>& k, double mu, int c, SegmentEnd end) {
+    const double a = std::max(0.0, double(k.sigma_a[c])), s = std::max(0.0, double(k.sigma_s[c]));
+    const double n = std::max(0.0, mu - a - s);
+    const double total = a + s + n;
+    if (!(total > 0.0)) return 0.0;
+    if (end == SegmentEnd::Passed) return n / total;
+    if constexpr (A::as_event) return (end == SegmentEnd::Absorbed ? a : s) / total;
+    else return end == SegmentEnd::Scattered ? (a + s) / total : 0.0;
+}
+
+/// log of channel c's pdf of a delta-tracked segment when channel c is tracked alone with its
+/// own majorant and event probabilities: nulls at `nulls`, then event `end` at t_end or the pass
+/// of tmax (see delta_segment_log_pdf). -inf where channel c cannot produce these vertices.
+template <AbsorptionPolicy A, Medium M, MajorantPolicy<M> Maj>
+double channel_delta_segment_log_pdf(const M& medium, const Maj& majorant, const Ray& ray, float tmax,
+                                     const typename M::Spectral::Wavelengths& lambda, int c,
+                                     std::span<const float> nulls, SegmentEnd end, float t_end) {
+    double lp = 0.0;
+    float prev = 0.f;
+    auto vertex = [&](float t, SegmentEnd e) {
+        const double mu = majorant_at<M>(majorant, ray, t, lambda, c);
+        const double p = mu > 0.0 ? channel_event_probability<A>(medium.coefficients(ray.at(t), lambda), mu, c, e) : 0.0;
+        lp += std::log(mu * p) - majorant_optical_depth<M>(majorant, ray, prev, t, lambda, c);
+        prev = t;
+    };
+    for (const float t : nulls) vertex(t, SegmentEnd::Passed);
+    if (end == SegmentEnd::Passed) return lp - majorant_optical_depth<M>(majorant, ray, prev, tmax, lambda, c);
+    vertex(t_end, end);
+    return lp;
+}
+
+/// log of channel c's ratio-tracking pdf of nulls at `nulls` on [0, tmax]:
+/// prod_j mu_bar_c(n_j) Tbar_c(n_j-1, n_j) * Tbar_c(n_m, tmax).
+template <Medium M, MajorantPolicy<M> Maj>
+double channel_ratio_segment_log_pdf(const Maj& majorant, const Ray& ray, float tmax,
+                                     const typename M::Spectral::Wavelengths& lambda, int c,
+                                     std::span<const float> nulls) {
+    double lp = 0.0;
+    float prev = 0.f;
+    for (const float t : nulls) {
+        lp += std::log(double(majorant_at<M>(majorant, ray, t, lambda, c))) -
+              majorant_optical_depth<M>(majorant, ray, prev, t, lambda, c);
+        prev = t;
+    }
+    return lp - majorant_optical_depth<M>(majorant, ray, prev, tmax, lambda, c);
 }
 
 }  // namespace nsp

@@ -46,9 +46,9 @@ template <SpectralMode S>
 struct MediumKind<HomogeneousMedium<S>> {
     static constexpr const char* name = "homogeneous";
     static constexpr bool analytic = true;  ///< has optical_depth()
-    static HomogeneousMedium<S> make(const Box& b, float density, const typename S::Spectrum& sa,
-                                     const typename S::Spectrum& ss, std::uint64_t /*seed*/) {
-        return {b, sa * density, ss * density};
+    static HomogeneousMedium<S> make(const Box& b, float density, const typename S::Coefficient& sa,
+                                     const typename S::Coefficient& ss, std::uint64_t /*seed*/) {
+        return {b, scale(sa, density), scale(ss, density)};
     }
 };
 
@@ -57,8 +57,8 @@ struct MediumKind<DenseGridMedium<S>> {
     static constexpr const char* name = "grid";
     static constexpr bool analytic = false;
     /// A small, non-cubic grid (5 x 4 x 6) of densities uniform in [0, 2 density).
-    static DenseGridMedium<S> make(const Box& b, float density, const typename S::Spectrum& sa,
-                                   const typename S::Spectrum& ss, std::uint64_t seed) {
+    static DenseGridMedium<S> make(const Box& b, float density, const typename S::Coefficient& sa,
+                                   const typename S::Coefficient& ss, std::uint64_t seed) {
         const std::array<int, 3> res{5, 4, 6};
         Pcg32 rng(seed, 77);
         std::vector<float> d(std::size_t(res[0] * res[1] * res[2]));
@@ -72,8 +72,8 @@ struct MediumKind<ExponentialMedium<S>> {
     static constexpr const char* name = "exponential";
     static constexpr bool analytic = true;
     /// Density `density` at the box centre, varying by e^2 along an oblique axis across the box.
-    static ExponentialMedium<S> make(const Box& b, float density, const typename S::Spectrum& sa,
-                                     const typename S::Spectrum& ss, std::uint64_t /*seed*/) {
+    static ExponentialMedium<S> make(const Box& b, float density, const typename S::Coefficient& sa,
+                                     const typename S::Coefficient& ss, std::uint64_t /*seed*/) {
         const Vec3 axis = glm::normalize(Vec3(1.f, 0.6f, -0.3f));
         const float k = 2.f / glm::length(b.hi - b.lo);
         const float s_centre = glm::dot(0.5f * (b.hi - b.lo), axis);
@@ -84,8 +84,8 @@ struct MediumKind<ExponentialMedium<S>> {
 /// A medium of type M over `b` with mean density about `density` and per-unit-density
 /// coefficients sa, ss.
 template <class M>
-M make_medium(const Box& b, float density, const typename M::Spectral::Spectrum& sa,
-              const typename M::Spectral::Spectrum& ss, std::uint64_t seed = 1) {
+M make_medium(const Box& b, float density, const typename M::Spectral::Coefficient& sa,
+              const typename M::Spectral::Coefficient& ss, std::uint64_t seed = 1) {
     return MediumKind<M>::make(b, density, sa, ss, seed);
 }
 

@@ -1,0 +1,351 @@
+// tests/test_spectral_pdf.cpp: the per-channel path-pdf state (THEORY 5.3, 5.1). For random
+// segments with nulls, every channel's pdf, contribution and NEE-alternative pdf that the channel
+// trackers report equal an independent evaluation (pdf.hpp, in double); the spectral-MIS weights
+// over channels x {uni, NEE} sum to 1 and equal the balance heuristic on the independent pdfs;
+// ratios stay finite when channels differ by 1e6 or one has majorant 0.
+#include <cmath>
+#include <limits>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "spectral.hpp"
+
+namespace {
+
+using namespace nsp_test;
+
+const Box kBox{Vec3(-1.f), Vec3(1.f)};
+
+/// log of what a state entry reports relative to the sampling channel's pdf, or -inf for 0.
+double log_or_ninf(double x) { return x > 0.0 ? std::log(x) : -std::numeric_limits<double>::infinity(); }
+
+/// Checks log(reported) == expected within `tol`, treating -inf (a pdf of 0) exactly. `base` is
+/// the log of the stored value the ratios are taken against (<= 0: the state keeps its largest
+/// entry at 1): an entry below 1e-30 of the largest is a denormal or 0 in float, accurate in
+/// absolute terms only, and is checked to stay that small.
+void check_log(double reported, double expected, double tol, double base) {
+    if (std::isinf(expected) && expected < 0.0) {
+        CHECK(reported == -std::numeric_limits<double>::infinity());
+    } else if (expected + base < std::log(1e-30)) {
+        CHECK(reported + base < std::log(1e-29));
+    } else {
+        CAPTURE(reported);
+        CAPTURE(expected);
+        CHECK(std::abs(reported - expected) <= tol);
+    }
+}
+
+/// The contribution f_c of a segment's vertices in double: prod_j mu_n,c(n_j) Tbar_c, then
+/// mu_s,c Tbar_c at a scattering end (THEORY 3, channel c's own majorant).
+template <Medium M, class Maj>
+double channel_contribution(const M& medium, const Maj& maj, const Ray& ray, float tmax,
+                            const typename M::Spectral::Wavelengths& lambda, int c,
+                            std::span<const float> nulls, SegmentEnd end, float t_end) {
+    double f = 1.0;
+    float prev = 0.f;
+    for (const float t : nulls) {
+        const auto k = medium.coefficients(ray.at(t), lambda);
+        f *= (double(majorant_at<M>(maj, ray, t, lambda, c)) - double(k.sigma_a[c]) - double(k.sigma_s[c])) *
+             std::exp(-majorant_optical_depth<M>(maj, ray, prev, t, lambda, c));
+        prev = t;
+    }
+    if (end == SegmentEnd::Passed) return f * std::exp(-majorant_optical_depth<M>(maj, ray, prev, tmax, lambda, c));
+    const auto k = medium.coefficients(ray.at(t_end), lambda);
+    return f * double(k.sigma_s[c]) * std::exp(-majorant_optical_depth<M>(maj, ray, prev, t_end, lambda, c));
+}
+
+/// A chromatic grid medium of mode S with one channel of zero extinction (Rgb green; Hero: a
+/// band around 550 nm) and channels 6x apart, so per-channel majorants differ.
+template <SpectralMode S>
+DenseGridMedium<S> chromatic_grid(std::uint64_t seed) {
+    return make_medium<DenseGridMedium<S>>(kBox, 1.f, chroma<S>(0.3f, 0.f, 1.f), chroma<S>(0.7f, 0.f, 5.f), seed);
+}
+
+/// One point of the pdf suites' product: mode, own-pdf channel policy, absorption, majorant.
+template <SpectralMode S, ChannelPolicy CP, AbsorptionPolicy A, bool kPerChannel>
+struct PdfCase {
+    using Spectral = S;
+    using Channels = CP;
+    using Absorption = A;
+    using Medium = DenseGridMedium<S>;
+    using Majorant = std::conditional_t<kPerChannel, ChannelMajorant<Medium>, GlobalMajorant<Medium>>;
+};
+
+template <SpectralMode S, ChannelPolicy CP>
+using PdfCasesOf = std::tuple<PdfCase<S, CP, absorption::Event, true>, PdfCase<S, CP, absorption::Weight, true>,
+                              PdfCase<S, CP, absorption::Event, false>, PdfCase<S, CP, absorption::Weight, false>>;
+
+using PdfCases = decltype(std::tuple_cat(PdfCasesOf<Rgb, channels::SpectralMis>{}, PdfCasesOf<Hero<4>, channels::SpectralMis>{},
+                                         PdfCasesOf<Rgb, channels::Independent>{}, PdfCasesOf<Hero<4>, channels::Independent>{}));
+
+// Tolerance on log pdfs: float accumulation of a few dozen factors (relative ~1e-6 each) and of
+// optical depths up to ~10; 1e-3 is far below any error in a factor or a missing term.
+constexpr double kLogTol = 1e-3;
+
+TEST_CASE_TEMPLATE_DEFINE("channel delta tracking reports every channel's pdf, contribution and NEE pdf", T, channel_delta_pdfs) {
+    using S = typename T::Spectral;
+    using M = typename T::Medium;
+    using A = typename T::Absorption;
+    using CP = typename T::Channels;
+    const std::string name = std::string(S::name) + "/" + CP::name + "/" + A::name +
+                             (is_per_channel_majorant_v<typename T::Majorant, M> ? "/per-channel" : "/global");
+    CAPTURE(name);
+    const M medium = chromatic_grid<S>(3);
+    const typename T::Majorant maj(medium);
+    Pcg32 rng(11, 4);
+    NoLookupCount none;
+    int with_nulls = 0, scattered = 0;
+    for (int i = 0; i < 400; ++i) {
+        CAPTURE(i);
+        const auto lambda = draw_wavelengths<S>(rng);
+        const Ray ray{random_point(rng, kBox), random_direction(rng)};
+        const float tmax = 0.3f + 2.5f * rng.uniform();
+        const int c = std::min(int(rng.uniform() * S::channels), S::channels - 1);
+        if (!(channel_of(maj.iterate(ray, 0.f, tmax, lambda).next()->sigma_maj, c) > 0.f)) continue;
+        ChannelPathState<S> st;
+        st.nee.setOnes();
+        SegmentRecord rec;
+        const ChannelTrack tr = track_channels_delta<CP, A>(medium, maj, ray, tmax, lambda, c, st, true, rng, none, rec);
+        if (tr.end == SegmentEnd::Absorbed) continue;  // the state is not updated for a path that ends
+        REQUIRE((tr.end == SegmentEnd::Passed || tr.end == SegmentEnd::Scattered));
+        std::vector<float> nulls = rec.t;
+        if (tr.end != SegmentEnd::Passed) nulls.pop_back();
+        with_nulls += !nulls.empty();
+        scattered += tr.end == SegmentEnd::Scattered;
+        const double lp_c = channel_delta_segment_log_pdf<A>(medium, maj, ray, tmax, lambda, c, nulls, tr.end, tr.t);
+        // What the sampler says it sampled with equals the independent evaluation.
+        CHECK(rec.log_pdf == doctest::Approx(lp_c).epsilon(1e-4).scale(1.0));
+        for (int k = 0; k < S::channels; ++k) {
+            CAPTURE(k);
+            CAPTURE(c);
+            const double lp_k = channel_delta_segment_log_pdf<A>(medium, maj, ray, tmax, lambda, k, nulls, tr.end, tr.t);
+            const double base = std::log(double(st.uni[c]));
+            check_log(log_or_ninf(st.uni[k]) - base, lp_k - lp_c, kLogTol, base);
+            const double f_k = channel_contribution(medium, maj, ray, tmax, lambda, k, nulls, tr.end, tr.t);
+            CHECK(double(st.f[k]) / double(st.uni[c]) ==
+                  doctest::Approx(f_k / std::exp(lp_c)).epsilon(kLogTol).scale(1e-12));
+            if (tr.end == SegmentEnd::Passed) {
+                const double lr_k = channel_ratio_segment_log_pdf<M>(maj, ray, tmax, lambda, k, nulls);
+                check_log(log_or_ninf(st.nee[k]) - base, lr_k - lp_c, kLogTol, base);
+            }
+        }
+    }
+    CHECK(with_nulls > 50);  // nulls were exercised
+    CHECK(scattered > 20);   // and real collisions
+}
+
+TEST_CASE_TEMPLATE_APPLY(channel_delta_pdfs, PdfCases);
+
+TEST_CASE_TEMPLATE_DEFINE("channel ratio tracking reports every channel's NEE pdf, uni alternative and contribution; "
+                          "spectral-MIS weights over channels x {uni, NEE} sum to 1", T, channel_ratio_pdfs) {
+    using S = typename T::Spectral;
+    using M = typename T::Medium;
+    using A = typename T::Absorption;
+    using CP = typename T::Channels;
+    const std::string name = std::string(S::name) + "/" + CP::name + "/" + A::name;
+    CAPTURE(name);
+    const M medium = chromatic_grid<S>(5);
+    const typename T::Majorant maj(medium);
+    Pcg32 rng(12, 4);
+    NoLookupCount none;
+    int with_nulls = 0;
+    for (int i = 0; i < 400; ++i) {
+        CAPTURE(i);
+        const auto lambda = draw_wavelengths<S>(rng);
+        const Ray ray{random_point(rng, kBox), random_direction(rng)};
+        const float tmax = 0.3f + 2.5f * rng.uniform();
+        const int c = std::min(int(rng.uniform() * S::channels), S::channels - 1);
+        if (!(channel_of(maj.iterate(ray, 0.f, tmax, lambda).next()->sigma_maj, c) > 0.f)) continue;
+        SegmentRecord rec;
+        const auto sh = track_channels_ratio<CP, A>(medium, maj, ray, tmax, lambda, c, S::Spectrum::Ones().eval(), true,
+                                                    rng, none, rec);
+        if (sh.end != SegmentEnd::Passed) continue;
+        const std::span<const float> nulls(rec.t);
+        with_nulls += !nulls.empty();
+        const double lr_c = channel_ratio_segment_log_pdf<M>(maj, ray, tmax, lambda, c, nulls);
+        CHECK(rec.log_pdf == doctest::Approx(lr_c).epsilon(1e-4).scale(1.0));
+        std::vector<double> lr(S::channels), lu(S::channels);
+        for (int k = 0; k < S::channels; ++k) {
+            CAPTURE(k);
+            CAPTURE(c);
+            lr[k] = channel_ratio_segment_log_pdf<M>(maj, ray, tmax, lambda, k, nulls);
+            lu[k] = channel_delta_segment_log_pdf<A>(medium, maj, ray, tmax, lambda, k, nulls, SegmentEnd::Passed, tmax);
+            const double base = std::log(double(sh.nee[c]));
+            check_log(log_or_ninf(sh.nee[k]) - base, lr[k] - lr_c, kLogTol, base);
+            check_log(log_or_ninf(sh.uni[k]) - base, lu[k] - lr_c, kLogTol, base);
+            const double f_k = channel_contribution(medium, maj, ray, tmax, lambda, k, nulls, SegmentEnd::Passed, tmax);
+            CHECK(double(sh.f[k]) / double(sh.nee[c]) == doctest::Approx(f_k / std::exp(lr_c)).epsilon(kLogTol).scale(1e-12));
+        }
+        // Spectral MIS + NEE (THEORY 5.3 with 5.1): a path through these nulls to a light has 2 x C
+        // techniques, (channel k, uni) with pdf q_k p_w lu_k and (channel k, NEE) with pdf q_k p_l lr_k
+        // (the shared prefix cancels). The estimator weighs technique (k, t) by q_k p_t,k / sum; from
+        // the reported ratios and from the independent logs, with non-uniform q.
+        const float p_w = 0.3f + rng.uniform(), p_l = 0.3f + rng.uniform();
+        typename S::Spectrum w = S::Spectrum::Zero();
+        for (int k = 0; k < S::channels; ++k) w[k] = 1.f + float(k) + rng.uniform();
+        const ChannelSelection<S> q(w);
+        const auto& qs = q.probabilities();
+        const typename S::Spectrum pdf = p_l * sh.nee + p_w * sh.uni;  // as the estimator sums them
+        const float denom = (qs * pdf).sum();
+        double log_denom = -std::numeric_limits<double>::infinity();
+        auto log_add = [](double a, double b) {
+            if (std::isinf(a) && a < 0.0) return b;
+            if (std::isinf(b) && b < 0.0) return a;
+            const double m = std::max(a, b);
+            return m + std::log(std::exp(a - m) + std::exp(b - m));
+        };
+        for (int k = 0; k < S::channels; ++k) {
+            log_denom = log_add(log_denom, std::log(double(qs[k]) * p_w) + lu[k]);
+            log_denom = log_add(log_denom, std::log(double(qs[k]) * p_l) + lr[k]);
+        }
+        double sum = 0.0;
+        for (int k = 0; k < S::channels; ++k) {
+            CAPTURE(k);
+            const double w_uni = double(qs[k]) * p_w * double(sh.uni[k]) / denom;
+            const double w_nee = double(qs[k]) * p_l * double(sh.nee[k]) / denom;
+            sum += w_uni + w_nee;
+            CHECK(w_uni == doctest::Approx(std::exp(std::log(double(qs[k]) * p_w) + lu[k] - log_denom)).epsilon(kLogTol).scale(1e-9));
+            CHECK(w_nee == doctest::Approx(std::exp(std::log(double(qs[k]) * p_l) + lr[k] - log_denom)).epsilon(kLogTol).scale(1e-9));
+        }
+        CHECK(sum == doctest::Approx(1.0).epsilon(1e-5));
+    }
+    CHECK(with_nulls > 50);
+}
+
+using RatioCases = std::tuple<PdfCase<Rgb, channels::SpectralMis, absorption::Weight, true>,
+                              PdfCase<Rgb, channels::SpectralMis, absorption::Event, true>,
+                              PdfCase<Hero<4>, channels::SpectralMis, absorption::Weight, true>,
+                              PdfCase<Rgb, channels::SpectralMis, absorption::Weight, false>,
+                              PdfCase<Hero<4>, channels::SpectralMis, absorption::Event, false>>;
+TEST_CASE_TEMPLATE_APPLY(channel_ratio_pdfs, RatioCases);
+
+/// Spectral tracking's pdf in double from the vertices: one grey majorant mu, event probabilities
+/// from the channel maxima (THEORY 5.3, Kutz et al. 2017), absorption as a weight.
+double spectral_tracking_max_log_pdf(const DenseGridMedium<Rgb>& medium, const GlobalMajorant<DenseGridMedium<Rgb>>& maj,
+                                     const Ray& ray, float tmax, std::span<const float> nulls, SegmentEnd end,
+                                     float t_end) {
+    using M = DenseGridMedium<Rgb>;
+    const float mu = maj.value();
+    double lp = 0.0;
+    float prev = 0.f;
+    auto vertex = [&](float t, bool null) {
+        const auto k = medium.coefficients(ray.at(t), {});
+        double tmax_c = 0.0, nmax_c = 0.0;
+        for (int c = 0; c < 3; ++c) {
+            const double tc = double(k.sigma_a[c]) + double(k.sigma_s[c]);
+            tmax_c = std::max(tmax_c, tc);
+            nmax_c = std::max(nmax_c, double(mu) - tc);
+        }
+        lp += std::log(double(mu) * (null ? nmax_c : tmax_c) / (tmax_c + nmax_c)) -
+              majorant_optical_depth<M>(maj, ray, prev, t, {});
+        prev = t;
+    };
+    for (const float t : nulls) vertex(t, true);
+    if (end == SegmentEnd::Passed) return lp - majorant_optical_depth<M>(maj, ray, prev, tmax, {});
+    vertex(t_end, false);
+    return lp;
+}
+
+TEST_CASE("spectral tracking (max): one pdf for every channel, as an independent evaluation gives") {
+    const auto medium = chromatic_grid<Rgb>(9);
+    const GlobalMajorant<DenseGridMedium<Rgb>> maj(medium);
+    Pcg32 rng(13, 4);
+    NoLookupCount none;
+    int with_nulls = 0;
+    for (int i = 0; i < 400; ++i) {
+        CAPTURE(i);
+        const Ray ray{random_point(rng, kBox), random_direction(rng)};
+        const float tmax = 0.3f + 2.5f * rng.uniform();
+        ChannelPathState<Rgb> st;
+        SegmentRecord rec;
+        const auto tr = track_channels_delta<channels::SpectralTrackingMax, absorption::Weight>(
+            medium, maj, ray, tmax, {}, 0, st, false, rng, none, rec);
+        std::vector<float> nulls = rec.t;
+        if (tr.end != SegmentEnd::Passed) nulls.pop_back();
+        with_nulls += !nulls.empty();
+        const double lp = spectral_tracking_max_log_pdf(medium, maj, ray, tmax, nulls, tr.end, tr.t);
+        CHECK(rec.log_pdf == doctest::Approx(lp).epsilon(1e-4).scale(1.0));
+        for (int k = 0; k < 3; ++k) {
+            CHECK(st.uni[k] == st.uni[0]);  // a shared pdf: the same for every channel
+            // f_k relative to the pdf: Tbar cancels (one majorant), the coefficients remain.
+            double f = 1.0;
+            for (const float t : nulls) {
+                const auto co = medium.coefficients(ray.at(t), {});
+                f *= double(maj.value()) - double(co.sigma_t()[k]);
+            }
+            if (tr.end == SegmentEnd::Scattered) f *= double(medium.coefficients(ray.at(tr.t), {}).sigma_s[k]);
+            const double mu_tau = majorant_optical_depth<DenseGridMedium<Rgb>>(maj, ray, 0.f, tr.t, {});
+            CHECK(double(st.f[k]) / double(st.uni[k]) == doctest::Approx(f * std::exp(-mu_tau - lp)).epsilon(kLogTol).scale(1e-12));
+        }
+    }
+    CHECK(with_nulls > 50);
+}
+
+TEST_CASE("per-channel pdf ratios stay finite when majorants differ by 1e6 or one is 0") {
+    // Channels with extinction 4e-6, 4 and 0 per unit density: majorants 1e6 apart and one 0.
+    const auto medium = make_medium<DenseGridMedium<Rgb>>(kBox, 1.f, spec<Rgb>(1e-6f, 1.f, 0.f),
+                                                          spec<Rgb>(3e-6f, 3.f, 0.f), 21);
+    const ChannelMajorant<DenseGridMedium<Rgb>> maj(medium);
+    const Scene<DenseGridMedium<Rgb>, ChannelMajorant<DenseGridMedium<Rgb>>, HenyeyGreensteinPhase> scene(
+        medium, maj, HenyeyGreensteinPhase(0.3f), [] {
+            Lights<Rgb> l;
+            l.set(EnvironmentLight<Rgb>{grey<Rgb>(1.f)});
+            l.set(SphereLight<Rgb>{Vec3(0.f, 3.f, 0.f), 0.5f, grey<Rgb>(4.f)});
+            return l;
+        }());
+    Pcg32 rng(14, 4);
+    NoLookupCount none;
+    for (int i = 0; i < 3000; ++i) {
+        const Ray ray{random_point(rng, kBox), random_direction(rng)};
+        for (int c = 0; c < 2; ++c) {  // channel 2 has majorant 0: it is never sampled with
+            ChannelPathState<Rgb> st;
+            const auto tr = track_channels_delta<channels::SpectralMis, absorption::Weight>(
+                medium, maj, ray, 3.f, {}, c, st, true, rng, none);
+            REQUIRE(tr.end != SegmentEnd::Aborted);
+            REQUIRE(all_finite(st.f));
+            REQUIRE(all_finite(st.uni));
+            REQUIRE(all_finite(st.nee));
+            if (tr.end != SegmentEnd::Absorbed) {
+                REQUIRE(st.uni[c] > 0.f);
+                REQUIRE(st.uni.maxCoeff() == doctest::Approx(1.f));  // renormalised
+            }
+            if (tr.end == SegmentEnd::Scattered) REQUIRE(st.uni[2] == 0.f);  // majorant 0: no collision pdf
+            const auto sh = track_channels_ratio<channels::SpectralMis, absorption::Weight>(
+                medium, maj, ray, 3.f, {}, c, Rgb::Spectrum::Ones().eval(), true, rng, none);
+            REQUIRE(all_finite(sh.f));
+            REQUIRE(all_finite(sh.nee));
+            REQUIRE(all_finite(sh.uni));
+        }
+    }
+    const SpectralPathEstimator<channels::SpectralMis, strategy::NullScatteringMis, mis::Balance> est;
+    for (int i = 0; i < 3000; ++i) {
+        const Ray ray{Vec3(0.f, 0.f, -3.f), glm::normalize(random_point(rng, kBox) - Vec3(0.f, 0.f, -3.f))};
+        const auto r = est.radiance(scene, ray, {}, rng, none);
+        REQUIRE(r.status == Status::Ok);
+        REQUIRE(all_finite(r.value));
+    }
+}
+
+TEST_CASE("ChannelSelection: probabilities, sampling frequencies (chi-square) and rejected weights") {
+    const ChannelSelection<Rgb> uniform;
+    CHECK(uniform.probabilities().isApprox(Rgb::Spectrum::Constant(1.f / 3.f)));
+    const ChannelSelection<Rgb> q(spec<Rgb>(1.f, 6.f, 3.f));
+    CHECK(q.probabilities().isApprox(spec<Rgb>(0.1f, 0.6f, 0.3f)));
+    // n = 1e5 draws, 3 bins, dof 2: critical value 13.816 at p = 1e-3.
+    std::vector<double> counts(3, 0.0);
+    Pcg32 rng(15, 4);
+    constexpr int n = 100000;
+    for (int i = 0; i < n; ++i) counts[std::size_t(q.sample(rng.uniform()))] += 1.0;
+    CHECK(chi_square(counts, {0.1, 0.6, 0.3}, n) < 13.816);
+    CHECK(q.sample(0.f) == 0);
+    CHECK(q.sample(std::nextafter(1.f, 0.f)) == 2);
+    CHECK_THROWS_WITH_AS(ChannelSelection<Rgb>(spec<Rgb>(1.f, 0.f, 1.f)),
+                         "nsp: ChannelSelection weight[1] = 0 is not allowed: every channel needs a finite weight > 0",
+                         InvalidArgument);
+    CHECK_THROWS_WITH_AS(ChannelSelection<Rgb>(spec<Rgb>(1.f, 1.f, -2.f)), doctest::Contains("weight[2] = -2"), InvalidArgument);
+    CHECK_THROWS_WITH_AS(ChannelSelection<Rgb>(spec<Rgb>(NAN, 1.f, 1.f)), doctest::Contains("weight[0] = nan"), InvalidArgument);
+    CHECK_THROWS_WITH_AS(ChannelSelection<Rgb>(spec<Rgb>(1.f, INFINITY, 1.f)), doctest::Contains("weight[1] = inf"), InvalidArgument);
+}
+
+}  // namespace
