@@ -15,6 +15,12 @@ static_assert(Medium<HomogeneousMedium<Mono>> && Medium<HomogeneousMedium<Rgb>>)
 static_assert(Medium<DenseGridMedium<Mono>> && Medium<DenseGridMedium<Rgb>>);
 static_assert(Medium<ExponentialMedium<Mono>> && Medium<ExponentialMedium<Rgb>>);
 static_assert(!Medium<int> && !Medium<Box>);
+static_assert(SpectralMode<Hero<4>> && SpectralMode<Hero<1>> && SpectralMode<Hero<8>>);
+static_assert(Medium<HomogeneousMedium<Hero<4>>> && Medium<DenseGridMedium<Hero<4>>> &&
+              Medium<ExponentialMedium<Hero<4>>>);
+static_assert(is_hero_v<Hero<4>> && !is_hero_v<Rgb> && !is_hero_v<Mono>);
+// Fixed-channel modes give coefficients as spectra: no conversion on a lookup.
+static_assert(std::is_same_v<Mono::Coefficient, Mono::Spectrum> && std::is_same_v<Rgb::Coefficient, Rgb::Spectrum>);
 
 // Majorants.
 static_assert(MajorantIterator<SingleSegmentIterator<>> && MajorantIterator<SingleSegmentIterator<Rgb::Spectrum>>);
@@ -25,6 +31,12 @@ static_assert(MajorantPolicy<GlobalMajorant<DenseGridMedium<Rgb>>, DenseGridMedi
 static_assert(MajorantPolicy<GlobalMajorant<ExponentialMedium<Mono>>, ExponentialMedium<Mono>>);
 static_assert(MajorantPolicy<GlobalMajorant<ExponentialMedium<Rgb>>, ExponentialMedium<Rgb>>);
 static_assert(GlobalMajorant<HomogeneousMedium<Mono>>::bounds_density);
+static_assert(MajorantPolicy<ChannelMajorant<DenseGridMedium<Rgb>>, DenseGridMedium<Rgb>>);
+static_assert(MajorantPolicy<ChannelMajorant<DenseGridMedium<Hero<4>>>, DenseGridMedium<Hero<4>>>);
+static_assert(MajorantPolicy<GlobalMajorant<DenseGridMedium<Hero<4>>>, DenseGridMedium<Hero<4>>>);
+static_assert(is_per_channel_majorant_v<ChannelMajorant<DenseGridMedium<Rgb>>, DenseGridMedium<Rgb>>);
+static_assert(!is_per_channel_majorant_v<GlobalMajorant<DenseGridMedium<Rgb>>, DenseGridMedium<Rgb>>);
+static_assert(ChannelBoundedMedium<HomogeneousMedium<Rgb>> && ChannelBoundedMedium<ExponentialMedium<Hero<4>>>);
 
 // Phase functions, RNG, counters, heuristics, policies.
 static_assert(PhaseFunction<IsotropicPhase> && PhaseFunction<HenyeyGreensteinPhase>);
@@ -39,9 +51,20 @@ static_assert(AbsorptionPolicy<absorption::Event> && AbsorptionPolicy<absorption
 static_assert(PathStrategy<strategy::Unidirectional> && PathStrategy<strategy::NextEvent> &&
               PathStrategy<strategy::DirectionalMis> && PathStrategy<strategy::NullScatteringMis>);
 
+// Channel policies.
+static_assert(ChannelPolicy<channels::Independent> && ChannelPolicy<channels::SpectralMis> &&
+              ChannelPolicy<channels::SpectralTrackingMax> && ChannelPolicy<channels::SpectralTrackingAverage>);
+static_assert(!ChannelPolicy<int> && !ChannelPolicy<mis::Balance>);
+
 // The tracking callbacks are collision callbacks.
 static_assert(CollisionCallback<DeltaCollision<absorption::Event, Rgb, Pcg32, NoRecord>, Rgb>);
 static_assert(CollisionCallback<RatioCollision<absorption::Weight, true, Mono, SegmentRecord>, Mono>);
+static_assert(CollisionCallback<ChannelDeltaCollision<channels::SpectralMis, absorption::Weight, Rgb, Pcg32, NoRecord>,
+                                Rgb, Rgb::Spectrum>);
+static_assert(CollisionCallback<ChannelDeltaCollision<channels::SpectralTrackingMax, absorption::Event, Rgb, Pcg32, NoRecord>,
+                                Rgb, float>);
+static_assert(CollisionCallback<ChannelRatioCollision<channels::Independent, absorption::Weight, Hero<4>, NoRecord>,
+                                Hero<4>, Hero<4>::Spectrum>);
 
 // NoLookupCount is stateless: a kernel instantiated with it carries no counter at all.
 static_assert(std::is_empty_v<NoLookupCount>);
@@ -51,6 +74,8 @@ static_assert(std::is_empty_v<NoRecord> && !NoRecord::enabled);
 // Policies are small, trivially copyable values (STYLE rule 5). (Media hold Eigen arrays,
 // which are copyable but not trivially, so they are not listed.)
 static_assert(std::is_trivially_copyable_v<GlobalMajorant<DenseGridMedium<Rgb>>>);
+static_assert(std::is_trivially_copyable_v<TabulatedSpectrum> && std::is_trivially_copyable_v<Hero<4>::Wavelengths>);
+static_assert(std::is_trivially_copyable_v<ChannelMajorant<DenseGridMedium<Hero<4>>>>);
 static_assert(std::is_trivially_copyable_v<IsotropicPhase> &&
               std::is_trivially_copyable_v<HenyeyGreensteinPhase>);
 static_assert(std::is_trivially_copyable_v<mis::Power> && std::is_empty_v<mis::Balance>);

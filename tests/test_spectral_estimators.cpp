@@ -252,9 +252,9 @@ TEST_CASE("hero wavelengths integrate a constant and a Gaussian spectrum to the 
     for (int i = 0; i < 1000; ++i) {
         const auto w = Hero<4>::Wavelengths::sample(rng.uniform());
         for (int k = 0; k < 4; ++k) {
-            REQUIRE(w.nm[k] >= kLambdaMin);
-            REQUIRE(w.nm[k] < kLambdaMax);
-            const float d = w.nm[(k + 1) % 4] - w.nm[k];
+            REQUIRE(w.nm[std::size_t(k)] >= kLambdaMin);
+            REQUIRE(w.nm[std::size_t(k)] < kLambdaMax);
+            const float d = w.nm[std::size_t((k + 1) % 4)] - w.nm[std::size_t(k)];
             REQUIRE(std::abs(d - 117.5f) < 1e-3f + float(d < 0.f) * 1e9f);  // neighbours 117.5 nm apart (mod range)
         }
     }

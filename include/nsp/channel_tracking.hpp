@@ -133,6 +133,7 @@ struct ChannelDeltaCollision {
             const float pa = d.absorb[c] * inv, ps = d.scatter[c] * inv;
             if (u < pa) {
                 event = SegmentEnd::Absorbed;
+                f_factor = k.sigma_a;
                 p_factor = d.absorb;
             } else if (u < pa + ps || !(d.null[c] > 0.f)) {  // rounding never picks a null of probability 0
                 event = SegmentEnd::Scattered;
@@ -149,6 +150,7 @@ struct ChannelDeltaCollision {
             float pe;
             if (u < p.absorb) {
                 event = SegmentEnd::Absorbed;
+                f_factor = k.sigma_a;
                 pe = p.absorb;
             } else if (u < p.absorb + p.scatter || !(p.null > 0.f)) {
                 event = SegmentEnd::Scattered;
@@ -244,7 +246,7 @@ struct ChannelRatioCollision {
     bool operator()(float t, const Coefficients<S>& k, const V& mu_v, const V& tau_v) {
         constexpr bool grey = std::is_same_v<V, float>;
         const Spec mu = detail::broadcast<Spec>(mu_v);
-        Spec f_factor = mu - k.sigma_t(), nee_factor = mu, uni_factor;
+        Spec f_factor = mu - k.sigma_t(), nee_factor = mu, uni_factor = Spec::Ones();
         if (uni_alternative) {
             if constexpr (CP::own_pdfs) {
                 uni_factor = channel_event_densities<A, S>(k, mu).null;
@@ -258,7 +260,7 @@ struct ChannelRatioCollision {
             const Spec tb = detail::relative_transmittance(tau_v, c);
             f_factor *= tb;
             nee_factor *= tb;
-            uni_factor *= tb;
+            if (uni_alternative) uni_factor *= tb;
         }
         out.f *= f_factor;
         out.nee *= nee_factor;

@@ -52,7 +52,7 @@ inline double cie_y_integral() noexcept {
 template <int N>
 Eigen::Array3d hero_to_xyz(const Eigen::Array<float, N, 1>& L, const HeroWavelengths<N>& lambda) noexcept {
     Eigen::Array3d xyz = Eigen::Array3d::Zero();
-    for (int i = 0; i < N; ++i) xyz += double(L[i]) * cie_xyz_bar(double(lambda.nm[i]));
+    for (int i = 0; i < N; ++i) xyz += double(L[i]) * cie_xyz_bar(double(lambda.nm[std::size_t(i)]));
     return xyz / (double(N) * double(HeroWavelengths<N>::pdf()) * cie_y_integral());
 }
 

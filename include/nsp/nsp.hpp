@@ -8,7 +8,6 @@
 #include "core/math.hpp"
 #include "core/rng.hpp"
 #include "estimator.hpp"
-#include "estimators/spectral.hpp"
 #include "light.hpp"
 #include "majorant.hpp"
 #include "media/exponential.hpp"

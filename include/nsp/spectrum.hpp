@@ -155,9 +155,9 @@ private:
 /// tabulated spectrum costs one interpolation per channel.
 template <int N>
 struct HeroWavelengths {
-    Eigen::Array<float, N, 1> nm = Eigen::Array<float, N, 1>::Constant(kLambdaMin);
-    std::array<int, N> index{};
-    Eigen::Array<float, N, 1> frac = Eigen::Array<float, N, 1>::Zero();
+    std::array<float, N> nm{};    ///< the wavelengths in nm (a default context evaluates spectra at kLambdaMin)
+    std::array<int, N> index{};   ///< table index of each wavelength
+    std::array<float, N> frac{};  ///< position between table entries index and index + 1
 
     /// Stratified rotation (Wilkie 2014): lambda_i = min + (max - min) frac(u + i / N). Each
     /// wavelength is uniform over the range, with pdf 1 / (kLambdaMax - kLambdaMin).
@@ -166,11 +166,11 @@ struct HeroWavelengths {
         for (int i = 0; i < N; ++i) {
             float v = u + float(i) / float(N);
             v -= std::floor(v);
-            w.nm[i] = kLambdaMin + (kLambdaMax - kLambdaMin) * v;
-            const float x = std::clamp((w.nm[i] - kLambdaMin) / TabulatedSpectrum::kStep, 0.f,
+            w.nm[std::size_t(i)] = kLambdaMin + (kLambdaMax - kLambdaMin) * v;
+            const float x = std::clamp((w.nm[std::size_t(i)] - kLambdaMin) / TabulatedSpectrum::kStep, 0.f,
                                        float(TabulatedSpectrum::kSize - 1));
             w.index[std::size_t(i)] = std::min(int(x), TabulatedSpectrum::kSize - 2);
-            w.frac[i] = x - float(w.index[std::size_t(i)]);
+            w.frac[std::size_t(i)] = x - float(w.index[std::size_t(i)]);
         }
         return w;
     }
@@ -190,7 +190,7 @@ struct Hero {
     static constexpr const char* name = "hero";
     static Spectrum sample(const Coefficient& k, const Wavelengths& l) noexcept {
         Spectrum s;
-        for (int i = 0; i < N; ++i) s[i] = k.at(l.index[std::size_t(i)], l.frac[i]);
+        for (int i = 0; i < N; ++i) s[i] = k.at(l.index[std::size_t(i)], l.frac[std::size_t(i)]);
         return s;
     }
 };

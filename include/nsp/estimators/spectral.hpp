@@ -15,7 +15,10 @@
 #include <type_traits>
 
 #include "../channel_tracking.hpp"
-#include "../estimator.hpp"
+#include "../core/counter.hpp"
+#include "../core/rng.hpp"
+#include "../mis.hpp"
+#include "common.hpp"
 #include "../path_pdf.hpp"
 #include "../scene.hpp"
 
@@ -44,7 +47,7 @@ public:
     using Absorption = A;
 
     /// Throws InvalidArgument on the option values PathEstimator rejects.
-    explicit SpectralPathEstimator(EstimatorOptions opts = {}) : opts_(PathEstimator<strategy::Unidirectional>(opts).options()) {}
+    explicit SpectralPathEstimator(EstimatorOptions opts = {}) : opts_(opts) { validate(opts); }
 
     const EstimatorOptions& options() const noexcept { return opts_; }
 

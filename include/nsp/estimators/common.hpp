@@ -1,0 +1,79 @@
+// nsp/estimators/common.hpp: what every path estimator shares: the path strategies (which
+// techniques run and how they combine), run-time options, and the result type.
+#pragma once
+
+#include <concepts>
+#include <cstdint>
+
+#include "../core/error.hpp"
+#include "../spectrum.hpp"
+
+namespace nsp {
+
+namespace strategy {
+/// Delta tracking; lights contribute when a path hits them.
+struct Unidirectional {
+    static constexpr const char* name = "unidirectional";
+    static constexpr bool samples_lights = false, hits_lights = true, combines = false, null_pdfs = false;
+};
+/// Next-event estimation with ratio-tracking transmittance; hits count only for camera rays.
+struct NextEvent {
+    static constexpr const char* name = "ratio-nee";
+    static constexpr bool samples_lights = true, hits_lights = false, combines = false, null_pdfs = false;
+};
+/// Unidirectional + NEE weighted by direction pdfs only (THEORY 5.2).
+struct DirectionalMis {
+    static constexpr const char* name = "directional-mis";
+    static constexpr bool samples_lights = true, hits_lights = true, combines = true, null_pdfs = false;
+};
+/// Unidirectional + NEE weighted by null-scattering path pdfs (THEORY 5.1).
+struct NullScatteringMis {
+    static constexpr const char* name = "uni-nee-mis";
+    static constexpr bool samples_lights = true, hits_lights = true, combines = true, null_pdfs = true;
+};
+}  // namespace strategy
+
+/// A path strategy: which techniques it runs and whether it combines them with MIS.
+template <class T>
+concept PathStrategy = requires {
+    { T::name } -> std::convertible_to<const char*>;
+    { T::samples_lights } -> std::convertible_to<bool>;
+    { T::hits_lights } -> std::convertible_to<bool>;
+    { T::combines } -> std::convertible_to<bool>;
+    { T::null_pdfs } -> std::convertible_to<bool>;
+};
+
+/// Run-time settings of a path estimator.
+struct EstimatorOptions {
+    int max_depth = 1000;          ///< most real scattering vertices on a path (>= 0)
+    bool russian_roulette = true;  ///< roulette at real vertices from `rr_start_depth` on
+    int rr_start_depth = 3;        ///< first real vertex (1-based) at which roulette may stop a path
+    float rr_max_survival = 0.95f; ///< survival q = min(rr_max_survival, max_c |throughput_c|), in (0, 1]
+};
+
+/// How a radiance estimate ended.
+enum class Status : std::uint8_t {
+    Ok,         ///< a finite estimate
+    Aborted,    ///< a flight hit the collision limit; that flight contributed 0 (rare, biased)
+    NonFinite,  ///< the estimate was NaN or Inf and has been replaced by 0
+};
+
+/// A radiance estimate and its status.
+template <SpectralMode S>
+struct RadianceSample {
+    typename S::Spectrum value;
+    Status status = Status::Ok;
+};
+
+/// Throws InvalidArgument on max_depth < 0, rr_start_depth < 1 or rr_max_survival outside (0, 1].
+inline void validate(const EstimatorOptions& opts) {
+    if (opts.max_depth < 0)
+        detail::fail("EstimatorOptions max_depth = ", opts.max_depth, " is not allowed: it must be >= 0");
+    if (opts.rr_start_depth < 1)
+        detail::fail("EstimatorOptions rr_start_depth = ", opts.rr_start_depth, " is not allowed: it must be >= 1");
+    if (!(opts.rr_max_survival > 0.f && opts.rr_max_survival <= 1.f))
+        detail::fail("EstimatorOptions rr_max_survival = ", opts.rr_max_survival,
+                     " is not allowed: it must lie in (0, 1]");
+}
+
+}  // namespace nsp
