@@ -170,17 +170,4 @@ Spec channel_estimate(const Spec& f, const Spec& pdf, const Spec& q, int c) noex
     }
 }
 
-/// The throughput f / p the path carries, for Russian roulette: with MIS over channels the
-/// estimate above; for independent tracking f_c / p_c of the sampling channel alone (without
-/// 1 / q_c, which is not part of the path's attenuation).
-template <ChannelPolicy CP, class Spec>
-Spec channel_throughput(const Spec& f, const Spec& pdf, const Spec& q, int c) noexcept {
-    if constexpr (CP::mis_over_channels) return channel_estimate<CP>(f, pdf, q, c);
-    else {
-        Spec out = Spec::Zero();
-        if (pdf[c] > 0.f) out[c] = f[c] / pdf[c];
-        return out;
-    }
-}
-
 }  // namespace nsp

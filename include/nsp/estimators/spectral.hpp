@@ -103,9 +103,11 @@ public:
 
             const Vec3 x = ray.at(seg.t);
             // Roulette survival is fixed before NEE: the continuing unidirectional path carries it.
+            // It follows what the path would contribute per unit of incident light, the largest
+            // channel estimate, as PathEstimator's max |beta| does.
             float rr = 1.f;
             if (opts_.russian_roulette && depth >= opts_.rr_start_depth)
-                rr = std::min(opts_.rr_max_survival, channel_throughput<CP>(st.f, st.uni, q, c).abs().maxCoeff());
+                rr = std::min(opts_.rr_max_survival, channel_estimate<CP>(st.f, st.uni, q, c).abs().maxCoeff());
             if constexpr (St::samples_lights) {
                 if (next_event(scene, x, ray.d, rr, lambda, q, c, st, rng, counter, L)) status = Status::Aborted;
             }
