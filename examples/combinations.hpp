@@ -1,12 +1,16 @@
 // examples/combinations.hpp: every valid combination of nsp's policies that the example renderer
-// can run, as one compile-time list.
+// can run, as compile-time lists.
 //
-// The policy lists below are multiplied out (spectral mode x strategy x heuristic x absorption x
-// majorant x medium) and the combinations PathEstimator rejects with a static_assert are
-// filtered out, so adding a policy to a list is all it takes to render it.
+// The policy lists below are multiplied out (spectral mode x channel policy x majorant x strategy
+// x heuristic x absorption x medium) and the combinations the library rejects with a
+// static_assert are filtered out before any of them is named as an estimator, so adding a policy
+// to a list is all it takes to render it. The channel policy `Grey` stands for nsp::PathEstimator
+// (one pdf for every channel, the grey-majorant baseline); the others select
+// nsp::SpectralPathEstimator with that channel policy.
 #pragma once
 
 #include <string>
+#include <type_traits>
 
 #include <nsp/nsp.hpp>
 
@@ -15,16 +19,25 @@
 
 namespace nsp_examples {
 
-/// The medium of the default scene: the procedural cloud on a dense grid.
+/// Which of the two scenes of default_scene.hpp a render uses.
+enum class SceneKind {
+    Cloud,      ///< the grey cloud (set-ups A, B)
+    Chromatic,  ///< the chromatic cloud, extinction 1 : 4 : 16 (set-ups C1, C2)
+};
+
+/// The medium of both scenes: the procedural cloud on a dense grid (grey or chromatic
+/// coefficients; the type is the same, so the scene is a run-time choice).
 struct DenseGridCloud {
     static constexpr const char* name = "dense-grid";
     template <nsp::SpectralMode S>
     using type = nsp::DenseGridMedium<S>;
     template <nsp::SpectralMode S>
-    static type<S> make() { return make_default_medium<S>(); }
+    static type<S> make(SceneKind scene) {
+        return scene == SceneKind::Cloud ? make_default_medium<S>() : make_chromatic_medium<S>();
+    }
 };
 
-/// One constant majorant for the whole medium (the tightest the grid allows).
+/// One constant grey majorant for the whole medium and every channel (the tightest the grid allows).
 struct GlobalMajorantPolicy {
     static constexpr const char* name = "global";
     template <nsp::Medium M>
@@ -33,53 +46,113 @@ struct GlobalMajorantPolicy {
     static type<M> make(const M& medium) { return type<M>(medium); }
 };
 
-using SpectralModes = tl::list<nsp::Mono, nsp::Rgb>;
+/// One constant majorant per channel, each channel's own extinction bound (THEORY 5.3).
+struct ChannelMajorantPolicy {
+    static constexpr const char* name = "per-channel";
+    template <nsp::Medium M>
+    using type = nsp::ChannelMajorant<M>;
+    template <nsp::Medium M>
+    static type<M> make(const M& medium) { return type<M>(medium); }
+};
+
+/// The channel policy of nsp::PathEstimator: one pdf driven by the channel means, grey majorant.
+struct Grey {
+    static constexpr const char* name = "grey";
+};
+
+/// Hero wavelengths, four per path.
+using Hero4 = nsp::Hero<4>;
+
+using SpectralModes = tl::list<nsp::Mono, nsp::Rgb, Hero4>;
+using ChannelPolicies = tl::list<Grey, nsp::channels::Independent, nsp::channels::SpectralTrackingMax,
+                                 nsp::channels::SpectralTrackingAverage, nsp::channels::SpectralMis>;
+using Majorants = tl::list<GlobalMajorantPolicy, ChannelMajorantPolicy>;
 using Strategies = tl::list<nsp::strategy::Unidirectional, nsp::strategy::NextEvent,
                             nsp::strategy::DirectionalMis, nsp::strategy::NullScatteringMis>;
 using Heuristics = tl::list<nsp::mis::None, nsp::mis::Balance, nsp::mis::Power>;
 using Absorptions = tl::list<nsp::absorption::Event, nsp::absorption::Weight>;
-using Majorants = tl::list<GlobalMajorantPolicy>;
 using MediumKinds = tl::list<DenseGridCloud>;
 
-/// One point of the product: the types a render needs, and its names.
+/// The library's static_asserts as a predicate on a point of the product, evaluated on the policy
+/// tags alone (nothing is instantiated for an invalid point):
+/// - PathEstimator (Grey): the grey majorant; MIS strategies take a combining heuristic, single
+///   strategies mis::None;
+/// - SpectralPathEstimator: a multi-channel mode; independent tracking and spectral MIS with the
+///   per-channel majorant, spectral tracking with the grey one; no DirectionalMis; mis::None for
+///   single strategies, mis::Balance for NullScatteringMis.
+template <class Tuple>
+struct is_valid;
+template <class S, class CP, class Maj, class St, class H, class A, class Med>
+struct is_valid<tl::list<S, CP, Maj, St, H, A, Med>> {
+    static constexpr bool grey = std::is_same_v<CP, Grey>;
+    static constexpr bool heuristic_fits =
+        St::combines ? (grey ? H::combines : std::is_same_v<H, nsp::mis::Balance>) : !H::combines;
+    static constexpr bool majorant_fits = [] {
+        if constexpr (grey) return std::is_same_v<Maj, GlobalMajorantPolicy>;
+        else return std::is_same_v<Maj, ChannelMajorantPolicy> == CP::own_pdfs;
+    }();
+    static constexpr bool value = heuristic_fits && majorant_fits &&
+                                  (grey || (S::channels > 1 && (St::null_pdfs || !St::combines)));
+};
+
+/// The estimator type of a combination (lazily, so that Grey is never passed to SpectralPathEstimator).
+template <class CP, class St, class H, class A>
+struct EstimatorFor {
+    using type = nsp::SpectralPathEstimator<CP, St, H, A>;
+};
+template <class St, class H, class A>
+struct EstimatorFor<Grey, St, H, A> {
+    using type = nsp::PathEstimator<St, H, A>;
+};
+
+/// One valid point of the product: the types a render needs, and its names.
 template <class Tuple>
 struct Combination;
-template <class S, class St, class H, class A, class Maj, class Med>
-struct Combination<tl::list<S, St, H, A, Maj, Med>> {
+template <class S, class CP, class Maj, class St, class H, class A, class Med>
+struct Combination<tl::list<S, CP, Maj, St, H, A, Med>> {
     using Spectral = S;
+    using ChannelPolicy = CP;
+    using MajorantKind = Maj;
     using Strategy = St;
     using Heuristic = H;
     using Absorption = A;
-    using MajorantKind = Maj;
     using MediumKind = Med;
     using Medium = typename Med::template type<S>;
     using Majorant = typename Maj::template type<Medium>;
     using Scene = nsp::Scene<Medium, Majorant, nsp::HenyeyGreensteinPhase>;
-    /// Naming the specialisation does not instantiate it; only valid combinations construct one.
-    using Estimator = nsp::PathEstimator<St, H, A>;
+    using Estimator = typename EstimatorFor<CP, St, H, A>::type;
 
-    /// PathEstimator's static_asserts as a predicate: MIS strategies take a combining
-    /// heuristic, single strategies take mis::None.
-    static constexpr bool valid = St::combines == H::combines;
+    /// True for nsp::SpectralPathEstimator (it takes a ChannelSelection).
+    static constexpr bool spectral = !std::is_same_v<CP, Grey>;
+    /// True when the channel selection probabilities change the estimator (not for spectral
+    /// tracking, whose one shared pdf makes the sampling channel irrelevant, nor for Grey).
+    static constexpr bool uses_selection = [] {
+        if constexpr (spectral) return CP::own_pdfs;
+        else return false;
+    }();
 
-    /// "uni-nee-mis_balance_absorb-weight" ("unidirectional_absorb-event" for single strategies).
+    /// Grey rows keep the names of the existing tables: "uni-nee-mis_balance_absorb-weight"
+    /// ("unidirectional_absorb-event" for single strategies). Spectral rows add the channel
+    /// policy and the majorant: "uni-nee-mis_spectral-mis_per-channel_balance_absorb-weight".
     static std::string name() {
         std::string n = St::name;
+        if constexpr (spectral) n += std::string("_") + CP::name + "_" + Maj::name;
         if constexpr (H::combines) n += std::string("_") + H::name;
         return n + "_" + A::name;
     }
 };
 
-template <class C>
-struct is_valid : std::bool_constant<C::valid> {};
+/// Every valid combination of spectral mode S, in the order of the policy lists.
+template <class S>
+using CombinationsOf = tl::transform<
+    Combination, tl::filter<is_valid, tl::product<tl::list<S>, ChannelPolicies, Majorants, Strategies, Heuristics,
+                                                  Absorptions, MediumKinds>>>;
 
-/// Every valid combination, in the order of the policy lists.
-using AllCombinations = tl::filter<
-    is_valid, tl::transform<Combination, tl::product<SpectralModes, Strategies, Heuristics, Absorptions,
-                                                    Majorants, MediumKinds>>>;
-
-// 2 spectral modes x (Unidirectional, NextEvent with None; two MIS strategies with Balance and
-// Power) x 2 absorption policies x 1 majorant x 1 medium.
-static_assert(tl::size<AllCombinations> == 2 * (2 + 2 * 2) * 2);
+// Grey: (Unidirectional, NextEvent with None; two MIS strategies with Balance and Power) x 2
+// absorption policies, in every mode. Spectral: 4 channel policies x (Unidirectional, NextEvent,
+// NullScatteringMis with Balance) x 2 absorption policies, in Rgb and Hero.
+static_assert(tl::size<CombinationsOf<nsp::Mono>> == (2 + 2 * 2) * 2);
+static_assert(tl::size<CombinationsOf<nsp::Rgb>> == (2 + 2 * 2) * 2 + 4 * 3 * 2);
+static_assert(tl::size<CombinationsOf<Hero4>> == (2 + 2 * 2) * 2 + 4 * 3 * 2);
 
 }  // namespace nsp_examples

@@ -1,26 +1,27 @@
 // examples/render.cpp: nsp_render, the example host renderer and the project's main job.
 //
-// Renders the default cloud (examples/default_scene.hpp) in light set-ups A and B with every
-// path estimator nsp offers, writes one EXR per render and prints an efficiency table per set-up
-// (THEORY 7: LTUV = density lookups per sample x variance of one sample). The command-line
-// choices are turned into types once, in `tl::with_index` over the compile-time list of every
-// valid policy combination (combinations.hpp); each render loop is monomorphic.
+// Renders two scenes of examples/default_scene.hpp with the path estimators nsp offers, writes one
+// EXR per render and prints an efficiency table per light set-up and spectral mode (THEORY 7:
+// LTUV = density lookups per sample x variance of one sample):
+// - the grey cloud in set-ups A and B (mono), with every nsp::PathEstimator;
+// - the chromatic cloud (extinction 1 : 4 : 16) in set-ups C1 and C2 (rgb and hero), with the
+//   spectral estimators (independent tracking, spectral tracking, spectral MIS) beside the
+//   grey-majorant baseline (THEORY 5.3).
+// This file plans renders by name and prints the tables; the command-line choices become types
+// once, in render_combination<S> (render_job.hpp), whose render loops are monomorphic.
 #include <algorithm>
 #include <array>
-#include <atomic>
 #include <charconv>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
-#include <ctime>
 #include <exception>
 #include <filesystem>
 #include <functional>
 #include <iostream>
 #include <limits>
-#include <mutex>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -30,13 +31,12 @@
 #include <utility>
 #include <vector>
 
-#include <unistd.h>
-
 #include <nsp/nsp.hpp>
 
 #include "combinations.hpp"
 #include "default_scene.hpp"
 #include "exr_writer.hpp"
+#include "render_job.hpp"
 #include "type_list.hpp"
 
 namespace {
@@ -44,55 +44,129 @@ namespace {
 using namespace nsp_examples;
 
 // ---------------------------------------------------------------------------------------------
+// Defaults
+
+/// The grey cloud keeps the resolution and sample count of the existing table.
+constexpr int kCloudWidth = 128, kCloudHeight = 128, kCloudSpp = 512;
+/// The chromatic cloud: its tracking costs several times the grey cloud's lookups per sample, and
+/// the default job must fit in about 5 minutes with the grey cloud's 90 s.
+constexpr int kChromaticWidth = 64, kChromaticHeight = 64, kChromaticSpp = 128;
+
+/// The estimators of the grey cloud by default: every PathEstimator (the existing table).
+const std::vector<std::string> kCloudEstimators{"grey"};
+/// The estimators of the chromatic cloud by default (absorb-weight rows): the grey-majorant
+/// baseline with NEE MIS; each spectral channel policy unidirectional and with NEE MIS; spectral
+/// MIS also with NEE alone; with --selection both, spectral MIS + NEE and independent + NEE also
+/// with luminance selection.
+const std::vector<std::string> kChromaticEstimators{
+    "uni-nee-mis_grey_balance_absorb-weight",
+    "unidirectional_independent_absorb-weight_uniform",
+    "uni-nee-mis_independent_absorb-weight",
+    "unidirectional_spectral-tracking-max_absorb-weight",
+    "uni-nee-mis_spectral-tracking-max_absorb-weight",
+    "unidirectional_spectral-tracking-avg_absorb-weight",
+    "uni-nee-mis_spectral-tracking-avg_absorb-weight",
+    "unidirectional_spectral-mis_absorb-weight_uniform",
+    "ratio-nee_spectral-mis_absorb-weight_uniform",
+    "uni-nee-mis_spectral-mis_absorb-weight",
+};
+
+// ---------------------------------------------------------------------------------------------
 // Command line
 
-constexpr int kDefaultWidth = 128, kDefaultHeight = 128, kDefaultSpp = 512;
-
-/// The estimators of the default run: every estimator, both MIS heuristics, both absorption
-/// policies (THEORY 4 asks to measure both), in the Mono mode.
-constexpr std::string_view kDefaultEstimators = "all";
-
 struct Options {
-    int width = kDefaultWidth, height = kDefaultHeight, spp = kDefaultSpp;
+    std::optional<int> width, height, spp;  ///< empty: the scene's default
     int threads = std::max(1, int(std::thread::hardware_concurrency()));
     std::uint64_t seed = 1;
+    int runs = 1;
     nsp::EstimatorOptions estimator;  ///< max depth and roulette settings
     std::string out = "out";
     bool write_exr = true;
     bool list = false;
-    std::vector<LightSetup> setups{LightSetup::A, LightSetup::B};
-    std::vector<std::string_view> modes{nsp::Mono::name};
-    std::vector<std::string> estimators;  ///< filter tokens (empty: kDefaultEstimators)
-    std::optional<float> env;                    ///< constant environment radiance
-    std::optional<std::array<float, 4>> point;   ///< x, y, z, intensity
-    std::optional<std::array<float, 5>> sphere;  ///< x, y, z, radius, radiance
+    std::vector<SceneKind> scenes{SceneKind::Cloud, SceneKind::Chromatic};
+    std::vector<std::string> setups{"A", "B", "C1", "C2"};
+    std::vector<std::string_view> modes;  ///< empty: mono for the cloud, rgb and hero for the chromatic cloud
+    std::vector<std::string> estimators;  ///< filter tokens (empty: the scene's defaults)
+    std::vector<SelectionRule> selections{SelectionRule::Uniform, SelectionRule::Luminance};
+    LightOverrides lights;
 };
 
-constexpr const char* kHelp = R"(nsp_render: render the default cloud with every nsp path estimator and print an
-efficiency table per light set-up (LTUV = density lookups per sample x variance per sample).
+constexpr const char* kHelp = R"(nsp_render: render the default cloud scenes with nsp's path estimators and print an
+efficiency table per light set-up and spectral mode (LTUV = density lookups per sample x
+variance per sample; lower is better).
+
+Default run (no flags): the grey cloud, set-ups A and B, mono, 128x128, 512 spp, every
+PathEstimator (24 renders); then the chromatic cloud, set-ups C1 and C2, rgb and hero, 64x64,
+128 spp, the grey-majorant baseline uni-nee-mis_balance_absorb-weight and the spectral
+estimators listed under --estimators, uniform and luminance selection (absorb-weight; 12
+renders per set-up and mode, 48 in all), one run each. scripts/run-main.sh then adds the
+heavy-tail comparison: baseline against spectral MIS + NEE, --runs 5 at 32x32 (see the last
+example below).
 
 usage: nsp_render [flags]
 
-  --spp N            samples per pixel, N >= 2 (default 512); the variance per sample is
-                     estimated from the N samples of each pixel
-  --res WxH          image size in pixels (default 128x128); also --width W, --height H
+  --scene S          cloud, chromatic or both (default both). cloud: the grey cloud (extinction
+                     20, albedo 0.9), set-ups A and B. chromatic: the same cloud with extinction
+                     5 : 20 : 80 in R : G : B (hero: a spectrum through those values), albedo
+                     0.95, set-ups C1 and C2
+  --setup LIST       comma-separated set-ups of the chosen scenes, from A, B, C1, C2, or 'all'
+                     (default; 'both' also means all). A: a small bright sphere light above the
+                     grey cloud (NEE should win); B: a large dim sphere light behind it
+                     (unidirectional should win); C1: a constant white environment around the
+                     chromatic cloud (unidirectional paths dominate); C2: set-up A's small light
+                     above the chromatic cloud (NEE matters)
+  --spectral LIST    comma-separated spectral modes from mono, rgb, hero; 'both' = mono,rgb;
+                     'all' = all three (default: mono for the cloud, rgb,hero for the chromatic
+                     cloud; a list given here applies to both scenes). hero: 4 wavelengths per
+                     path (stratified rotation), drawn from the pixel's random stream; every
+                     sample is converted to linear sRGB via CIE XYZ before any statistic
+  --estimators LIST  comma-separated filter. Each item selects the rows whose fields include all
+                     of its '_'-separated fields, e.g. uni-nee-mis (every NEE-MIS row),
+                     uni-nee-mis_power, spectral-mis_lum, absorb-event; 'all' selects every
+                     valid combination. Fields of a row's name: strategy (unidirectional,
+                     ratio-nee, directional-mis, uni-nee-mis), channel policy (independent,
+                     spectral-tracking-max, spectral-tracking-avg, spectral-mis), majorant
+                     (global, per-channel), heuristic (balance, power), absorption
+                     (absorb-event, absorb-weight), lum (luminance selection). Rows of
+                     nsp::PathEstimator keep their names without channel policy and majorant
+                     and also match 'grey' and 'global'; uniform-selection rows also match
+                     'uniform'. Default for the cloud: grey (every PathEstimator). Default for
+                     the chromatic cloud:
+                       uni-nee-mis_grey_balance_absorb-weight (the grey-majorant baseline),
+                       unidirectional_independent_absorb-weight_uniform,
+                       uni-nee-mis_independent_absorb-weight,
+                       unidirectional_spectral-tracking-max_absorb-weight,
+                       uni-nee-mis_spectral-tracking-max_absorb-weight,
+                       unidirectional_spectral-tracking-avg_absorb-weight,
+                       uni-nee-mis_spectral-tracking-avg_absorb-weight,
+                       unidirectional_spectral-mis_absorb-weight_uniform,
+                       ratio-nee_spectral-mis_absorb-weight_uniform,
+                       uni-nee-mis_spectral-mis_absorb-weight
+  --selection R      uniform, luminance or both (default both): how the spectral estimators that
+                     use it (independent tracking, spectral MIS) choose a path's sampling
+                     channel. luminance: q_c proportional to 0.5/C + 0.5 y_c / sum(y), y = Rec. 709
+                     weights (0.2126, 0.7152, 0.0722) in rgb, the CIE y-bar of each of the path's
+                     wavelengths in hero. Luminance rows get the name field 'lum'. Spectral
+                     tracking (one shared pdf) does not depend on the selection and is rendered
+                     once, with uniform selection
+  --runs K           render each selected row K times with seeds seed, seed+1, ..., seed+K-1
+                     and report the median over the runs of seconds, lookups/spl, var/spl, LTUV
+                     and cpu-s*var (default 1); K > 1 adds the min..max of var/spl. For
+                     heavy-tailed estimators, whose sample variance is itself unreliable
+  --spp N            samples per pixel, N >= 2 (default 512 for the cloud, 128 for the
+                     chromatic cloud); the variance per sample is estimated from the N samples
+                     of each pixel
+  --res WxH          image size in pixels (default 128x128 for the cloud, 64x64 for the
+                     chromatic cloud); also --width W, --height H
   --threads N        worker threads (default: hardware concurrency)
   --seed N           random seed, an unsigned 64-bit integer (default 1); images do not depend
                      on --threads
   --max-depth N      most real scattering vertices on a path, N >= 0 (default 1000; 0 renders
                      the directly transmitted light only); Russian roulette from depth 3 on
-  --out DIR          directory for the EXR images (default out), created if missing; one image
-                     per render, named SETUP_ESTIMATOR[_HEURISTIC]_ABSORPTION[_rgb].exr
-  --no-exr           do not write images (timings and table only)
-  --setup S          A, B or both (default both). A: a small bright sphere light above the
-                     cloud (NEE should win); B: a large dim sphere light behind it
-                     (unidirectional should win)
-  --spectral M       mono, rgb or both (default mono): the spectral mode of the renders
-  --estimators LIST  comma-separated filter (default all). Each item selects the combinations
-                     whose name contains all of its '_'-separated fields, e.g.
-                     uni-nee-mis (4 renders), uni-nee-mis_power, absorb-event, ratio-nee;
-                     'all' selects every valid combination. Names: unidirectional, ratio-nee,
-                     directional-mis, uni-nee-mis; balance, power; absorb-event, absorb-weight.
+  --out DIR          directory for the EXR images (default out), created if missing; one linear
+                     RGB image (linear sRGB in hero mode) per row, from its first run, named
+                     SETUP_ROW[_rgb|_hero].exr, e.g. C1_uni-nee-mis_balance_absorb-weight_hero.exr
+  --no-exr           do not write images (timings and tables only)
   --list             list every compiled policy combination and exit
   --env L            add a constant environment light of radiance L >= 0
   --point X,Y,Z,I    add an isotropic point light of intensity I >= 0 at (X, Y, Z); only next-
@@ -101,8 +175,10 @@ usage: nsp_render [flags]
                      lie outside the medium box [-1, 1]^3
   --help             this text
 
-Examples: nsp_render --setup A --spp 256 --estimators uni-nee-mis_balance
-          nsp_render --spectral both --estimators all --spp 4 --res 64x64
+Examples: nsp_render --scene cloud --setup A --spp 256 --estimators uni-nee-mis_balance
+          nsp_render --scene chromatic --estimators all --spp 16 --res 32x32
+          nsp_render --scene chromatic --runs 5 --res 32x32 --spp 128 --no-exr \
+                     --estimators uni-nee-mis_grey_balance_absorb-weight,uni-nee-mis_spectral-mis_absorb-weight
 )";
 
 [[noreturn]] void usage_error(const std::string& msg) {
@@ -148,6 +224,13 @@ std::array<float, N> parse_floats(std::string_view flag, std::string_view text) 
     return v;
 }
 
+/// The spectral mode names, in the order of SpectralModes.
+std::vector<std::string_view> mode_names() {
+    std::vector<std::string_view> names;
+    tl::for_each<SpectralModes>([&]<class S>(std::type_identity<S>) { names.emplace_back(S::name); });
+    return names;
+}
+
 Options parse(int argc, char** argv) {
     Options o;
     std::vector<std::string_view> args(argv + 1, argv + argc);
@@ -185,6 +268,8 @@ Options parse(int argc, char** argv) {
             o.threads = parse_number<int>(flag, value(), 1, 1024);
         } else if (flag == "--seed") {
             o.seed = parse_number<std::uint64_t>(flag, value(), 0, std::numeric_limits<std::uint64_t>::max());
+        } else if (flag == "--runs") {
+            o.runs = parse_number<int>(flag, value(), 1, 1000);
         } else if (flag == "--max-depth") {
             o.estimator.max_depth = parse_number<int>(flag, value(), 0, 1 << 20);
         } else if (flag == "--out") {
@@ -196,32 +281,52 @@ Options parse(int argc, char** argv) {
         } else if (flag == "--list") {
             no_value();
             o.list = true;
+        } else if (flag == "--scene") {
+            const std::string_view v = value();
+            if (v == "cloud") o.scenes = {SceneKind::Cloud};
+            else if (v == "chromatic") o.scenes = {SceneKind::Chromatic};
+            else if (v == "both") o.scenes = {SceneKind::Cloud, SceneKind::Chromatic};
+            else usage_error("--scene: '" + std::string(v) + "' is not one of cloud, chromatic, both");
         } else if (flag == "--setup") {
-            const std::string_view v = value();
-            if (v == "A" || v == "a") o.setups = {LightSetup::A};
-            else if (v == "B" || v == "b") o.setups = {LightSetup::B};
-            else if (v == "both") o.setups = {LightSetup::A, LightSetup::B};
-            else usage_error("--setup: '" + std::string(v) + "' is not one of A, B, both");
+            o.setups.clear();
+            for (const auto t : split(value(), ',')) {
+                if (t == "all" || t == "both") o.setups = {"A", "B", "C1", "C2"};
+                else if (t == "A" || t == "a") o.setups.emplace_back("A");
+                else if (t == "B" || t == "b") o.setups.emplace_back("B");
+                else if (t == "C1" || t == "c1") o.setups.emplace_back("C1");
+                else if (t == "C2" || t == "c2") o.setups.emplace_back("C2");
+                else usage_error("--setup: '" + std::string(t) + "' is not one of A, B, C1, C2, all");
+            }
         } else if (flag == "--spectral") {
-            const std::string_view v = value();
-            if (v == nsp::Mono::name) o.modes = {nsp::Mono::name};
-            else if (v == nsp::Rgb::name) o.modes = {nsp::Rgb::name};
-            else if (v == "both") o.modes = {nsp::Mono::name, nsp::Rgb::name};
-            else usage_error("--spectral: '" + std::string(v) + "' is not one of mono, rgb, both");
+            const auto known = mode_names();
+            o.modes.clear();
+            for (const auto t : split(value(), ',')) {
+                if (t == "all") o.modes = known;
+                else if (t == "both") o.modes = {nsp::Mono::name, nsp::Rgb::name};
+                else if (const auto it = std::find(known.begin(), known.end(), t); it != known.end())
+                    o.modes.push_back(*it);
+                else usage_error("--spectral: '" + std::string(t) + "' is not one of mono, rgb, hero, both, all");
+            }
         } else if (flag == "--estimators") {
             o.estimators.clear();
             for (const auto t : split(value(), ','))
                 if (!t.empty()) o.estimators.emplace_back(t);
             if (o.estimators.empty()) usage_error("--estimators needs at least one name");
+        } else if (flag == "--selection") {
+            const std::string_view v = value();
+            if (v == "uniform") o.selections = {SelectionRule::Uniform};
+            else if (v == "luminance") o.selections = {SelectionRule::Luminance};
+            else if (v == "both") o.selections = {SelectionRule::Uniform, SelectionRule::Luminance};
+            else usage_error("--selection: '" + std::string(v) + "' is not one of uniform, luminance, both");
         } else if (flag == "--env") {
-            o.env = parse_number<float>(flag, value(), 0.f, 1e30f);
+            o.lights.env = parse_number<float>(flag, value(), 0.f, 1e30f);
         } else if (flag == "--point") {
-            o.point = parse_floats<4>(flag, value());
-            if ((*o.point)[3] < 0.f) usage_error("--point: the intensity must be >= 0");
+            o.lights.point = parse_floats<4>(flag, value());
+            if ((*o.lights.point)[3] < 0.f) usage_error("--point: the intensity must be >= 0");
         } else if (flag == "--sphere") {
-            o.sphere = parse_floats<5>(flag, value());
-            if (!((*o.sphere)[3] > 0.f)) usage_error("--sphere: the radius must be > 0");
-            if ((*o.sphere)[4] < 0.f) usage_error("--sphere: the radiance must be >= 0");
+            o.lights.sphere = parse_floats<5>(flag, value());
+            if (!((*o.lights.sphere)[3] > 0.f)) usage_error("--sphere: the radius must be > 0");
+            if ((*o.lights.sphere)[4] < 0.f) usage_error("--sphere: the radiance must be >= 0");
         } else {
             usage_error("unknown flag '" + std::string(args[i]) + "'");
         }
@@ -230,214 +335,168 @@ Options parse(int argc, char** argv) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Selecting combinations (run-time names, compile-time types)
+// Planning: which rows to render (run-time names of compile-time combinations)
 
-/// The '_'-separated fields of a combination's name.
-template <class C>
-std::vector<std::string> fields_of() {
-    const std::string name = C::name();
-    std::vector<std::string> f;
-    for (const auto p : split(name, '_')) f.emplace_back(p);
-    return f;
+/// One row of a table: a combination of one mode with a selection rule, and its names.
+struct Candidate {
+    std::size_t index = 0;  ///< into CombinationsOf<S>
+    SelectionRule selection = SelectionRule::Uniform;
+    std::string name;                 ///< the row's name, e.g. uni-nee-mis_spectral-mis_per-channel_balance_absorb-weight_lum
+    std::vector<std::string> fields;  ///< the name's '_'-separated fields and the implied ones (grey, global, uniform)
+    std::string channels;             ///< the channel policy ("grey" for PathEstimator)
+    std::string strategy;
+    std::string absorption;
+    bool uses_selection = false;
+};
+
+/// Every row spectral mode S offers with selection rules `rules`, in list order (a row that
+/// uses the selection once per rule, the luminance one right after the uniform one).
+template <class S>
+std::vector<Candidate> candidates_of(const std::vector<SelectionRule>& rules) {
+    std::vector<Candidate> out;
+    std::size_t index = 0;
+    tl::for_each<CombinationsOf<S>>([&]<class C>(std::type_identity<C>) {
+        Candidate c;
+        c.index = index++;
+        c.channels = C::ChannelPolicy::name;
+        c.strategy = C::Strategy::name;
+        c.absorption = C::Absorption::name;
+        c.uses_selection = C::uses_selection;
+        c.name = C::name();
+        for (const auto f : split(c.name, '_')) c.fields.emplace_back(f);
+        if constexpr (!C::spectral) {
+            c.fields.emplace_back("grey");
+            c.fields.emplace_back("global");
+        }
+        if (!C::uses_selection) {
+            out.push_back(c);
+            return;
+        }
+        for (const SelectionRule r : rules) {
+            Candidate s = c;
+            s.selection = r;
+            if (r == SelectionRule::Luminance) {
+                s.name += "_lum";
+                s.fields.emplace_back("lum");
+            } else {
+                s.fields.emplace_back("uniform");
+            }
+            out.push_back(std::move(s));
+        }
+    });
+    return out;
 }
 
-/// True when every field of `token` is a field of the combination C.
-template <class C>
-bool matches(std::string_view token) {
+std::vector<Candidate> candidates(std::string_view mode, const std::vector<SelectionRule>& rules) {
+    std::vector<Candidate> out;
+    tl::for_each<SpectralModes>([&]<class S>(std::type_identity<S>) {
+        if (mode == S::name) out = candidates_of<S>(rules);
+    });
+    return out;
+}
+
+/// True when every field of `token` is a field of the row.
+bool matches(const Candidate& c, std::string_view token) {
     if (token == "all") return true;
-    const auto fields = fields_of<C>();
     for (const auto t : split(token, '_'))
-        if (std::find(fields.begin(), fields.end(), t) == fields.end()) return false;
+        if (std::find(c.fields.begin(), c.fields.end(), t) == c.fields.end()) return false;
     return true;
 }
 
-/// Indices into AllCombinations of the renders to run for spectral mode `mode`, in list order.
-std::vector<std::size_t> select(const Options& o, std::string_view mode) {
-    std::vector<std::string> tokens = o.estimators;
-    if (tokens.empty()) tokens.emplace_back(kDefaultEstimators);
-    std::vector<std::size_t> chosen;
-    std::vector<bool> used(tokens.size(), false);
-    std::size_t index = 0;
-    tl::for_each<AllCombinations>([&]<class C>(std::type_identity<C>) {
-        if (mode == C::Spectral::name) {
-            bool any = false;
-            for (std::size_t t = 0; t < tokens.size(); ++t)
-                if (matches<C>(tokens[t])) used[t] = any = true;
-            if (any) chosen.push_back(index);
+/// The renders of one table: one set-up of one scene in one spectral mode.
+struct TablePlan {
+    SceneChoice scene;
+    std::string_view mode;
+    int width = 0, height = 0, spp = 0;
+    std::vector<Candidate> rows;
+};
+
+std::vector<TablePlan> plan(const Options& o) {
+    std::vector<TablePlan> tables;
+    std::vector<std::string> all_tokens = o.estimators;
+    std::vector<bool> used(all_tokens.size(), false);
+    for (const SceneKind kind : o.scenes) {
+        const bool cloud = kind == SceneKind::Cloud;
+        std::vector<SceneChoice> choices;
+        for (const auto& s : o.setups) {
+            if (cloud && (s == "A" || s == "B")) choices.push_back({kind, s == "A" ? LightSetup::A : LightSetup::B});
+            if (!cloud && (s == "C1" || s == "C2"))
+                choices.push_back({kind, LightSetup::A, s == "C1" ? ChromaticSetup::Env : ChromaticSetup::Small});
         }
-        ++index;
-    });
-    for (std::size_t t = 0; t < tokens.size(); ++t)
-        if (!used[t]) usage_error("--estimators: '" + tokens[t] + "' matches no estimator (see --list)");
-    return chosen;
-}
-
-// ---------------------------------------------------------------------------------------------
-// Rendering
-
-/// CPU time of the calling thread (POSIX): unlike wall time, not inflated by other processes.
-double thread_cpu_seconds() {
-    timespec ts{};
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-    return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
-}
-
-/// What one render measured.
-struct RenderStats {
-    std::string name;
-    double wall_seconds = 0.0;
-    double cpu_seconds = 0.0;      ///< summed over worker threads
-    std::uint64_t samples = 0;
-    std::uint64_t lookups = 0;     ///< density lookups, summed over threads
-    std::uint64_t aborted = 0, nonfinite = 0;
-    std::uint64_t nonzero = 0;     ///< samples with a nonzero estimate
-    double variance = 0.0;         ///< mean over pixels of the per-pixel sample variance
-    double mean = 0.0;             ///< image mean of the channel mean (an unbiasedness check)
-
-    double lookups_per_sample() const { return double(lookups) / double(samples); }
-    double ltuv() const { return lookups_per_sample() * variance; }
-    double time_variance() const { return cpu_seconds / double(samples) * variance; }
-};
-
-/// Per-thread accumulators, summed after the join.
-struct ThreadTotals {
-    nsp::LookupCount counter;
-    std::uint64_t aborted = 0, nonfinite = 0, nonzero = 0;
-    double variance_sum = 0.0, mean_sum = 0.0, cpu_seconds = 0.0;
-};
-
-/// Prints "label  NN%" in place on a terminal; nothing elsewhere (the caller prints a line per render).
-class Progress {
-public:
-    Progress(std::string label, bool tty) : label_(std::move(label)), tty_(tty) {}
-
-    /// Called by any worker after a row; prints at most every 0.25 s.
-    void update(int done, int total) {
-        if (!tty_ || !mutex_.try_lock()) return;
-        const auto now = std::chrono::steady_clock::now();
-        if (now - last_ > std::chrono::milliseconds(250)) {
-            last_ = now;
-            std::fprintf(stderr, "\r  %-60s %3d%%", label_.c_str(), int(100.0 * done / total));
-            std::fflush(stderr);
+        std::vector<std::string_view> modes = o.modes;
+        if (modes.empty()) {
+            if (cloud) modes = {nsp::Mono::name};
+            else modes = {nsp::Rgb::name, Hero4::name};
         }
-        mutex_.unlock();
-    }
-    /// Replaces the progress line with a summary line.
-    void finish(const std::string& summary) {
-        if (tty_) std::fprintf(stderr, "\r%-80s\r", "");
-        std::fprintf(stderr, "  %s\n", summary.c_str());
-    }
-
-private:
-    std::string label_;
-    bool tty_;
-    std::mutex mutex_;
-    std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
-};
-
-/// Renders `scene` with combination C's estimator: per pixel, `o.spp` jittered camera rays; one
-/// Pcg32 stream per pixel (so images do not depend on the thread count); rows handed out to
-/// threads through an atomic counter. Writes the mean radiance into `rgb`.
-template <class C>
-RenderStats render(const typename C::Scene& scene, const Options& o, const std::string& label,
-                   std::vector<float>& rgb) {
-    using S = typename C::Spectral;
-    const typename C::Estimator estimator{o.estimator};
-    const int w = o.width, h = o.height;
-    const float aspect = float(w) / float(h);
-    rgb.assign(std::size_t(w) * std::size_t(h) * 3u, 0.f);
-
-    std::atomic<int> next_row{0}, rows_done{0};
-    std::vector<ThreadTotals> totals(std::size_t(o.threads));
-    Progress progress(label, isatty(STDERR_FILENO) != 0);
-
-    auto work = [&](ThreadTotals& out) {
-        ThreadTotals t;  // local: the counters of different threads must not share a cache line
-        const double cpu0 = thread_cpu_seconds();
-        const typename S::Wavelengths lambda{};
-        for (int y; (y = next_row.fetch_add(1)) < h;) {
-            for (int x = 0; x < w; ++x) {
-                const std::size_t pixel = std::size_t(y) * std::size_t(w) + std::size_t(x);
-                nsp::Pcg32 rng(o.seed, pixel);
-                typename S::Spectrum sum = S::Spectrum::Zero();
-                double mean = 0.0, m2 = 0.0;  // Welford on the channel mean
-                for (int k = 1; k <= o.spp; ++k) {
-                    const float u = (float(x) + rng.uniform()) / float(w);
-                    const float v = 1.f - (float(y) + rng.uniform()) / float(h);
-                    const auto r = estimator.radiance(scene, camera_ray(u, v, aspect), lambda, rng, t.counter);
-                    if (r.status == nsp::Status::Aborted) ++t.aborted;
-                    else if (r.status == nsp::Status::NonFinite) ++t.nonfinite;
-                    sum += r.value;
-                    const double s = double(r.value.mean());
-                    if (s != 0.0) ++t.nonzero;
-                    const double d = s - mean;
-                    mean += d / k;
-                    m2 += d * (s - mean);
+        const std::vector<std::string>& tokens =
+            !o.estimators.empty() ? o.estimators : (cloud ? kCloudEstimators : kChromaticEstimators);
+        for (const SceneChoice& choice : choices) {
+            for (const auto mode : modes) {
+                TablePlan t{choice, mode,
+                            o.width.value_or(cloud ? kCloudWidth : kChromaticWidth),
+                            o.height.value_or(cloud ? kCloudHeight : kChromaticHeight),
+                            o.spp.value_or(cloud ? kCloudSpp : kChromaticSpp),
+                            {}};
+                for (const Candidate& c : candidates(mode, o.selections)) {
+                    bool any = false;
+                    for (std::size_t k = 0; k < tokens.size(); ++k) {
+                        if (!matches(c, tokens[k])) continue;
+                        any = true;
+                        if (!o.estimators.empty()) used[k] = true;
+                    }
+                    if (any) t.rows.push_back(c);
                 }
-                t.variance_sum += m2 / double(o.spp - 1);
-                t.mean_sum += mean;
-                const typename S::Spectrum avg = sum / float(o.spp);
-                for (int c = 0; c < 3; ++c) rgb[3 * pixel + std::size_t(c)] = avg[S::channels == 3 ? c : 0];
+                if (!t.rows.empty()) tables.push_back(std::move(t));
             }
-            progress.update(rows_done.fetch_add(1) + 1, h);
         }
-        t.cpu_seconds = thread_cpu_seconds() - cpu0;
-        out = t;
-    };
-
-    const auto t0 = std::chrono::steady_clock::now();
-    {
-        std::vector<std::jthread> pool;
-        for (int i = 1; i < o.threads; ++i) pool.emplace_back(work, std::ref(totals[std::size_t(i)]));
-        work(totals[0]);
     }
-    RenderStats st;
-    st.name = C::name();
-    st.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    st.samples = std::uint64_t(w) * std::uint64_t(h) * std::uint64_t(o.spp);
-    double variance_sum = 0.0, mean_sum = 0.0;
-    for (const ThreadTotals& t : totals) {
-        st.lookups += t.counter.count();
-        st.aborted += t.aborted;
-        st.nonfinite += t.nonfinite;
-        st.nonzero += t.nonzero;
-        st.cpu_seconds += t.cpu_seconds;
-        variance_sum += t.variance_sum;
-        mean_sum += t.mean_sum;
-    }
-    const double pixels = double(w) * double(h);
-    st.variance = variance_sum / pixels;
-    st.mean = mean_sum / pixels;
-    std::ostringstream os;
-    os.precision(3);
-    os << label << ": " << std::fixed << st.wall_seconds << " s";
-    progress.finish(os.str());
-    return st;
-}
-
-/// The scene of combination C in `setup`, with the lights the flags add or replace.
-template <class C>
-typename C::Scene make_scene(LightSetup setup, const Options& o) {
-    using S = typename C::Spectral;
-    using Spec = typename S::Spectrum;
-    nsp::Lights<S> lights = default_lights<S>(setup);
-    if (o.sphere) {
-        const auto& s = *o.sphere;
-        lights.set(nsp::SphereLight<S>{nsp::Vec3(s[0], s[1], s[2]), s[3], Spec::Constant(s[4])});
-    }
-    if (o.point) {
-        const auto& p = *o.point;
-        lights.set(nsp::PointLight<S>{nsp::Vec3(p[0], p[1], p[2]), Spec::Constant(p[3])});
-    }
-    if (o.env) lights.set(nsp::EnvironmentLight<S>{Spec::Constant(*o.env)});
-    auto medium = C::MediumKind::template make<S>();
-    auto majorant = C::MajorantKind::make(medium);
-    return typename C::Scene(std::move(medium), std::move(majorant), nsp::HenyeyGreensteinPhase(kPhaseG),
-                             std::move(lights));
+    for (std::size_t k = 0; k < all_tokens.size(); ++k)
+        if (!used[k])
+            usage_error("--estimators: '" + all_tokens[k] + "' matches no row of the chosen scenes, set-ups and "
+                        "spectral modes (see --list)");
+    if (tables.empty()) usage_error("nothing to render: --scene and --setup choose no set-up in common");
+    return tables;
 }
 
 // ---------------------------------------------------------------------------------------------
-// The table
+// The tables
+
+/// A rendered row: its runs.
+struct Row {
+    Candidate c;
+    std::vector<RenderStats> runs;
+
+    /// The median over runs of metric f (the mean of the two middle values for an even count).
+    template <class F>
+    double median(F f) const {
+        std::vector<double> v;
+        for (const RenderStats& r : runs) v.push_back(f(r));
+        std::sort(v.begin(), v.end());
+        const std::size_t n = v.size();
+        return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+    }
+    template <class F>
+    std::pair<double, double> range(F f) const {
+        double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+        for (const RenderStats& r : runs) {
+            lo = std::min(lo, f(r));
+            hi = std::max(hi, f(r));
+        }
+        return {lo, hi};
+    }
+};
+
+/// The statistics of one table: which variance it reports (see the footers).
+struct Metrics {
+    bool per_channel = false;  ///< per-channel variance (chromatic) or variance of the channel mean (cloud)
+
+    double variance(const RenderStats& r) const { return per_channel ? r.variance_per_channel : r.variance_of_mean; }
+    double ltuv(const RenderStats& r) const { return r.lookups_per_sample() * variance(r); }
+    double time_variance(const RenderStats& r) const { return r.cpu_seconds_per_sample() * variance(r); }
+
+    double var(const Row& row) const { return row.median([&](const RenderStats& r) { return variance(r); }); }
+    double ltuv(const Row& row) const { return row.median([&](const RenderStats& r) { return ltuv(r); }); }
+};
 
 std::string num(double v) {
     char buf[32];
@@ -445,69 +504,221 @@ std::string num(double v) {
     return buf;
 }
 
-const RenderStats* find_row(const std::vector<RenderStats>& rows, std::string_view name) {
-    for (const RenderStats& r : rows)
-        if (r.name == name) return &r;
+const Row* find_row(const std::vector<Row>& rows, std::string_view name) {
+    for (const Row& r : rows)
+        if (r.c.name == name) return &r;
     return nullptr;
 }
 
-void print_table(LightSetup setup, std::string_view mode, const Options& o, const std::vector<RenderStats>& rows) {
-    if (rows.empty()) return;
+/// "a, b, c": a metric of every run.
+template <class F>
+std::string per_run(const Row& row, F f) {
+    std::string s;
+    for (const RenderStats& r : row.runs) s += (s.empty() ? "" : ", ") + num(f(r));
+    return s;
+}
+
+/// The rows and columns every table shares; returns the best (lowest positive) LTUV.
+double print_rows(const TablePlan& t, const Options& o, const std::vector<Row>& rows, const Metrics& m) {
+    const bool chromatic = t.scene.kind == SceneKind::Chromatic;
     // Best row: the lowest LTUV among rows that measured any variance (a strategy that never
     // found the light has variance 0 and an LTUV that means nothing).
     double best = std::numeric_limits<double>::infinity();
-    for (const RenderStats& r : rows)
-        if (r.ltuv() > 0.0) best = std::min(best, r.ltuv());
-    std::printf("\nSet-up %s (%.*s, %dx%d, %d spp, %d threads)\n", name(setup), int(mode.size()), mode.data(),
-                o.width, o.height, o.spp, o.threads);
-    std::printf("%-36s %5s %8s %11s %11s %11s %11s %9s %9s\n", "estimator", "spp", "seconds", "lookups/spl",
-                "var/spl", "LTUV", "cpu-s*var", "LTUV/best", "mean");
-    std::uint64_t aborted = 0, nonfinite = 0;
-    for (const RenderStats& r : rows) {
-        const bool measured = r.ltuv() > 0.0 && std::isfinite(best);
-        std::printf("%-36s %5d %8.2f %11s %11s %11s %11s %9s %9s\n", r.name.c_str(), o.spp, r.wall_seconds,
-                    num(r.lookups_per_sample()).c_str(), num(r.variance).c_str(), num(r.ltuv()).c_str(),
-                    num(r.time_variance()).c_str(), measured ? num(r.ltuv() / best).c_str() : "n/a",
-                    num(r.mean).c_str());
-        aborted += r.aborted;
-        nonfinite += r.nonfinite;
+    for (const Row& r : rows)
+        if (m.ltuv(r) > 0.0) best = std::min(best, m.ltuv(r));
+    std::size_t width = 36;
+    for (const Row& r : rows) width = std::max(width, r.c.name.size());
+    const int wn = int(width);
+    std::printf("%-*s %5s %8s %11s %11s %11s %11s %9s", wn, "estimator", "spp", "seconds", "lookups/spl", "var/spl",
+                "LTUV", "cpu-s*var", "LTUV/best");
+    if (o.runs > 1) std::printf(" %19s", "var/spl min..max");
+    std::printf(chromatic ? " %s\n" : " %9s\n", chromatic ? "mean R G B" : "mean");
+    for (const Row& r : rows) {
+        const double ltuv = m.ltuv(r);
+        const bool measured = ltuv > 0.0 && std::isfinite(best);
+        std::printf("%-*s %5d %8.2f %11s %11s %11s %11s %9s", wn, r.c.name.c_str(), t.spp,
+                    r.median([](const RenderStats& s) { return s.wall_seconds; }),
+                    num(r.median([](const RenderStats& s) { return s.lookups_per_sample(); })).c_str(),
+                    num(m.var(r)).c_str(), num(ltuv).c_str(),
+                    num(r.median([&](const RenderStats& s) { return m.time_variance(s); })).c_str(),
+                    measured ? num(ltuv / best).c_str() : "n/a");
+        if (o.runs > 1) {
+            const auto [lo, hi] = r.range([&](const RenderStats& s) { return m.variance(s); });
+            std::printf(" %19s", (num(lo) + ".." + num(hi)).c_str());
+        }
+        std::array<double, 3> mean{};
+        for (const RenderStats& s : r.runs)
+            for (int i = 0; i < 3; ++i) mean[std::size_t(i)] += s.mean[std::size_t(i)] / double(r.runs.size());
+        if (chromatic)
+            std::printf(" %s %s %s\n", num(mean[0]).c_str(), num(mean[1]).c_str(), num(mean[2]).c_str());
+        else
+            std::printf(" %9s\n", num((mean[0] + mean[1] + mean[2]) / 3.0).c_str());
     }
-    std::printf("var/spl: per-pixel sample variance of the %d samples of each pixel (Welford)%s, averaged over "
-                "the %d pixels.\n", o.spp, mode == nsp::Rgb::name ? " of the channel mean" : "", o.width * o.height);
-    std::printf("LTUV = lookups/spl x var/spl; cpu-s*var = thread CPU seconds per sample x var/spl; lower is "
-                "better. mean: image mean (should agree across rows).\n");
+    return best;
+}
+
+/// Footer lines every table shares: medians, status counts, rarely nonzero rows.
+void print_common_footer(const Options& o, const std::vector<Row>& rows) {
+    if (o.runs > 1)
+        std::printf("seconds, lookups/spl, var/spl, LTUV, cpu-s*var: MEDIAN over %d runs (seeds %llu..%llu), "
+                    "LTUV/best from the median LTUV; min..max: var/spl over the runs; mean: over the runs.\n",
+                    o.runs, (unsigned long long)o.seed, (unsigned long long)(o.seed + std::uint64_t(o.runs) - 1));
+    std::uint64_t aborted = 0, nonfinite = 0;
+    for (const Row& r : rows)
+        for (const RenderStats& s : r.runs) {
+            aborted += s.aborted;
+            nonfinite += s.nonfinite;
+        }
     std::printf("paths with status Aborted: %llu, NonFinite: %llu\n", (unsigned long long)aborted,
                 (unsigned long long)nonfinite);
-    if (o.point)
+    if (o.lights.point)
         std::printf("note: the point light (--point) is reachable by next-event estimation only, so the "
                     "unidirectional rows leave out its light and their mean is lower\n");
-    for (const RenderStats& r : rows)
-        if (r.nonzero < 1000)
+    for (const Row& r : rows) {
+        std::uint64_t nonzero = 0, samples = 0;
+        for (const RenderStats& s : r.runs) {
+            nonzero += s.nonzero;
+            samples += s.samples;
+        }
+        if (nonzero < 1000)
             std::printf("note: %s: only %llu of %llu samples were nonzero (the light is rarely found); its "
                         "variance and mean rest on those few and are themselves very noisy\n",
-                        r.name.c_str(), (unsigned long long)r.nonzero, (unsigned long long)r.samples);
+                        r.c.name.c_str(), (unsigned long long)nonzero, (unsigned long long)samples);
+    }
+}
+
+void print_cloud_table(const TablePlan& t, const Options& o, const std::vector<Row>& rows) {
+    const Metrics m{false};
+    std::printf("\nSet-up %s (%.*s, %dx%d, %d spp, %d threads%s)\n", t.scene.name(), int(t.mode.size()),
+                t.mode.data(), t.width, t.height, t.spp, o.threads,
+                o.runs > 1 ? (", " + std::to_string(o.runs) + " runs").c_str() : "");
+    print_rows(t, o, rows, m);
+    std::printf("var/spl: per-pixel sample variance of the %d samples of each pixel (Welford)%s, averaged over "
+                "the %d pixels.\n", t.spp,
+                t.mode == nsp::Mono::name ? ""
+                : t.mode == Hero4::name   ? " of the channel mean of its linear sRGB values"
+                                          : " of the channel mean",
+                t.width * t.height);
+    std::printf("LTUV = lookups/spl x var/spl; cpu-s*var = thread CPU seconds per sample x var/spl; lower is "
+                "better. mean: image mean (should agree across rows).\n");
+    print_common_footer(o, rows);
     // THEORY 7's claim, on the absorb-weight rows when present.
     const auto* uni = find_row(rows, "unidirectional_absorb-weight");
     const auto* nee = find_row(rows, "ratio-nee_absorb-weight");
     const auto* mis = find_row(rows, "uni-nee-mis_balance_absorb-weight");
-    if (uni && nee) std::printf("ratio-nee / unidirectional LTUV: %s", num(nee->ltuv() / uni->ltuv()).c_str());
+    if (uni && nee) std::printf("ratio-nee / unidirectional LTUV: %s", num(m.ltuv(*nee) / m.ltuv(*uni)).c_str());
     if (uni && nee && mis)
         std::printf("; uni-nee-mis_balance / best single strategy: %s",
-                    num(mis->ltuv() / std::min(uni->ltuv(), nee->ltuv())).c_str());
+                    num(m.ltuv(*mis) / std::min(m.ltuv(*uni), m.ltuv(*nee))).c_str());
     if (uni && nee) std::printf(" (absorb-weight rows)\n");
-    std::fflush(stdout);
+}
+
+/// The lowest-LTUV row among `rows` that `pred` accepts (nullptr if none measured a variance).
+template <class P>
+const Row* best_of(const std::vector<Row>& rows, const Metrics& m, P pred) {
+    const Row* best = nullptr;
+    for (const Row& r : rows)
+        if (pred(r) && m.ltuv(r) > 0.0 && (!best || m.ltuv(r) < m.ltuv(*best))) best = &r;
+    return best;
+}
+
+void print_chromatic_table(const TablePlan& t, const Options& o, const std::vector<Row>& rows) {
+    const Metrics m{true};
+    std::printf("\nSet-up %s (chromatic 1:4:16, %.*s, %dx%d, %d spp, %d threads%s)\n", t.scene.name(),
+                int(t.mode.size()), t.mode.data(), t.width, t.height, t.spp, o.threads,
+                o.runs > 1 ? (", " + std::to_string(o.runs) + " runs").c_str() : "");
+    print_rows(t, o, rows, m);
+    const bool hero = t.mode == Hero4::name;
+    std::printf("var/spl: per-channel sample variance of the %d samples of each pixel (Welford)%s, averaged over "
+                "the 3 channels and the %d pixels; the variance of the channel mean would hide independent "
+                "tracking's colour noise.\n", t.spp, hero ? " of its linear sRGB values" : "", t.width * t.height);
+    std::printf("LTUV = lookups/spl x var/spl; cpu-s*var = thread CPU seconds per sample x var/spl; lower is "
+                "better. mean R G B: image mean per channel%s (should agree across rows).\n",
+                hero ? " (linear sRGB)" : "");
+    std::printf("Rows without a channel policy are nsp::PathEstimator with the grey (global) majorant; _lum: "
+                "luminance channel selection, otherwise uniform.\n");
+    print_common_footer(o, rows);
+
+    const std::string runs_note = o.runs > 1 ? "median over " + std::to_string(o.runs) + " runs"
+                                             : "one run; the baseline is heavy-tailed, see --runs";
+    // (a) spectral MIS + NEE against the grey-majorant baseline of the same mode.
+    const Row* base = find_row(rows, "uni-nee-mis_balance_absorb-weight");
+    for (const char* suffix : {"", "_lum"}) {
+        const Row* smis =
+            find_row(rows, std::string("uni-nee-mis_spectral-mis_per-channel_balance_absorb-weight") + suffix);
+        if (!base || !smis) continue;
+        std::printf("grey-majorant baseline / spectral-mis + NEE%s (uni-nee-mis, absorb-weight): var/spl %s, "
+                    "LTUV %s (%s)\n", *suffix ? " with luminance selection" : "",
+                    num(m.var(*base) / m.var(*smis)).c_str(), num(m.ltuv(*base) / m.ltuv(*smis)).c_str(),
+                    runs_note.c_str());
+        if (o.runs > 1)
+            std::printf("  var/spl per run: baseline %s; spectral-mis + NEE%s %s\n",
+                        per_run(*base, [&](const RenderStats& s) { return m.variance(s); }).c_str(), suffix,
+                        per_run(*smis, [&](const RenderStats& s) { return m.variance(s); }).c_str());
+    }
+    // (b) the best of each channel policy, and the best overall, by LTUV.
+    struct Family {
+        const char* label;
+        std::function<bool(const Row&)> pred;
+    };
+    const std::vector<Family> families{
+        {"independent", [](const Row& r) { return r.c.channels == "independent"; }},
+        {"spectral tracking", [](const Row& r) { return r.c.channels.starts_with("spectral-tracking"); }},
+        {"spectral MIS", [](const Row& r) { return r.c.channels == "spectral-mis" && r.c.strategy != "uni-nee-mis"; }},
+        {"spectral MIS + NEE", [](const Row& r) { return r.c.channels == "spectral-mis" && r.c.strategy == "uni-nee-mis"; }},
+    };
+    std::string line;
+    std::vector<std::pair<double, const char*>> bests;
+    for (const Family& f : families) {
+        const Row* r = best_of(rows, m, f.pred);
+        if (!r) continue;
+        line += std::string(line.empty() ? "" : "; ") + f.label + " " + num(m.ltuv(*r)) + " (" + r->c.name + ")";
+        bests.emplace_back(m.ltuv(*r), f.label);
+    }
+    if (!bests.empty()) {
+        std::sort(bests.begin(), bests.end());
+        std::string close;  // within 10% of the lowest: no ranking at this noise level
+        for (std::size_t i = 1; i < bests.size(); ++i)
+            if (bests[i].first <= 1.1 * bests[0].first) close += std::string(close.empty() ? "" : ", ") + bests[i].second;
+        std::printf("best LTUV per channel policy: %s -> lowest: %s%s\n", line.c_str(), bests[0].second,
+                    close.empty() ? "" : (" (within 10%: " + close + ")").c_str());
+    }
+    // (c) luminance against uniform selection, row by row.
+    std::string sel;
+    for (const Row& r : rows) {
+        if (r.c.selection != SelectionRule::Luminance) continue;
+        const Row* u = find_row(rows, r.c.name.substr(0, r.c.name.size() - 4));
+        if (u && m.ltuv(*u) > 0.0)
+            sel += std::string(sel.empty() ? "" : "; ") + u->c.name + " " + num(m.ltuv(r) / m.ltuv(*u));
+    }
+    if (!sel.empty()) std::printf("luminance / uniform selection, LTUV: %s\n", sel.c_str());
 }
 
 void list_combinations() {
-    std::printf("%-6s %-18s %-9s %-14s %-9s %-11s %s\n", "mode", "strategy", "heuristic", "absorption", "majorant",
-                "medium", "name");
-    tl::for_each<AllCombinations>([]<class C>(std::type_identity<C>) {
-        std::printf("%-6s %-18s %-9s %-14s %-9s %-11s %s\n", C::Spectral::name, C::Strategy::name,
-                    C::Heuristic::name, C::Absorption::name, C::MajorantKind::name, C::MediumKind::name,
-                    C::name().c_str());
+    std::printf("%-5s %-21s %-11s %-15s %-9s %-13s %-10s %s\n", "mode", "channels", "majorant", "strategy",
+                "heuristic", "absorption", "medium", "name");
+    std::size_t total = 0;
+    tl::for_each<SpectralModes>([&]<class S>(std::type_identity<S>) {
+        tl::for_each<CombinationsOf<S>>([]<class C>(std::type_identity<C>) {
+            std::printf("%-5s %-21s %-11s %-15s %-9s %-13s %-10s %s\n", C::Spectral::name, C::ChannelPolicy::name,
+                        C::MajorantKind::name, C::Strategy::name, C::Heuristic::name, C::Absorption::name,
+                        C::MediumKind::name, C::name().c_str());
+        });
+        std::printf("  %s: %zu combinations\n", S::name, tl::size<CombinationsOf<S>>);
+        total += tl::size<CombinationsOf<S>>;
     });
-    std::printf("%zu valid combinations (PathEstimator rejects a heuristic on a single strategy and mis::None "
-                "on an MIS strategy).\n", tl::size<AllCombinations>);
+    std::printf("%zu valid combinations. channels 'grey' is nsp::PathEstimator (grey majorant; a heuristic on a "
+                "single strategy and mis::None on an MIS strategy are rejected); the others are "
+                "nsp::SpectralPathEstimator, only in multi-channel modes: independent and spectral-mis with the "
+                "per-channel majorant, spectral tracking with the global one; no directional-mis; mis::None for "
+                "single strategies, balance for uni-nee-mis. Independent and spectral-mis rows are rendered once "
+                "per --selection rule (luminance rows end in _lum).\n", total);
+}
+
+RenderStats render_in_mode(std::string_view mode, std::size_t index, const RenderRequest& rq, std::vector<float>& rgb) {
+    if (mode == nsp::Mono::name) return render_combination<nsp::Mono>(index, rq, rgb);
+    if (mode == nsp::Rgb::name) return render_combination<nsp::Rgb>(index, rq, rgb);
+    return render_combination<Hero4>(index, rq, rgb);
 }
 
 int run(const Options& o) {
@@ -515,38 +726,47 @@ int run(const Options& o) {
         list_combinations();
         return 0;
     }
+    const std::vector<TablePlan> tables = plan(o);
     if (o.write_exr) std::filesystem::create_directories(o.out);
-    std::vector<std::pair<std::string_view, std::vector<std::size_t>>> plan;
     std::size_t total = 0;
-    for (const auto mode : o.modes) {
-        plan.emplace_back(mode, select(o, mode));
-        total += plan.back().second.size() * o.setups.size();
-    }
-    std::fprintf(stderr, "nsp_render: %zu renders of %dx%d at %d spp on %d threads\n", total, o.width, o.height,
-                 o.spp, o.threads);
+    for (const TablePlan& t : tables) total += t.rows.size() * std::size_t(o.runs);
+    std::fprintf(stderr, "nsp_render: %zu renders in %zu tables on %d threads\n", total, tables.size(), o.threads);
     const auto t0 = std::chrono::steady_clock::now();
     std::size_t done = 0;
-    for (const LightSetup setup : o.setups) {
-        for (const auto& [mode, indices] : plan) {
-            std::vector<RenderStats> rows;
-            for (const std::size_t i : indices) {
-                tl::with_index<AllCombinations>(i, [&]<class C>(std::type_identity<C>) {
-                    const auto scene = make_scene<C>(setup, o);
-                    std::string file = std::string(name(setup)) + "_" + C::name();
-                    if constexpr (std::is_same_v<typename C::Spectral, nsp::Rgb>) file += "_rgb";
-                    const std::string label = "[" + std::to_string(++done) + "/" + std::to_string(total) + "] " + file;
-                    std::vector<float> rgb;
-                    rows.push_back(render<C>(scene, o, label, rgb));
-                    if (o.write_exr)
-                        write_exr_rgb((std::filesystem::path(o.out) / (file + ".exr")).string(), o.width, o.height, rgb);
-                });
+    for (const TablePlan& t : tables) {
+        std::vector<Row> rows;
+        for (const Candidate& c : t.rows) {
+            Row row{c, {}};
+            std::string file = std::string(t.scene.name()) + "_" + c.name;
+            if (t.mode != nsp::Mono::name) file.append("_").append(t.mode);
+            for (int run = 0; run < o.runs; ++run) {
+                RenderRequest rq;
+                rq.scene = t.scene;
+                rq.lights = o.lights;
+                rq.selection = c.selection;
+                rq.width = t.width;
+                rq.height = t.height;
+                rq.spp = t.spp;
+                rq.threads = o.threads;
+                rq.seed = o.seed + std::uint64_t(run);
+                rq.estimator = o.estimator;
+                std::ostringstream label;  // not "[" + std::to_string(..): GCC 12 warns (-Wrestrict, bug 105329)
+                label << '[' << ++done << '/' << total << "] " << file;
+                if (o.runs > 1) label << " run " << run + 1;
+                rq.label = label.str();
+                std::vector<float> rgb;
+                row.runs.push_back(render_in_mode(t.mode, c.index, rq, rgb));
+                if (o.write_exr && run == 0)
+                    write_exr_rgb((std::filesystem::path(o.out) / (file + ".exr")).string(), t.width, t.height, rgb);
             }
-            print_table(setup, mode, o, rows);
+            rows.push_back(std::move(row));
         }
+        if (t.scene.kind == SceneKind::Cloud) print_cloud_table(t, o, rows);
+        else print_chromatic_table(t, o, rows);
+        std::fflush(stdout);
     }
     const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    std::printf("\ntotal wall time: %.1f s%s\n", secs,
-                o.write_exr ? (", images in " + o.out + "/").c_str() : "");
+    std::printf("\ntotal wall time: %.1f s%s\n", secs, o.write_exr ? (", images in " + o.out + "/").c_str() : "");
     return 0;
 }
 

@@ -1,0 +1,84 @@
+// examples/render_job.hpp: what nsp_render asks of one render and what it gets back.
+//
+// The driver (render.cpp) plans renders by name; `render_combination<S>` turns the index of a
+// combination of spectral mode S (combinations.hpp) into its types once and runs a monomorphic
+// render loop (render_job_impl.hpp). Its instantiations live in one translation unit per mode
+// (render_mono.cpp, render_rgb.cpp, render_hero.cpp) so that they compile in parallel.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nsp/nsp.hpp>
+
+#include "combinations.hpp"
+#include "default_scene.hpp"
+
+namespace nsp_examples {
+
+/// One light set-up of one scene: A or B of the grey cloud, C1 or C2 of the chromatic cloud.
+struct SceneChoice {
+    SceneKind kind = SceneKind::Cloud;
+    LightSetup cloud = LightSetup::A;              ///< with SceneKind::Cloud
+    ChromaticSetup chromatic = ChromaticSetup::Env;  ///< with SceneKind::Chromatic
+
+    /// "A", "B", "C1" or "C2".
+    const char* name() const { return kind == SceneKind::Cloud ? nsp_examples::name(cloud) : nsp_examples::name(chromatic); }
+};
+
+/// Lights the command line adds to (or replaces in) a set-up.
+struct LightOverrides {
+    std::optional<float> env;                    ///< constant environment radiance
+    std::optional<std::array<float, 4>> point;   ///< x, y, z, intensity
+    std::optional<std::array<float, 5>> sphere;  ///< x, y, z, radius, radiance
+};
+
+/// How a spectral estimator picks a path's sampling channel (THEORY 5.3).
+enum class SelectionRule {
+    Uniform,    ///< q_c = 1 / C
+    Luminance,  ///< q_c proportional to 0.5 / C + 0.5 y_c / sum_c y_c (y: Rec. 709 weights, or CIE y-bar per hero wavelength)
+};
+
+/// Everything one render needs besides the combination.
+struct RenderRequest {
+    SceneChoice scene;
+    LightOverrides lights;
+    SelectionRule selection = SelectionRule::Uniform;  ///< ignored by combinations without uses_selection
+    int width = 0, height = 0, spp = 0, threads = 1;
+    std::uint64_t seed = 1;
+    nsp::EstimatorOptions estimator;
+    std::string label;  ///< for the progress line
+};
+
+/// What one render measured. The estimates of each sample are taken as linear RGB (mono: the value
+/// in all three; hero: converted to linear sRGB via XYZ) before any statistic is formed.
+struct RenderStats {
+    double wall_seconds = 0.0;
+    double cpu_seconds = 0.0;             ///< summed over worker threads
+    std::uint64_t samples = 0;
+    std::uint64_t lookups = 0;            ///< density lookups, summed over threads
+    std::uint64_t aborted = 0, nonfinite = 0;
+    std::uint64_t nonzero = 0;            ///< samples with a nonzero estimate
+    double variance_of_mean = 0.0;        ///< mean over pixels of the sample variance of the channel mean
+    double variance_per_channel = 0.0;    ///< mean over pixels and the 3 channels of each channel's sample variance
+    std::array<double, 3> mean{};         ///< image mean per channel (an unbiasedness check)
+
+    double lookups_per_sample() const { return double(lookups) / double(samples); }
+    double cpu_seconds_per_sample() const { return cpu_seconds / double(samples); }
+};
+
+/// Renders combination `index` of CombinationsOf<S> (an index the driver got by enumerating that
+/// list) and writes the per-pixel mean as interleaved linear RGB into `rgb`. Throws
+/// nsp::InvalidArgument if the scene cannot be built (e.g. a --sphere inside the medium).
+template <nsp::SpectralMode S>
+RenderStats render_combination(std::size_t index, const RenderRequest& request, std::vector<float>& rgb);
+
+extern template RenderStats render_combination<nsp::Mono>(std::size_t, const RenderRequest&, std::vector<float>&);
+extern template RenderStats render_combination<nsp::Rgb>(std::size_t, const RenderRequest&, std::vector<float>&);
+extern template RenderStats render_combination<Hero4>(std::size_t, const RenderRequest&, std::vector<float>&);
+
+}  // namespace nsp_examples

@@ -1,0 +1,251 @@
+// examples/render_job_impl.hpp: the render loop of nsp_render (see render_job.hpp), included only
+// by the per-mode translation units that instantiate render_combination<S>.
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <functional>
+#include <mutex>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
+#include <unistd.h>
+
+#include <Eigen/Core>
+
+#include <nsp/nsp.hpp>
+
+#include "combinations.hpp"
+#include "default_scene.hpp"
+#include "render_job.hpp"
+#include "type_list.hpp"
+
+namespace nsp_examples {
+
+namespace detail {
+
+/// CPU time of the calling thread (POSIX): unlike wall time, not inflated by other processes.
+inline double thread_cpu_seconds() {
+    timespec ts{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+}
+
+/// Welford's running mean and sum of squared deviations of one quantity.
+struct Welford {
+    double mean = 0.0, m2 = 0.0;
+    void add(double x, int k) {  // k: 1-based count including x
+        const double d = x - mean;
+        mean += d / k;
+        m2 += d * (x - mean);
+    }
+};
+
+/// Per-thread accumulators, summed after the join.
+struct ThreadTotals {
+    nsp::LookupCount counter;
+    std::uint64_t aborted = 0, nonfinite = 0, nonzero = 0;
+    double variance_of_mean_sum = 0.0, variance_per_channel_sum = 0.0, cpu_seconds = 0.0;
+    std::array<double, 3> mean_sum{};
+};
+
+/// Prints "label  NN%" in place on a terminal; nothing elsewhere (the caller prints a line per render).
+class Progress {
+public:
+    Progress(std::string label, bool tty) : label_(std::move(label)), tty_(tty) {}
+
+    /// Called by any worker after a row; prints at most every 0.25 s.
+    void update(int done, int total) {
+        if (!tty_ || !mutex_.try_lock()) return;
+        const auto now = std::chrono::steady_clock::now();
+        if (now - last_ > std::chrono::milliseconds(250)) {
+            last_ = now;
+            std::fprintf(stderr, "\r  %-70s %3d%%", label_.c_str(), int(100.0 * done / total));
+            std::fflush(stderr);
+        }
+        mutex_.unlock();
+    }
+    /// Replaces the progress line with a summary line.
+    void finish(const std::string& summary) {
+        if (tty_) std::fprintf(stderr, "\r%-90s\r", "");
+        std::fprintf(stderr, "  %s\n", summary.c_str());
+    }
+
+private:
+    std::string label_;
+    bool tty_;
+    std::mutex mutex_;
+    std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
+};
+
+/// The luminance-based channel selection of the chromatic tables: q_c proportional to
+/// 0.5 / C + 0.5 y_c / sum_c y_c, with y the Rec. 709 luminance weights in Rgb and the CIE y-bar
+/// of each of the path's wavelengths in Hero mode. The uniform half keeps every q_c >= 0.5 / C.
+template <nsp::SpectralMode S>
+nsp::ChannelSelection<S> luminance_selection(const typename S::Wavelengths& lambda) {
+    using Spectrum = typename S::Spectrum;
+    Spectrum y;
+    if constexpr (nsp::is_hero_v<S>) {
+        for (int i = 0; i < S::channels; ++i) y[i] = float(nsp::cie_xyz_bar(double(lambda.nm[std::size_t(i)]))[1]);
+    } else if constexpr (S::channels == 3) {
+        (void)lambda;
+        y = Spectrum(0.2126f, 0.7152f, 0.0722f);
+    } else {
+        (void)lambda;
+        y = Spectrum::Ones();
+    }
+    Spectrum w = Spectrum::Constant(0.5f / float(S::channels));
+    if (const float sum = y.sum(); sum > 0.f) w += 0.5f * y / sum;
+    return nsp::ChannelSelection<S>(w);
+}
+
+/// A radiance estimate of mode S as linear RGB: Mono in all three channels, Rgb as it is, Hero
+/// through CIE XYZ to linear sRGB (color.hpp).
+template <nsp::SpectralMode S>
+Eigen::Array3d to_linear_rgb(const typename S::Spectrum& L, const typename S::Wavelengths& lambda) {
+    if constexpr (nsp::is_hero_v<S>) return nsp::xyz_to_linear_srgb(nsp::hero_to_xyz<S::channels>(L, lambda));
+    else if constexpr (S::channels == 3) return L.template cast<double>();
+    else return Eigen::Array3d::Constant(double(L[0]));
+}
+
+/// The scene of combination C in `choice`, with the lights the flags add or replace.
+template <class C>
+typename C::Scene make_scene(const SceneChoice& choice, const LightOverrides& o) {
+    using S = typename C::Spectral;
+    nsp::Lights<S> lights = choice.kind == SceneKind::Cloud ? default_lights<S>(choice.cloud)
+                                                            : chromatic_lights<S>(choice.chromatic);
+    if (o.sphere) {
+        const auto& s = *o.sphere;
+        lights.set(nsp::SphereLight<S>{nsp::Vec3(s[0], s[1], s[2]), s[3], nsp::constant_coefficient<S>(s[4])});
+    }
+    if (o.point) {
+        const auto& p = *o.point;
+        lights.set(nsp::PointLight<S>{nsp::Vec3(p[0], p[1], p[2]), nsp::constant_coefficient<S>(p[3])});
+    }
+    if (o.env) lights.set(nsp::EnvironmentLight<S>{nsp::constant_coefficient<S>(*o.env)});
+    auto medium = C::MediumKind::template make<S>(choice.kind);
+    auto majorant = C::MajorantKind::make(medium);
+    return typename C::Scene(std::move(medium), std::move(majorant), nsp::HenyeyGreensteinPhase(kPhaseG),
+                             std::move(lights));
+}
+
+/// Renders `scene` with combination C's estimator: per pixel, `spp` jittered camera rays (and in
+/// Hero mode a wavelength draw per path); one Pcg32 stream per pixel (so images do not depend on
+/// the thread count); rows handed out to threads through an atomic counter. Writes the mean
+/// linear RGB into `rgb`.
+template <class C>
+RenderStats render(const typename C::Scene& scene, const RenderRequest& rq, std::vector<float>& rgb) {
+    using S = typename C::Spectral;
+    const typename C::Estimator estimator{rq.estimator};
+    const int w = rq.width, h = rq.height;
+    const float aspect = float(w) / float(h);
+    rgb.assign(std::size_t(w) * std::size_t(h) * 3u, 0.f);
+    // Fixed channels: one selection for the whole image; hero wavelengths: one per path.
+    const nsp::ChannelSelection<S> fixed_selection =
+        rq.selection == SelectionRule::Luminance ? luminance_selection<S>({}) : nsp::ChannelSelection<S>{};
+
+    std::atomic<int> next_row{0}, rows_done{0};
+    std::vector<ThreadTotals> totals(std::size_t(rq.threads));
+    Progress progress(rq.label, isatty(STDERR_FILENO) != 0);
+
+    auto work = [&](ThreadTotals& out) {
+        ThreadTotals t;  // local: the counters of different threads must not share a cache line
+        const double cpu0 = thread_cpu_seconds();
+        for (int y; (y = next_row.fetch_add(1)) < h;) {
+            for (int x = 0; x < w; ++x) {
+                const std::size_t pixel = std::size_t(y) * std::size_t(w) + std::size_t(x);
+                nsp::Pcg32 rng(rq.seed, pixel);
+                std::array<Welford, 3> channel{};
+                Welford channel_mean;
+                Eigen::Array3d sum = Eigen::Array3d::Zero();
+                for (int k = 1; k <= rq.spp; ++k) {
+                    const float u = (float(x) + rng.uniform()) / float(w);
+                    const float v = 1.f - (float(y) + rng.uniform()) / float(h);
+                    typename S::Wavelengths lambda{};
+                    if constexpr (nsp::is_hero_v<S>) lambda = S::Wavelengths::sample(rng.uniform());
+                    const nsp::Ray ray = camera_ray(u, v, aspect);
+                    nsp::RadianceSample<S> r;
+                    if constexpr (!C::uses_selection) {
+                        r = estimator.radiance(scene, ray, lambda, rng, t.counter);
+                    } else if constexpr (nsp::is_hero_v<S>) {  // luminance at this path's wavelengths
+                        if (rq.selection == SelectionRule::Luminance)
+                            r = estimator.radiance(scene, ray, lambda, luminance_selection<S>(lambda), rng, t.counter);
+                        else
+                            r = estimator.radiance(scene, ray, lambda, fixed_selection, rng, t.counter);
+                    } else {
+                        r = estimator.radiance(scene, ray, lambda, fixed_selection, rng, t.counter);
+                    }
+                    if (r.status == nsp::Status::Aborted) ++t.aborted;
+                    else if (r.status == nsp::Status::NonFinite) ++t.nonfinite;
+                    if ((r.value != 0.f).any()) ++t.nonzero;
+                    const Eigen::Array3d c = to_linear_rgb<S>(r.value, lambda);
+                    sum += c;
+                    for (int i = 0; i < 3; ++i) channel[std::size_t(i)].add(c[i], k);
+                    channel_mean.add(c.mean(), k);
+                }
+                const double n1 = double(rq.spp - 1);
+                t.variance_of_mean_sum += channel_mean.m2 / n1;
+                for (int i = 0; i < 3; ++i) {
+                    t.variance_per_channel_sum += channel[std::size_t(i)].m2 / n1 / 3.0;
+                    t.mean_sum[std::size_t(i)] += channel[std::size_t(i)].mean;
+                    rgb[3 * pixel + std::size_t(i)] = float(sum[i] / double(rq.spp));
+                }
+            }
+            progress.update(rows_done.fetch_add(1) + 1, h);
+        }
+        t.cpu_seconds = thread_cpu_seconds() - cpu0;
+        out = t;
+    };
+
+    const auto t0 = std::chrono::steady_clock::now();
+    {
+        std::vector<std::jthread> pool;
+        for (int i = 1; i < rq.threads; ++i) pool.emplace_back(work, std::ref(totals[std::size_t(i)]));
+        work(totals[0]);
+    }
+    RenderStats st;
+    st.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    st.samples = std::uint64_t(w) * std::uint64_t(h) * std::uint64_t(rq.spp);
+    double var_mean = 0.0, var_channel = 0.0;
+    std::array<double, 3> mean{};
+    for (const ThreadTotals& t : totals) {
+        st.lookups += t.counter.count();
+        st.aborted += t.aborted;
+        st.nonfinite += t.nonfinite;
+        st.nonzero += t.nonzero;
+        st.cpu_seconds += t.cpu_seconds;
+        var_mean += t.variance_of_mean_sum;
+        var_channel += t.variance_per_channel_sum;
+        for (int i = 0; i < 3; ++i) mean[std::size_t(i)] += t.mean_sum[std::size_t(i)];
+    }
+    const double pixels = double(w) * double(h);
+    st.variance_of_mean = var_mean / pixels;
+    st.variance_per_channel = var_channel / pixels;
+    for (int i = 0; i < 3; ++i) st.mean[std::size_t(i)] = mean[std::size_t(i)] / pixels;
+    char summary[64];
+    std::snprintf(summary, sizeof summary, ": %.3f s", st.wall_seconds);
+    progress.finish(rq.label + summary);
+    return st;
+}
+
+}  // namespace detail
+
+template <nsp::SpectralMode S>
+RenderStats render_combination(std::size_t index, const RenderRequest& request, std::vector<float>& rgb) {
+    RenderStats stats;
+    const bool found = tl::with_index<CombinationsOf<S>>(index, [&]<class C>(std::type_identity<C>) {
+        const auto scene = detail::make_scene<C>(request.scene, request.lights);
+        stats = detail::render<C>(scene, request, rgb);
+    });
+    if (!found) throw std::out_of_range("render_combination: no combination " + std::to_string(index));
+    return stats;
+}
+
+}  // namespace nsp_examples

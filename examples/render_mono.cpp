@@ -1,0 +1,7 @@
+// examples/render_mono.cpp: the render loops of nsp_render for the mono mode (render_job.hpp), in a
+// translation unit of their own so that the three modes compile in parallel.
+#include "render_job_impl.hpp"
+
+namespace nsp_examples {
+template RenderStats render_combination<nsp::Mono>(std::size_t, const RenderRequest&, std::vector<float>&);
+}  // namespace nsp_examples
