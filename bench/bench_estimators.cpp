@@ -1,9 +1,10 @@
 // bench/bench_estimators.cpp: one benchmark per path estimator x absorption policy x spectral
-// mode x light set-up on the default scene: time per radiance() call (one sample) and density
-// lookups per sample. Camera rays are pre-generated (fixtures.hpp) and cycled.
+// mode x light set-up on the default (grey) scene: time per radiance() call (one sample) and
+// density lookups per sample. Camera rays are pre-generated (fixtures.hpp) and cycled; Hero<4>
+// draws each sample's wavelengths from the benchmark's generator.
 //
-// The 40 combinations are the Cartesian product of four type lists, registered by a fold at
-// start-up (the BENCHMARK_TEMPLATE idea without 40 hand-written lines); names come from the
+// The 60 combinations are the Cartesian product of four type lists, registered by a fold at
+// start-up (the BENCHMARK_TEMPLATE idea without 60 hand-written lines); names come from the
 // policies' own `name`s: BM_Radiance/<strategy[:heuristic]>/<absorption>/<mode>/<set-up>.
 // The timed loop counts with LookupCount (one integer increment per lookup); the BM_CountCost
 // pair shows that this costs nothing measurable.
@@ -35,9 +36,10 @@ using Kinds = List<Kind<nsp::strategy::Unidirectional>, Kind<nsp::strategy::Next
                    Kind<nsp::strategy::NullScatteringMis, nsp::mis::Balance>,
                    Kind<nsp::strategy::NullScatteringMis, nsp::mis::Power>>;
 using Absorptions = List<nsp::absorption::Event, nsp::absorption::Weight>;
-using Modes = List<nsp::Mono, nsp::Rgb>;
+using Modes = List<nsp::Mono, nsp::Rgb, Hero4>;
 
-/// One radiance sample per iteration on the next camera ray; the generator runs on.
+/// One radiance sample per iteration on the next camera ray; the generator runs on. In Mono and
+/// Rgb the wavelength context is empty and no random number is drawn for it.
 template <class K, nsp::AbsorptionPolicy A, nsp::SpectralMode S, nsp::LookupCounter C>
 void BM_Radiance(benchmark::State& state, LightSetup setup) {
     const auto& scene = default_scene<S>(setup);
@@ -47,7 +49,8 @@ void BM_Radiance(benchmark::State& state, LightSetup setup) {
     C counter;
     std::size_t i = 0;
     for (auto _ : state) {
-        auto r = estimator.radiance(scene, rays[i], {}, rng, counter);
+        const auto lambda = draw_wavelengths<S>(rng);
+        auto r = estimator.radiance(scene, rays[i], lambda, rng, counter);
         benchmark::DoNotOptimize(r);
         i = (i + 1) & kSetMask;
     }

@@ -11,6 +11,10 @@
 //   uniform: random points in the box in random order (no spatial coherence, more L2/L3 misses).
 // Two diagnostics explain the ratio: chained raw lookups (latency, no overlap) and tracking
 // through a homogeneous medium (the loop's own cost). bench/report.py prints the ratios.
+//
+// Every tracker also runs in Hero<4> on the same grey cloud (coefficients tabulated over
+// wavelength, four wavelengths drawn per tracked ray): with Mono and Rgb, what each spectral mode
+// costs on a medium that does not need it (bench/RESULTS.md, "cost of each spectral mode").
 #include <vector>
 
 #include <benchmark/benchmark.h>
@@ -33,6 +37,13 @@ struct TrackedPoints {
     static const std::vector<nsp::Vec3>& get() { return tracked_points(); }
 };
 
+/// The wavelengths of the raw-lookup benchmarks: one fixed draw in Hero mode, empty otherwise.
+template <nsp::SpectralMode S>
+typename S::Wavelengths lookup_wavelengths() {
+    nsp::Pcg32 rng(7, 77);
+    return draw_wavelengths<S>(rng);
+}
+
 /// kSetSize lookups per iteration, one per point of the set; the coefficients are summed so
 /// the compiler cannot drop a lookup, and the sum is consumed once at the end. The lookups are
 /// independent, so the CPU overlaps several: this is the lookup's throughput.
@@ -40,10 +51,11 @@ template <nsp::SpectralMode S, class Points>
 void BM_RawLookup(benchmark::State& state) {
     const auto& medium = default_scene<S>(LightSetup::A).medium;
     const std::vector<nsp::Vec3>& pts = Points::get();
+    const typename S::Wavelengths lambda = lookup_wavelengths<S>();
     typename S::Spectrum acc = S::Spectrum::Zero();
     for (auto _ : state) {
         for (const nsp::Vec3& p : pts) {
-            const auto c = medium.coefficients(p, {});
+            const auto c = medium.coefficients(p, lambda);
             acc += c.sigma_a + c.sigma_s;
         }
         benchmark::ClobberMemory();
@@ -59,10 +71,11 @@ template <nsp::SpectralMode S>
 void BM_RawLookupChained(benchmark::State& state) {
     const auto& medium = default_scene<S>(LightSetup::A).medium;
     const std::vector<nsp::Vec3>& pts = tracked_points();
+    const typename S::Wavelengths lambda = lookup_wavelengths<S>();
     float prev = 0.f;
     for (auto _ : state) {
         for (const nsp::Vec3& p : pts) {
-            const auto c = medium.coefficients(p + nsp::Vec3(0.f * prev), {});
+            const auto c = medium.coefficients(p + nsp::Vec3(0.f * prev), lambda);
             prev = c.sigma_s[0];
         }
     }
@@ -77,20 +90,23 @@ BENCHMARK_TEMPLATE(BM_RawLookup, Rgb, UniformPoints)->MinTime(kMinTime);
 BENCHMARK_TEMPLATE(BM_RawLookup, Rgb, TrackedPoints)->MinTime(kMinTime);
 BENCHMARK_TEMPLATE(BM_RawLookupChained, Mono)->MinTime(kMinTime);
 BENCHMARK_TEMPLATE(BM_RawLookupChained, Rgb)->MinTime(kMinTime);
+BENCHMARK_TEMPLATE(BM_RawLookup, Hero4, UniformPoints)->MinTime(kMinTime);
+BENCHMARK_TEMPLATE(BM_RawLookup, Hero4, TrackedPoints)->MinTime(kMinTime);
+BENCHMARK_TEMPLATE(BM_RawLookupChained, Hero4)->MinTime(kMinTime);
 
-/// Trackers: one call tracks one ray over [0, kTmax] through the medium's box.
+/// Trackers: one call tracks one ray over [0, kTmax] through the medium's box at wavelengths l.
 template <nsp::AbsorptionPolicy A>
 struct Delta {
-    template <class M, class Maj, class R, class C>
-    static auto run(const M& m, const Maj& maj, const nsp::Ray& ray, R& rng, C& counter) {
-        return nsp::track_delta<A>(m, maj, ray, kTmax, {}, rng, counter);
+    template <class M, class Maj, class L, class R, class C>
+    static auto run(const M& m, const Maj& maj, const nsp::Ray& ray, const L& l, R& rng, C& counter) {
+        return nsp::track_delta<A>(m, maj, ray, kTmax, l, rng, counter);
     }
 };
 template <nsp::AbsorptionPolicy A, bool kNullRatio>
 struct Ratio {
-    template <class M, class Maj, class R, class C>
-    static auto run(const M& m, const Maj& maj, const nsp::Ray& ray, R& rng, C& counter) {
-        return nsp::track_ratio<A, kNullRatio>(m, maj, ray, kTmax, {}, rng, counter);
+    template <class M, class Maj, class L, class R, class C>
+    static auto run(const M& m, const Maj& maj, const nsp::Ray& ray, const L& l, R& rng, C& counter) {
+        return nsp::track_ratio<A, kNullRatio>(m, maj, ray, kTmax, l, rng, counter);
     }
 };
 using DeltaEvent = Delta<nsp::absorption::Event>;
@@ -125,7 +141,8 @@ struct Trivial {
 };
 
 /// One tracked ray per iteration, cycling through tracking_rays(); the generator runs on across
-/// iterations, so every pass over the set draws new collisions.
+/// iterations, so every pass over the set draws new collisions. Hero mode draws each ray's
+/// wavelengths from the same generator.
 template <class Tracker, nsp::SpectralMode S, class Media = Cloud, nsp::LookupCounter C = LookupCount>
 void BM_Track(benchmark::State& state) {
     const auto& medium = Media::template medium<S>();
@@ -135,7 +152,8 @@ void BM_Track(benchmark::State& state) {
     C counter;
     std::size_t i = 0;
     for (auto _ : state) {
-        auto r = Tracker::run(medium, majorant, rays[i], rng, counter);
+        const auto lambda = draw_wavelengths<S>(rng);
+        auto r = Tracker::run(medium, majorant, rays[i], lambda, rng, counter);
         benchmark::DoNotOptimize(r);
         i = (i + 1) & kSetMask;
     }
@@ -152,6 +170,11 @@ BENCHMARK_TEMPLATE(BM_Track, DeltaWeight, Rgb)->MinTime(kMinTime);
 BENCHMARK_TEMPLATE(BM_Track, RatioPlain, Rgb)->MinTime(kMinTime);
 BENCHMARK_TEMPLATE(BM_Track, RatioNullEvent, Rgb)->MinTime(kMinTime);
 BENCHMARK_TEMPLATE(BM_Track, RatioNullWeight, Rgb)->MinTime(kMinTime);
+BENCHMARK_TEMPLATE(BM_Track, DeltaEvent, Hero4)->MinTime(kMinTime);
+BENCHMARK_TEMPLATE(BM_Track, DeltaWeight, Hero4)->MinTime(kMinTime);
+BENCHMARK_TEMPLATE(BM_Track, RatioPlain, Hero4)->MinTime(kMinTime);
+BENCHMARK_TEMPLATE(BM_Track, RatioNullEvent, Hero4)->MinTime(kMinTime);
+BENCHMARK_TEMPLATE(BM_Track, RatioNullWeight, Hero4)->MinTime(kMinTime);
 
 // Diagnostic: the loop's own cost, on the trivial medium.
 BENCHMARK_TEMPLATE(BM_Track, DeltaWeight, Mono, Trivial)->MinTime(kMinTime);

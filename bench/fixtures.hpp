@@ -1,5 +1,6 @@
 // bench/fixtures.hpp: the data every nsp benchmark shares, built once, outside the timed loops:
-// the default cloud scene (examples/default_scene.hpp) and pre-generated point and ray sets.
+// the default cloud scene (examples/default_scene.hpp), pre-generated point and ray sets, and the
+// per-sample wavelength draw of the hero mode.
 #pragma once
 
 #include <cstddef>
@@ -19,8 +20,8 @@ using nsp_examples::LightSetup;
 inline constexpr std::size_t kSetSize = std::size_t(1) << 14;
 inline constexpr std::size_t kSetMask = kSetSize - 1;
 
-/// Minimum time of one repetition of one benchmark, in seconds: with 5 repetitions the whole
-/// run stays under three minutes on 2 cores.
+/// Minimum time of one repetition of one benchmark, in seconds: with 5 repetitions the main run
+/// of bench/run.sh (148 benchmarks) takes about three and a half minutes on 2 cores.
 inline constexpr double kMinTime = 0.2;
 
 /// Far end of every tracked segment: past the cloud's box from any ray origin used here.
@@ -32,6 +33,18 @@ const auto& default_scene(LightSetup setup) {
     static const auto a = nsp_examples::make_default_scene<S>(LightSetup::A);
     static const auto b = nsp_examples::make_default_scene<S>(LightSetup::B);
     return setup == LightSetup::A ? a : b;
+}
+
+/// Hero<4>, under a name without a comma (BENCHMARK_TEMPLATE arguments, benchmark names).
+using Hero4 = nsp::Hero<4>;
+
+/// The wavelength context of one sample: in Hero mode drawn from the benchmark's own generator
+/// (one uniform number per sample, part of the timed work, as in a renderer); empty and free in
+/// Mono and Rgb, which then consume exactly the random numbers they did before Hero existed.
+template <nsp::SpectralMode S, nsp::UniformRng R>
+typename S::Wavelengths draw_wavelengths(R& rng) {
+    if constexpr (nsp::is_hero_v<S>) return S::Wavelengths::sample(rng.uniform());
+    else return {};
 }
 
 /// A point drawn uniformly in the box.
