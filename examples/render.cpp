@@ -341,7 +341,7 @@ Options parse(int argc, char** argv) {
 struct Candidate {
     std::size_t index = 0;  ///< into CombinationsOf<S>
     SelectionRule selection = SelectionRule::Uniform;
-    std::string name;                 ///< the row's name, e.g. uni-nee-mis_spectral-mis_per-channel_balance_absorb-weight_lum
+    std::string name;                 ///< e.g. uni-nee-mis_spectral-mis_per-channel_balance_absorb-weight_lum
     std::vector<std::string> fields;  ///< the name's '_'-separated fields and the implied ones (grey, global, uniform)
     std::string channels;             ///< the channel policy ("grey" for PathEstimator)
     std::string strategy;
@@ -475,6 +475,22 @@ struct Row {
         const std::size_t n = v.size();
         return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
     }
+    /// Channel c's image mean over the runs, and its standard error (from the per-pixel variances).
+    double mean(int ch) const {
+        double m = 0.0;
+        for (const RenderStats& r : runs) m += r.mean[std::size_t(ch)];
+        return m / double(runs.size());
+    }
+    double standard_error(int ch) const {
+        double v = 0.0;
+        for (const RenderStats& r : runs) v += r.channel_variance[std::size_t(ch)] / double(r.samples);
+        return std::sqrt(v) / double(runs.size());
+    }
+    std::uint64_t nonzero() const {
+        std::uint64_t n = 0;
+        for (const RenderStats& r : runs) n += r.nonzero;
+        return n;
+    }
     template <class F>
     std::pair<double, double> range(F f) const {
         double lo = std::numeric_limits<double>::infinity(), hi = -lo;
@@ -490,7 +506,7 @@ struct Row {
 struct Metrics {
     bool per_channel = false;  ///< per-channel variance (chromatic) or variance of the channel mean (cloud)
 
-    double variance(const RenderStats& r) const { return per_channel ? r.variance_per_channel : r.variance_of_mean; }
+    double variance(const RenderStats& r) const { return per_channel ? r.variance_per_channel() : r.variance_of_mean; }
     double ltuv(const RenderStats& r) const { return r.lookups_per_sample() * variance(r); }
     double time_variance(const RenderStats& r) const { return r.cpu_seconds_per_sample() * variance(r); }
 
@@ -546,15 +562,30 @@ double print_rows(const TablePlan& t, const Options& o, const std::vector<Row>& 
             const auto [lo, hi] = r.range([&](const RenderStats& s) { return m.variance(s); });
             std::printf(" %19s", (num(lo) + ".." + num(hi)).c_str());
         }
-        std::array<double, 3> mean{};
-        for (const RenderStats& s : r.runs)
-            for (int i = 0; i < 3; ++i) mean[std::size_t(i)] += s.mean[std::size_t(i)] / double(r.runs.size());
         if (chromatic)
-            std::printf(" %s %s %s\n", num(mean[0]).c_str(), num(mean[1]).c_str(), num(mean[2]).c_str());
+            std::printf(" %s %s %s\n", num(r.mean(0)).c_str(), num(r.mean(1)).c_str(), num(r.mean(2)).c_str());
         else
-            std::printf(" %9s\n", num((mean[0] + mean[1] + mean[2]) / 3.0).c_str());
+            std::printf(" %9s\n", num((r.mean(0) + r.mean(1) + r.mean(2)) / 3.0).c_str());
     }
     return best;
+}
+
+/// Below this many nonzero samples a row's statistics rest on too few samples to mean much.
+constexpr std::uint64_t kFewNonzero = 1000;
+
+/// More standard errors than this between two rows' image means is reported (see mean_gap).
+constexpr double kMeanGap = 4.0;
+
+/// How far apart the image means of rows a and b are: the largest over channels of
+/// |mean_a - mean_b| / sqrt(se_a^2 + se_b^2), and that channel.
+std::pair<double, int> mean_gap(const Row& a, const Row& b) {
+    std::pair<double, int> worst{0.0, 0};
+    for (int c = 0; c < 3; ++c) {
+        const double se = std::hypot(a.standard_error(c), b.standard_error(c));
+        const double z = se > 0.0 ? std::abs(a.mean(c) - b.mean(c)) / se : 0.0;
+        if (z > worst.first) worst = {z, c};
+    }
+    return worst;
 }
 
 /// Footer lines every table shares: medians, status counts, rarely nonzero rows.
@@ -575,15 +606,12 @@ void print_common_footer(const Options& o, const std::vector<Row>& rows) {
         std::printf("note: the point light (--point) is reachable by next-event estimation only, so the "
                     "unidirectional rows leave out its light and their mean is lower\n");
     for (const Row& r : rows) {
-        std::uint64_t nonzero = 0, samples = 0;
-        for (const RenderStats& s : r.runs) {
-            nonzero += s.nonzero;
-            samples += s.samples;
-        }
-        if (nonzero < 1000)
+        std::uint64_t samples = 0;
+        for (const RenderStats& s : r.runs) samples += s.samples;
+        if (r.nonzero() < kFewNonzero)
             std::printf("note: %s: only %llu of %llu samples were nonzero (the light is rarely found); its "
                         "variance and mean rest on those few and are themselves very noisy\n",
-                        r.c.name.c_str(), (unsigned long long)nonzero, (unsigned long long)samples);
+                        r.c.name.c_str(), (unsigned long long)r.nonzero(), (unsigned long long)samples);
     }
 }
 
@@ -638,6 +666,18 @@ void print_chromatic_table(const TablePlan& t, const Options& o, const std::vect
     std::printf("Rows without a channel policy are nsp::PathEstimator with the grey (global) majorant; _lum: "
                 "luminance channel selection, otherwise uniform.\n");
     print_common_footer(o, rows);
+    // Means that disagree: the per-pixel variances give each image mean a standard error, and a
+    // row far from the best row is heavy-tailed (its sample variance understates its variance,
+    // and its mean is low in most runs) or biased.
+    const Row* ref = best_of(rows, m, [](const Row& r) { return r.nonzero() >= kFewNonzero; });
+    for (const Row& r : rows) {
+        if (!ref || &r == ref || r.nonzero() < kFewNonzero) continue;
+        const auto [z, c] = mean_gap(r, *ref);
+        if (z > kMeanGap)
+            std::printf("note: %s: image mean %s in %c is %.1f standard errors from %s's %s: a heavy tail (its "
+                        "var/spl then understates the variance) or a bias\n", r.c.name.c_str(),
+                        num(r.mean(c)).c_str(), "RGB"[c], z, ref->c.name.c_str(), num(ref->mean(c)).c_str());
+    }
 
     const std::string runs_note = o.runs > 1 ? "median over " + std::to_string(o.runs) + " runs"
                                              : "one run; the baseline is heavy-tailed, see --runs";
@@ -647,10 +687,14 @@ void print_chromatic_table(const TablePlan& t, const Options& o, const std::vect
         const Row* smis =
             find_row(rows, std::string("uni-nee-mis_spectral-mis_per-channel_balance_absorb-weight") + suffix);
         if (!base || !smis) continue;
+        const auto [z, c] = mean_gap(*base, *smis);
         std::printf("grey-majorant baseline / spectral-mis + NEE%s (uni-nee-mis, absorb-weight): var/spl %s, "
-                    "LTUV %s (%s)\n", *suffix ? " with luminance selection" : "",
-                    num(m.var(*base) / m.var(*smis)).c_str(), num(m.ltuv(*base) / m.ltuv(*smis)).c_str(),
-                    runs_note.c_str());
+                    "LTUV %s (%s); image means %.1f standard errors apart in %c%s\n",
+                    *suffix ? " with luminance selection" : "", num(m.var(*base) / m.var(*smis)).c_str(),
+                    num(m.ltuv(*base) / m.ltuv(*smis)).c_str(), runs_note.c_str(), z, "RGB"[c],
+                    z > kMeanGap ? " (too far apart: a heavy tail of the baseline, whose var/spl then understates "
+                                   "its variance, or a bias)"
+                                 : "");
         if (o.runs > 1)
             std::printf("  var/spl per run: baseline %s; spectral-mis + NEE%s %s\n",
                         per_run(*base, [&](const RenderStats& s) { return m.variance(s); }).c_str(), suffix,
@@ -665,7 +709,8 @@ void print_chromatic_table(const TablePlan& t, const Options& o, const std::vect
         {"independent", [](const Row& r) { return r.c.channels == "independent"; }},
         {"spectral tracking", [](const Row& r) { return r.c.channels.starts_with("spectral-tracking"); }},
         {"spectral MIS", [](const Row& r) { return r.c.channels == "spectral-mis" && r.c.strategy != "uni-nee-mis"; }},
-        {"spectral MIS + NEE", [](const Row& r) { return r.c.channels == "spectral-mis" && r.c.strategy == "uni-nee-mis"; }},
+        {"spectral MIS + NEE",
+         [](const Row& r) { return r.c.channels == "spectral-mis" && r.c.strategy == "uni-nee-mis"; }},
     };
     std::string line;
     std::vector<std::pair<double, const char*>> bests;
@@ -679,7 +724,8 @@ void print_chromatic_table(const TablePlan& t, const Options& o, const std::vect
         std::sort(bests.begin(), bests.end());
         std::string close;  // within 10% of the lowest: no ranking at this noise level
         for (std::size_t i = 1; i < bests.size(); ++i)
-            if (bests[i].first <= 1.1 * bests[0].first) close += std::string(close.empty() ? "" : ", ") + bests[i].second;
+            if (bests[i].first <= 1.1 * bests[0].first)
+                close += std::string(close.empty() ? "" : ", ") + bests[i].second;
         std::printf("best LTUV per channel policy: %s -> lowest: %s%s\n", line.c_str(), bests[0].second,
                     close.empty() ? "" : (" (within 10%: " + close + ")").c_str());
     }

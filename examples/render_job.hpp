@@ -27,7 +27,9 @@ struct SceneChoice {
     ChromaticSetup chromatic = ChromaticSetup::Env;  ///< with SceneKind::Chromatic
 
     /// "A", "B", "C1" or "C2".
-    const char* name() const { return kind == SceneKind::Cloud ? nsp_examples::name(cloud) : nsp_examples::name(chromatic); }
+    const char* name() const {
+        return kind == SceneKind::Cloud ? nsp_examples::name(cloud) : nsp_examples::name(chromatic);
+    }
 };
 
 /// Lights the command line adds to (or replaces in) a set-up.
@@ -40,7 +42,7 @@ struct LightOverrides {
 /// How a spectral estimator picks a path's sampling channel (THEORY 5.3).
 enum class SelectionRule {
     Uniform,    ///< q_c = 1 / C
-    Luminance,  ///< q_c proportional to 0.5 / C + 0.5 y_c / sum_c y_c (y: Rec. 709 weights, or CIE y-bar per hero wavelength)
+    Luminance,  ///< q_c proportional to 0.5 / C + 0.5 y_c / sum_c y_c (Rec. 709 weights; hero: CIE y-bar)
 };
 
 /// Everything one render needs besides the combination.
@@ -63,10 +65,14 @@ struct RenderStats {
     std::uint64_t lookups = 0;            ///< density lookups, summed over threads
     std::uint64_t aborted = 0, nonfinite = 0;
     std::uint64_t nonzero = 0;            ///< samples with a nonzero estimate
-    double variance_of_mean = 0.0;        ///< mean over pixels of the sample variance of the channel mean
-    double variance_per_channel = 0.0;    ///< mean over pixels and the 3 channels of each channel's sample variance
-    std::array<double, 3> mean{};         ///< image mean per channel (an unbiasedness check)
+    double variance_of_mean = 0.0;             ///< mean over pixels of the sample variance of the channel mean
+    std::array<double, 3> channel_variance{};  ///< per channel: mean over pixels of its sample variance
+    std::array<double, 3> mean{};              ///< image mean per channel (an unbiasedness check)
 
+    /// The mean over the 3 channels of channel_variance.
+    double variance_per_channel() const {
+        return (channel_variance[0] + channel_variance[1] + channel_variance[2]) / 3.0;
+    }
     double lookups_per_sample() const { return double(lookups) / double(samples); }
     double cpu_seconds_per_sample() const { return cpu_seconds / double(samples); }
 };

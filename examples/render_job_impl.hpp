@@ -52,8 +52,8 @@ struct Welford {
 struct ThreadTotals {
     nsp::LookupCount counter;
     std::uint64_t aborted = 0, nonfinite = 0, nonzero = 0;
-    double variance_of_mean_sum = 0.0, variance_per_channel_sum = 0.0, cpu_seconds = 0.0;
-    std::array<double, 3> mean_sum{};
+    double variance_of_mean_sum = 0.0, cpu_seconds = 0.0;
+    std::array<double, 3> variance_sum{}, mean_sum{};
 };
 
 /// Prints "label  NN%" in place on a terminal; nothing elsewhere (the caller prints a line per render).
@@ -193,7 +193,7 @@ RenderStats render(const typename C::Scene& scene, const RenderRequest& rq, std:
                 const double n1 = double(rq.spp - 1);
                 t.variance_of_mean_sum += channel_mean.m2 / n1;
                 for (int i = 0; i < 3; ++i) {
-                    t.variance_per_channel_sum += channel[std::size_t(i)].m2 / n1 / 3.0;
+                    t.variance_sum[std::size_t(i)] += channel[std::size_t(i)].m2 / n1;
                     t.mean_sum[std::size_t(i)] += channel[std::size_t(i)].mean;
                     rgb[3 * pixel + std::size_t(i)] = float(sum[i] / double(rq.spp));
                 }
@@ -213,8 +213,8 @@ RenderStats render(const typename C::Scene& scene, const RenderRequest& rq, std:
     RenderStats st;
     st.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     st.samples = std::uint64_t(w) * std::uint64_t(h) * std::uint64_t(rq.spp);
-    double var_mean = 0.0, var_channel = 0.0;
-    std::array<double, 3> mean{};
+    double var_mean = 0.0;
+    std::array<double, 3> var_channel{}, mean{};
     for (const ThreadTotals& t : totals) {
         st.lookups += t.counter.count();
         st.aborted += t.aborted;
@@ -222,13 +222,17 @@ RenderStats render(const typename C::Scene& scene, const RenderRequest& rq, std:
         st.nonzero += t.nonzero;
         st.cpu_seconds += t.cpu_seconds;
         var_mean += t.variance_of_mean_sum;
-        var_channel += t.variance_per_channel_sum;
-        for (int i = 0; i < 3; ++i) mean[std::size_t(i)] += t.mean_sum[std::size_t(i)];
+        for (int i = 0; i < 3; ++i) {
+            var_channel[std::size_t(i)] += t.variance_sum[std::size_t(i)];
+            mean[std::size_t(i)] += t.mean_sum[std::size_t(i)];
+        }
     }
     const double pixels = double(w) * double(h);
     st.variance_of_mean = var_mean / pixels;
-    st.variance_per_channel = var_channel / pixels;
-    for (int i = 0; i < 3; ++i) st.mean[std::size_t(i)] = mean[std::size_t(i)] / pixels;
+    for (int i = 0; i < 3; ++i) {
+        st.channel_variance[std::size_t(i)] = var_channel[std::size_t(i)] / pixels;
+        st.mean[std::size_t(i)] = mean[std::size_t(i)] / pixels;
+    }
     char summary[64];
     std::snprintf(summary, sizeof summary, ": %.3f s", st.wall_seconds);
     progress.finish(rq.label + summary);
