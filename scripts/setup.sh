@@ -1,6 +1,9 @@
 #!/usr/bin/env bash
 # Installs the Debian packages nsp builds with, skipping those already present, then configures
 # and builds into ./build. Needs root (or sudo) only when a package is missing.
+# usage: scripts/setup.sh [TARGET...]: without arguments builds everything (run-tests.sh and CI
+# rely on that); with targets, only those (run-main.sh builds nsp_render alone, which on a fresh
+# 2-core machine takes about a minute instead of the whole test suite's build).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -21,4 +24,6 @@ fi
 generator=()
 command -v ninja >/dev/null && generator=(-G Ninja)
 cmake -S . -B build "${generator[@]}" -DCMAKE_BUILD_TYPE=Release
-cmake --build build --parallel "$(nproc)"
+targets=()
+[ $# -eq 0 ] || targets=(--target "$@")
+cmake --build build --parallel "$(nproc)" "${targets[@]}"
