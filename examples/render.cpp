@@ -24,6 +24,7 @@
 #include <limits>
 #include <optional>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <string_view>
 #include <thread>
@@ -49,8 +50,10 @@ using namespace nsp_examples;
 /// The grey cloud keeps the resolution and sample count of the existing table.
 constexpr int kCloudWidth = 128, kCloudHeight = 128, kCloudSpp = 512;
 /// The chromatic cloud: its tracking costs several times the grey cloud's lookups per sample, and
-/// the default job must fit in about 5 minutes with the grey cloud's 90 s.
-constexpr int kChromaticWidth = 64, kChromaticHeight = 64, kChromaticSpp = 128;
+/// scripts/run-main.sh (the grey cloud's ~100 s, these 4 tables, the heavy-tail comparison with its
+/// reference images) must render in about 200 s on 2 cores. The size of the comparison, so that
+/// a default table's row is run 1 (seed 1) of the comparison.
+constexpr int kChromaticWidth = 32, kChromaticHeight = 32, kChromaticSpp = 128;
 
 /// The estimators of the grey cloud by default: every PathEstimator (the existing table).
 const std::vector<std::string> kCloudEstimators{"grey"};
@@ -66,10 +69,18 @@ const std::vector<std::string> kChromaticEstimators{
     "uni-nee-mis_spectral-tracking-max_absorb-weight",
     "unidirectional_spectral-tracking-avg_absorb-weight",
     "uni-nee-mis_spectral-tracking-avg_absorb-weight",
-    "unidirectional_spectral-mis_absorb-weight_uniform",
-    "ratio-nee_spectral-mis_absorb-weight_uniform",
-    "uni-nee-mis_spectral-mis_absorb-weight",
+    "unidirectional_spectral-mis_per-channel_absorb-weight_uniform",
+    "ratio-nee_spectral-mis_per-channel_absorb-weight_uniform",
+    "uni-nee-mis_spectral-mis_per-channel_absorb-weight",
+    "unidirectional_spectral-mis_global_absorb-weight_uniform",
+    "uni-nee-mis_spectral-mis_global_absorb-weight",
 };
+
+/// The estimator of --reference-spp: unbiased, finite variance on the chromatic cloud (one shared
+/// pdf under the grey majorant, weights mu_c / (mu_bar P) bounded), and none of the compared ones.
+constexpr const char* kReferenceEstimator = "uni-nee-mis_spectral-tracking-avg_global_balance_absorb-weight";
+/// The reference's seeds: seed + this (the rows use seed .. seed + runs - 1, runs <= 1000).
+constexpr std::uint64_t kReferenceSeedOffset = 1000000;
 
 // ---------------------------------------------------------------------------------------------
 // Command line
@@ -79,6 +90,7 @@ struct Options {
     int threads = std::max(1, int(std::thread::hardware_concurrency()));
     std::uint64_t seed = 1;
     int runs = 1;
+    std::optional<int> reference_spp;  ///< --reference-spp: effective (error-based) variance
     nsp::EstimatorOptions estimator;  ///< max depth and roulette settings
     std::string out = "out";
     bool write_exr = true;
@@ -96,12 +108,12 @@ efficiency table per light set-up and spectral mode (LTUV = density lookups per 
 variance per sample; lower is better).
 
 Default run (no flags): the grey cloud, set-ups A and B, mono, 128x128, 512 spp, every
-PathEstimator (24 renders); then the chromatic cloud, set-ups C1 and C2, rgb and hero, 64x64,
+PathEstimator (24 renders); then the chromatic cloud, set-ups C1 and C2, rgb and hero, 32x32,
 128 spp, the grey-majorant baseline uni-nee-mis_balance_absorb-weight and the spectral
-estimators listed under --estimators, uniform and luminance selection (absorb-weight; 12
-renders per set-up and mode, 48 in all), one run each. scripts/run-main.sh then adds the
-heavy-tail comparison: baseline against spectral MIS + NEE, --runs 5 at 32x32 (see the last
-example below).
+estimators listed under --estimators, uniform and luminance selection (absorb-weight; 15
+renders per set-up and mode, 60 in all), one run each. scripts/run-main.sh then adds the
+heavy-tail comparison: baseline against spectral MIS + NEE with each majorant, --runs 5 at
+32x32 with a 2048-spp reference image for the effective variance (the last example below).
 
 usage: nsp_render [flags]
 
@@ -139,9 +151,15 @@ usage: nsp_render [flags]
                        uni-nee-mis_spectral-tracking-max_absorb-weight,
                        unidirectional_spectral-tracking-avg_absorb-weight,
                        uni-nee-mis_spectral-tracking-avg_absorb-weight,
-                       unidirectional_spectral-mis_absorb-weight_uniform,
-                       ratio-nee_spectral-mis_absorb-weight_uniform,
-                       uni-nee-mis_spectral-mis_absorb-weight
+                       unidirectional_spectral-mis_per-channel_absorb-weight_uniform,
+                       ratio-nee_spectral-mis_per-channel_absorb-weight_uniform,
+                       uni-nee-mis_spectral-mis_per-channel_absorb-weight,
+                       unidirectional_spectral-mis_global_absorb-weight_uniform,
+                       uni-nee-mis_spectral-mis_global_absorb-weight
+                     Spectral MIS comes with either majorant: per-channel (each channel's own
+                     tight free-flight density; with extinction 1 : 4 : 16 the channels' pdfs
+                     barely overlap) or global (one grey free-flight density, per-channel event
+                     probabilities: the pdfs overlap and the balance heuristic combines them)
   --selection R      uniform, luminance or both (default both): how the spectral estimators that
                      use it (independent tracking, spectral MIS) choose a path's sampling
                      channel. luminance: q_c proportional to 0.5/C + 0.5 y_c / sum(y), y = Rec. 709
@@ -152,11 +170,25 @@ usage: nsp_render [flags]
   --runs K           render each selected row K times with seeds seed, seed+1, ..., seed+K-1
                      and report the median over the runs of seconds, lookups/spl, var/spl, LTUV
                      and cpu-s*var (default 1); K > 1 adds the min..max of var/spl. For
-                     heavy-tailed estimators, whose sample variance is itself unreliable
+                     heavy-tailed estimators, whose sample variance is itself unreliable (and
+                     understates their error: see --reference-spp)
+  --reference-spp N  effective (error-based) variance: before the rows of each rgb or hero
+                     table, render a reference image of the same set-up, mode and resolution with
+                     uni-nee-mis_spectral-tracking-avg_global_balance_absorb-weight (unbiased,
+                     finite variance here), N spp, seed + 1000000; then for every row and run
+                     report eff var/spl = spp x mean over pixels and channels of (pixel mean -
+                     reference pixel mean)^2 - spp x mean(var_ref / N): an unbiased estimate of
+                     spp x the image's MSE, which is the variance per sample of a finite-variance
+                     estimator and, for a heavy-tailed one, includes the error its sample
+                     variance misses. Adds the columns eff var/spl, eff LTUV and img eff var
+                     (the same from the error of the image mean: spp x pixels x (image mean -
+                     reference's)^2 - the same reference term; 3 degrees of freedom per run, but
+                     a tail missed in every pixel adds up there) and the ratios baseline /
+                     spectral MIS + NEE of all three (not in mono tables; default: off)
   --spp N            samples per pixel, N >= 2 (default 512 for the cloud, 128 for the
                      chromatic cloud); the variance per sample is estimated from the N samples
                      of each pixel
-  --res WxH          image size in pixels (default 128x128 for the cloud, 64x64 for the
+  --res WxH          image size in pixels (default 128x128 for the cloud, 32x32 for the
                      chromatic cloud); also --width W, --height H
   --threads N        worker threads (default: hardware concurrency)
   --seed N           random seed, an unsigned 64-bit integer (default 1); images do not depend
@@ -178,6 +210,7 @@ usage: nsp_render [flags]
 Examples: nsp_render --scene cloud --setup A --spp 256 --estimators uni-nee-mis_balance
           nsp_render --scene chromatic --estimators all --spp 16 --res 32x32
           nsp_render --scene chromatic --runs 5 --res 32x32 --spp 128 --no-exr \
+                     --reference-spp 2048 --selection uniform \
                      --estimators uni-nee-mis_grey_balance_absorb-weight,uni-nee-mis_spectral-mis_absorb-weight
 )";
 
@@ -268,6 +301,8 @@ Options parse(int argc, char** argv) {
             o.threads = parse_number<int>(flag, value(), 1, 1024);
         } else if (flag == "--seed") {
             o.seed = parse_number<std::uint64_t>(flag, value(), 0, std::numeric_limits<std::uint64_t>::max());
+        } else if (flag == "--reference-spp") {
+            o.reference_spp = parse_number<int>(flag, value(), 2, 1 << 24);
         } else if (flag == "--runs") {
             o.runs = parse_number<int>(flag, value(), 1, 1000);
         } else if (flag == "--max-depth") {
@@ -465,6 +500,10 @@ std::vector<TablePlan> plan(const Options& o) {
 struct Row {
     Candidate c;
     std::vector<RenderStats> runs;
+    /// With --reference-spp, per run: the effective variance per sample (see effective_variance).
+    std::vector<double> effective;
+    /// With --reference-spp, per run: the same from the error of the image mean (effective_image_variance).
+    std::vector<double> effective_image;
 
     /// The median over runs of metric f (the mean of the two middle values for an even count).
     template <class F>
@@ -512,7 +551,72 @@ struct Metrics {
 
     double var(const Row& row) const { return row.median([&](const RenderStats& r) { return variance(r); }); }
     double ltuv(const Row& row) const { return row.median([&](const RenderStats& r) { return ltuv(r); }); }
+
+    /// With --reference-spp: the median over runs of the effective variance per sample, and of the
+    /// effective LTUV (lookups/spl x effective variance of the same run); NaN without a reference.
+    static double eff(const Row& row) { return median_of(row.effective); }
+    static double eff_image(const Row& row) { return median_of(row.effective_image); }
+    static double eff_ltuv(const Row& row) {
+        std::vector<double> v;
+        for (std::size_t i = 0; i < row.effective.size(); ++i)
+            v.push_back(row.runs[i].lookups_per_sample() * row.effective[i]);
+        return median_of(v);
+    }
+    static double median_of(std::vector<double> v) {
+        if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
+        std::sort(v.begin(), v.end());
+        const std::size_t n = v.size();
+        return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+    }
 };
+
+/// The reference image of --reference-spp for one table, and what it cost.
+struct Reference {
+    int spp = 0;
+    std::uint64_t seed = 0;
+    RenderStats stats;  ///< with pixel_mean and pixel_variance
+    /// spp_row x the mean over pixels and channels of var_ref / spp_ref: what the reference's own
+    /// noise adds, in expectation, to spp_row x the squared error against it.
+    double contribution(int spp_row) const {
+        double v = 0.0;
+        for (const double x : stats.pixel_variance) v += x;
+        return double(spp_row) * v / double(stats.pixel_variance.size()) / double(spp);
+    }
+};
+
+/// The effective variance per sample of one run: spp x (mean over pixels and channels of
+/// (pixel mean - reference pixel mean)^2) - the reference's contribution. For an unbiased
+/// estimator independent of the reference this is an unbiased estimate of spp x the image's
+/// mean squared error, i.e. of its variance per sample when that is finite; for a heavy-tailed
+/// one it includes the error of the rare huge samples its sample variance misses in this run.
+double effective_variance(const RenderStats& run, int spp, const Reference& ref) {
+    const auto& a = run.pixel_mean;
+    const auto& b = ref.stats.pixel_mean;
+    if (a.size() != b.size() || a.empty()) throw std::logic_error("effective_variance: image sizes differ");
+    double sq = 0.0;
+    for (std::size_t i = 0; i < a.size(); ++i) sq += (a[i] - b[i]) * (a[i] - b[i]);
+    return double(spp) * sq / double(a.size()) - ref.contribution(spp);
+}
+
+/// The effective variance per sample from the error of the image mean: spp x pixels x (mean over
+/// channels of (image mean - reference image mean)^2) - the same reference contribution (the
+/// pixels are independent, so for an unbiased estimator its expectation is again the variance
+/// per sample). Only 3 degrees of freedom per run, so noisy; but where a heavy-tailed estimator
+/// misses the same rare samples in every pixel, its per-pixel errors add up coherently here,
+/// while per pixel they hide under the sampling noise of 'spp' samples.
+double effective_image_variance(const RenderStats& run, int spp, const Reference& ref) {
+    const auto& a = run.pixel_mean;
+    const auto& b = ref.stats.pixel_mean;
+    const std::size_t pixels = a.size() / 3;
+    double sq = 0.0;
+    for (int c = 0; c < 3; ++c) {
+        double d = 0.0;
+        for (std::size_t i = 0; i < pixels; ++i) d += a[3 * i + std::size_t(c)] - b[3 * i + std::size_t(c)];
+        d /= double(pixels);
+        sq += d * d;
+    }
+    return double(spp) * double(pixels) * sq / 3.0 - ref.contribution(spp);
+}
 
 std::string num(double v) {
     char buf[32];
@@ -548,6 +652,8 @@ double print_rows(const TablePlan& t, const Options& o, const std::vector<Row>& 
     std::printf("%-*s %5s %8s %11s %11s %11s %11s %9s", wn, "estimator", "spp", "seconds", "lookups/spl", "var/spl",
                 "LTUV", "cpu-s*var", "LTUV/best");
     if (o.runs > 1) std::printf(" %19s", "var/spl min..max");
+    const bool effective = std::any_of(rows.begin(), rows.end(), [](const Row& r) { return !r.effective.empty(); });
+    if (effective) std::printf(" %11s %11s %11s", "eff var/spl", "eff LTUV", "img eff var");
     std::printf(chromatic ? " %s\n" : " %9s\n", chromatic ? "mean R G B" : "mean");
     for (const Row& r : rows) {
         const double ltuv = m.ltuv(r);
@@ -562,6 +668,9 @@ double print_rows(const TablePlan& t, const Options& o, const std::vector<Row>& 
             const auto [lo, hi] = r.range([&](const RenderStats& s) { return m.variance(s); });
             std::printf(" %19s", (num(lo) + ".." + num(hi)).c_str());
         }
+        if (effective)
+            std::printf(" %11s %11s %11s", num(Metrics::eff(r)).c_str(), num(Metrics::eff_ltuv(r)).c_str(),
+                        num(Metrics::eff_image(r)).c_str());
         if (chromatic)
             std::printf(" %s %s %s\n", num(r.mean(0)).c_str(), num(r.mean(1)).c_str(), num(r.mean(2)).c_str());
         else
@@ -650,7 +759,8 @@ const Row* best_of(const std::vector<Row>& rows, const Metrics& m, P pred) {
     return best;
 }
 
-void print_chromatic_table(const TablePlan& t, const Options& o, const std::vector<Row>& rows) {
+void print_chromatic_table(const TablePlan& t, const Options& o, const std::vector<Row>& rows,
+                           const Reference* reference) {
     const Metrics m{true};
     std::printf("\nSet-up %s (chromatic 1:4:16, %.*s, %dx%d, %d spp, %d threads%s)\n", t.scene.name(),
                 int(t.mode.size()), t.mode.data(), t.width, t.height, t.spp, o.threads,
@@ -666,6 +776,30 @@ void print_chromatic_table(const TablePlan& t, const Options& o, const std::vect
     std::printf("Rows without a channel policy are nsp::PathEstimator with the grey (global) majorant; _lum: "
                 "luminance channel selection, otherwise uniform.\n");
     print_common_footer(o, rows);
+    if (reference) {
+        double smallest = std::numeric_limits<double>::infinity();
+        for (const Row& r : rows)
+            if (!r.effective.empty()) smallest = std::min(smallest, Metrics::eff(r));
+        const double contrib = reference->contribution(t.spp);
+        std::printf("eff var/spl: effective variance per sample against a reference image of this set-up, mode "
+                    "and resolution: %s, %d spp, seed %llu (independent of every row), %.1f s, var/spl %s. Per "
+                    "run: %d x mean over pixels and channels of (pixel mean - reference pixel mean)^2, minus the "
+                    "reference's own noise, %d x mean(var_ref/%d) = %s (%.1f%% of the lowest eff var/spl). For an "
+                    "unbiased estimator it is an unbiased estimate of %d x the image's MSE = its variance per "
+                    "sample; for a heavy-tailed one it also holds the error its sample variance misses. eff LTUV "
+                    "= lookups/spl x eff var/spl; img eff var: the same from the image mean's error, %d x %d "
+                    "pixels x mean over channels of (image mean - reference's)^2 minus the same reference term "
+                    "(3 degrees of freedom per run, noisy, but a tail missed in every pixel adds up there); all "
+                    "%s. Reference image mean R G B: %s %s %s.\n",
+                    kReferenceEstimator, reference->spp, (unsigned long long)reference->seed,
+                    reference->stats.wall_seconds, num(reference->stats.variance_per_channel()).c_str(), t.spp,
+                    t.spp, reference->spp, num(contrib).c_str(),
+                    std::isfinite(smallest) && smallest > 0.0 ? 100.0 * contrib / smallest : 0.0, t.spp, t.spp,
+                    t.width * t.height,
+                    o.runs > 1 ? ("median over " + std::to_string(o.runs) + " runs").c_str() : "one run",
+                    num(reference->stats.mean[0]).c_str(), num(reference->stats.mean[1]).c_str(),
+                    num(reference->stats.mean[2]).c_str());
+    }
     // Means that disagree: the per-pixel variances give each image mean a standard error, and a
     // row far from the best row is heavy-tailed (its sample variance understates its variance,
     // and its mean is low in most runs) or biased.
@@ -680,25 +814,55 @@ void print_chromatic_table(const TablePlan& t, const Options& o, const std::vect
     }
 
     const std::string runs_note = o.runs > 1 ? "median over " + std::to_string(o.runs) + " runs"
-                                             : "one run; the baseline is heavy-tailed, see --runs";
-    // (a) spectral MIS + NEE against the grey-majorant baseline of the same mode.
+                                             : "one run; the baseline is heavy-tailed, see --runs, --reference-spp";
+    // (a) spectral MIS + NEE (each majorant) against the grey-majorant baseline of the same mode.
     const Row* base = find_row(rows, "uni-nee-mis_balance_absorb-weight");
-    for (const char* suffix : {"", "_lum"}) {
-        const Row* smis =
-            find_row(rows, std::string("uni-nee-mis_spectral-mis_per-channel_balance_absorb-weight") + suffix);
-        if (!base || !smis) continue;
-        const auto [z, c] = mean_gap(*base, *smis);
-        std::printf("grey-majorant baseline / spectral-mis + NEE%s (uni-nee-mis, absorb-weight): var/spl %s, "
-                    "LTUV %s (%s); image means %.1f standard errors apart in %c%s\n",
-                    *suffix ? " with luminance selection" : "", num(m.var(*base) / m.var(*smis)).c_str(),
-                    num(m.ltuv(*base) / m.ltuv(*smis)).c_str(), runs_note.c_str(), z, "RGB"[c],
-                    z > kMeanGap ? " (too far apart: a heavy tail of the baseline, whose var/spl then understates "
-                                   "its variance, or a bias)"
-                                 : "");
-        if (o.runs > 1)
-            std::printf("  var/spl per run: baseline %s; spectral-mis + NEE%s %s\n",
-                        per_run(*base, [&](const RenderStats& s) { return m.variance(s); }).c_str(), suffix,
-                        per_run(*smis, [&](const RenderStats& s) { return m.variance(s); }).c_str());
+    std::vector<std::pair<std::string, const Row*>> compared;
+    for (const char* majorant : {"per-channel", "global"})
+        for (const char* suffix : {"", "_lum"}) {
+            const Row* smis = find_row(rows, std::string("uni-nee-mis_spectral-mis_") + majorant +
+                                                 "_balance_absorb-weight" + suffix);
+            if (!base || !smis) continue;
+            const auto [z, c] = mean_gap(*base, *smis);
+            const std::string label = std::string("spectral-mis ") + majorant + " + NEE" + (*suffix ? " lum" : "");
+            std::printf("baseline / %s: var/spl %s, LTUV %s (%s); image means %.1f standard errors apart in %c%s\n",
+                        label.c_str(), num(m.var(*base) / m.var(*smis)).c_str(),
+                        num(m.ltuv(*base) / m.ltuv(*smis)).c_str(), runs_note.c_str(), z, "RGB"[c],
+                        z > kMeanGap ? " (too far apart: a heavy tail of the baseline, whose var/spl then "
+                                       "understates its variance, or a bias)"
+                                     : "");
+            if (!base->effective.empty() && !smis->effective.empty()) {
+                std::string each;  // run i of both rows used the same seed
+                for (std::size_t i = 0; i < base->effective.size() && i < smis->effective.size(); ++i)
+                    each += (each.empty() ? "" : ", ") + num(base->effective[i] / smis->effective[i]);
+                std::string each_image;
+                for (std::size_t i = 0; i < base->effective_image.size() && i < smis->effective_image.size(); ++i)
+                    each_image += (each_image.empty() ? "" : ", ") +
+                                  num(base->effective_image[i] / smis->effective_image[i]);
+                std::printf("  against the reference: eff var/spl %s, eff LTUV %s, img eff var %s (%s)%s%s\n",
+                            num(Metrics::eff(*base) / Metrics::eff(*smis)).c_str(),
+                            num(Metrics::eff_ltuv(*base) / Metrics::eff_ltuv(*smis)).c_str(),
+                            num(Metrics::eff_image(*base) / Metrics::eff_image(*smis)).c_str(),
+                            o.runs > 1 ? ("ratio of the medians over " + std::to_string(o.runs) + " runs").c_str()
+                                       : "one run",
+                            o.runs > 1 ? ("; eff var/spl ratio per run: " + each).c_str() : "",
+                            o.runs > 1 ? ("; img eff var ratio per run: " + each_image).c_str() : "");
+            }
+            compared.emplace_back(label, smis);
+        }
+    if (o.runs > 1 && !compared.empty()) {
+        auto runs_of = [&](const Row& r) {
+            std::string v = per_run(r, [&](const RenderStats& s) { return m.variance(s); });
+            if (!r.effective.empty()) {
+                std::string e, g;
+                for (const double x : r.effective) e += (e.empty() ? "" : ", ") + num(x);
+                for (const double x : r.effective_image) g += (g.empty() ? "" : ", ") + num(x);
+                v += "; eff var/spl " + e + "; img eff var " + g;
+            }
+            return v;
+        };
+        std::printf("  per run, var/spl: baseline %s\n", runs_of(*base).c_str());
+        for (const auto& [label, r] : compared) std::printf("  per run, var/spl: %s %s\n", label.c_str(), runs_of(*r).c_str());
     }
     // (b) the best of each channel policy, and the best overall, by LTUV.
     struct Family {
@@ -755,8 +919,9 @@ void list_combinations() {
     });
     std::printf("%zu valid combinations. channels 'grey' is nsp::PathEstimator (grey majorant; a heuristic on a "
                 "single strategy and mis::None on an MIS strategy are rejected); the others are "
-                "nsp::SpectralPathEstimator, only in multi-channel modes: independent and spectral-mis with the "
-                "per-channel majorant, spectral tracking with the global one; no directional-mis; mis::None for "
+                "nsp::SpectralPathEstimator, only in multi-channel modes: independent tracking with the per-channel "
+                "majorant, spectral tracking with the global one, spectral-mis with either; no directional-mis; "
+                "mis::None for "
                 "single strategies, balance for uni-nee-mis. Independent and spectral-mis rows are rendered once "
                 "per --selection rule (luminance rows end in _lum).\n", total);
 }
@@ -774,41 +939,76 @@ int run(const Options& o) {
     }
     const std::vector<TablePlan> tables = plan(o);
     if (o.write_exr) std::filesystem::create_directories(o.out);
+    // --reference-spp: the multi-channel tables get a reference image (mono has no spectral tracking).
+    auto reference_index = [&](std::string_view mode) -> std::optional<std::size_t> {
+        if (!o.reference_spp) return std::nullopt;
+        for (const Candidate& c : candidates(mode, {SelectionRule::Uniform}))
+            if (c.name == kReferenceEstimator) return c.index;
+        return std::nullopt;
+    };
     std::size_t total = 0;
-    for (const TablePlan& t : tables) total += t.rows.size() * std::size_t(o.runs);
+    for (const TablePlan& t : tables) total += t.rows.size() * std::size_t(o.runs) + (reference_index(t.mode) ? 1 : 0);
     std::fprintf(stderr, "nsp_render: %zu renders in %zu tables on %d threads\n", total, tables.size(), o.threads);
     const auto t0 = std::chrono::steady_clock::now();
     std::size_t done = 0;
+    auto request = [&](const TablePlan& t, std::uint64_t seed, SelectionRule selection) {
+        RenderRequest rq;
+        rq.scene = t.scene;
+        rq.lights = o.lights;
+        rq.selection = selection;
+        rq.width = t.width;
+        rq.height = t.height;
+        rq.spp = t.spp;
+        rq.threads = o.threads;
+        rq.seed = seed;
+        rq.estimator = o.estimator;
+        return rq;
+    };
     for (const TablePlan& t : tables) {
+        std::optional<Reference> reference;
+        if (const auto index = reference_index(t.mode)) {
+            reference.emplace();
+            reference->spp = *o.reference_spp;
+            reference->seed = o.seed + kReferenceSeedOffset;
+            RenderRequest rq = request(t, reference->seed, SelectionRule::Uniform);
+            rq.spp = reference->spp;
+            rq.pixel_stats = true;
+            std::ostringstream label;
+            label << '[' << ++done << '/' << total << "] " << t.scene.name() << "_reference_" << t.mode;
+            rq.label = label.str();
+            std::vector<float> rgb;
+            reference->stats = render_in_mode(t.mode, *index, rq, rgb);
+        } else if (o.reference_spp) {
+            std::fprintf(stderr, "nsp_render: --reference-spp: no reference in %.*s mode (it needs %s)\n",
+                         int(t.mode.size()), t.mode.data(), kReferenceEstimator);
+        }
         std::vector<Row> rows;
         for (const Candidate& c : t.rows) {
-            Row row{c, {}};
+            Row row{c, {}, {}, {}};
             std::string file = std::string(t.scene.name()) + "_" + c.name;
             if (t.mode != nsp::Mono::name) file.append("_").append(t.mode);
             for (int run = 0; run < o.runs; ++run) {
-                RenderRequest rq;
-                rq.scene = t.scene;
-                rq.lights = o.lights;
-                rq.selection = c.selection;
-                rq.width = t.width;
-                rq.height = t.height;
-                rq.spp = t.spp;
-                rq.threads = o.threads;
-                rq.seed = o.seed + std::uint64_t(run);
-                rq.estimator = o.estimator;
+                RenderRequest rq = request(t, o.seed + std::uint64_t(run), c.selection);
+                rq.pixel_stats = reference.has_value();
                 std::ostringstream label;  // not "[" + std::to_string(..): GCC 12 warns (-Wrestrict, bug 105329)
                 label << '[' << ++done << '/' << total << "] " << file;
                 if (o.runs > 1) label << " run " << run + 1;
                 rq.label = label.str();
                 std::vector<float> rgb;
                 row.runs.push_back(render_in_mode(t.mode, c.index, rq, rgb));
+                if (reference) {
+                    row.effective.push_back(effective_variance(row.runs.back(), t.spp, *reference));
+                    row.effective_image.push_back(effective_image_variance(row.runs.back(), t.spp, *reference));
+                    row.runs.back().pixel_mean = {};
+                    row.runs.back().pixel_variance = {};
+                }
                 if (o.write_exr && run == 0)
                     write_exr_rgb((std::filesystem::path(o.out) / (file + ".exr")).string(), t.width, t.height, rgb);
             }
             rows.push_back(std::move(row));
         }
         if (t.scene.kind == SceneKind::Cloud) print_cloud_table(t, o, rows);
-        else print_chromatic_table(t, o, rows);
+        else print_chromatic_table(t, o, rows, reference ? &*reference : nullptr);
         std::fflush(stdout);
     }
     const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

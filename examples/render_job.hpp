@@ -54,6 +54,7 @@ struct RenderRequest {
     std::uint64_t seed = 1;
     nsp::EstimatorOptions estimator;
     std::string label;  ///< for the progress line
+    bool pixel_stats = false;  ///< also return every pixel's mean and sample variance (RenderStats)
 };
 
 /// What one render measured. The estimates of each sample are taken as linear RGB (mono: the value
@@ -68,6 +69,9 @@ struct RenderStats {
     double variance_of_mean = 0.0;             ///< mean over pixels of the sample variance of the channel mean
     std::array<double, 3> channel_variance{};  ///< per channel: mean over pixels of its sample variance
     std::array<double, 3> mean{};              ///< image mean per channel (an unbiasedness check)
+    /// Only with RenderRequest::pixel_stats: per pixel and channel (interleaved RGB, row-major),
+    /// the mean of the spp samples and their sample variance (per sample, not of the mean).
+    std::vector<double> pixel_mean, pixel_variance;
 
     /// The mean over the 3 channels of channel_variance.
     double variance_per_channel() const {

@@ -147,6 +147,11 @@ RenderStats render(const typename C::Scene& scene, const RenderRequest& rq, std:
     const int w = rq.width, h = rq.height;
     const float aspect = float(w) / float(h);
     rgb.assign(std::size_t(w) * std::size_t(h) * 3u, 0.f);
+    std::vector<double> pixel_mean, pixel_variance;  // written by pixel index: no sharing between threads
+    if (rq.pixel_stats) {
+        pixel_mean.assign(rgb.size(), 0.0);
+        pixel_variance.assign(rgb.size(), 0.0);
+    }
     // Fixed channels: one selection for the whole image; hero wavelengths: one per path.
     const nsp::ChannelSelection<S> fixed_selection =
         rq.selection == SelectionRule::Luminance ? luminance_selection<S>({}) : nsp::ChannelSelection<S>{};
@@ -196,6 +201,10 @@ RenderStats render(const typename C::Scene& scene, const RenderRequest& rq, std:
                     t.variance_sum[std::size_t(i)] += channel[std::size_t(i)].m2 / n1;
                     t.mean_sum[std::size_t(i)] += channel[std::size_t(i)].mean;
                     rgb[3 * pixel + std::size_t(i)] = float(sum[i] / double(rq.spp));
+                    if (rq.pixel_stats) {
+                        pixel_mean[3 * pixel + std::size_t(i)] = channel[std::size_t(i)].mean;
+                        pixel_variance[3 * pixel + std::size_t(i)] = channel[std::size_t(i)].m2 / n1;
+                    }
                 }
             }
             progress.update(rows_done.fetch_add(1) + 1, h);
@@ -233,6 +242,8 @@ RenderStats render(const typename C::Scene& scene, const RenderRequest& rq, std:
         st.channel_variance[std::size_t(i)] = var_channel[std::size_t(i)] / pixels;
         st.mean[std::size_t(i)] = mean[std::size_t(i)] / pixels;
     }
+    st.pixel_mean = std::move(pixel_mean);
+    st.pixel_variance = std::move(pixel_variance);
     char summary[64];
     std::snprintf(summary, sizeof summary, ": %.3f s", st.wall_seconds);
     progress.finish(rq.label + summary);
