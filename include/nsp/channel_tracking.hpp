@@ -123,45 +123,34 @@ struct ChannelDeltaCollision {
     template <class V>
     bool operator()(float t, const Coefficients<S>& k, const V& mu_v, const V& tau_v) {
         constexpr bool grey = std::is_same_v<V, float>;
-        const float u = rng.uniform();
-        SegmentEnd event;
-        Spec f_factor, p_factor;
+        const Spec mu = detail::broadcast<Spec>(mu_v);
+        // Every channel's density mu_bar_c P_x,c of each event: its own (own pdfs) or the one
+        // shared by all channels (spectral tracking). The sampling channel's picks the event.
+        ChannelEventDensities<Spec> d;
         if constexpr (CP::own_pdfs) {
-            const Spec mu = detail::broadcast<Spec>(mu_v);
-            const auto d = channel_event_densities<A, S>(k, mu);
-            const float inv = 1.f / mu[c];  // mu_c* > 0: free flight samples nothing where it is 0
-            const float pa = d.absorb[c] * inv, ps = d.scatter[c] * inv;
-            if (u < pa) {
-                event = SegmentEnd::Absorbed;
-                f_factor = k.sigma_a;
-                p_factor = d.absorb;
-            } else if (u < pa + ps || !(d.null[c] > 0.f)) {  // rounding never picks a null of probability 0
-                event = SegmentEnd::Scattered;
-                f_factor = k.sigma_s;
-                p_factor = d.scatter;
-            } else {
-                event = SegmentEnd::Passed;  // a null
-                f_factor = mu - k.sigma_t();
-                p_factor = d.null;
-            }
+            d = channel_event_densities<A, S>(k, mu);
         } else {
             static_assert(grey, "nsp: spectral tracking shares one pdf and needs a grey majorant (GlobalMajorant)");
             const EventProbabilities p = shared_event_probabilities<A, CP::throughput_weighted, S>(k, mu_v, st.f);
-            float pe;
-            if (u < p.absorb) {
-                event = SegmentEnd::Absorbed;
-                f_factor = k.sigma_a;
-                pe = p.absorb;
-            } else if (u < p.absorb + p.scatter || !(p.null > 0.f)) {
-                event = SegmentEnd::Scattered;
-                f_factor = k.sigma_s;
-                pe = p.scatter;
-            } else {
-                event = SegmentEnd::Passed;
-                f_factor = Spec::Constant(mu_v) - k.sigma_t();
-                pe = p.null;
-            }
-            p_factor = Spec::Constant(mu_v * pe);
+            d = {Spec::Constant(mu_v * p.absorb), Spec::Constant(mu_v * p.scatter), Spec::Constant(mu_v * p.null)};
+        }
+        const float inv = 1.f / mu[c];  // mu_c* > 0: free flight samples nothing where it is 0
+        const float pa = d.absorb[c] * inv, ps = d.scatter[c] * inv;
+        const float u = rng.uniform();
+        SegmentEnd event;
+        Spec f_factor, p_factor;
+        if (u < pa) {
+            event = SegmentEnd::Absorbed;
+            f_factor = k.sigma_a;
+            p_factor = d.absorb;
+        } else if (u < pa + ps || !(d.null[c] > 0.f)) {  // rounding never picks a null of probability 0
+            event = SegmentEnd::Scattered;
+            f_factor = k.sigma_s;
+            p_factor = d.scatter;
+        } else {
+            event = SegmentEnd::Passed;  // a null
+            f_factor = mu - k.sigma_t();
+            p_factor = d.null;
         }
         if constexpr (Rec::enabled)
             rec.vertex(t, std::log(double(p_factor[c])) - double(channel_of(tau_v, c)));
@@ -169,14 +158,14 @@ struct ChannelDeltaCollision {
             out = {event, t};
             return false;
         }
-        if constexpr (!grey) {
+        Spec nee_factor = mu;  // ratio tracking's pdf of a null, for the NEE alternative (THEORY 5.1)
+        if constexpr (!grey) {  // a grey majorant's Tbar is common to every channel and cancels
             const Spec tb = detail::relative_transmittance(tau_v, c);
             f_factor *= tb;
             p_factor *= tb;
-            if (event == SegmentEnd::Passed && nee_alternative) st.nee *= mu_v * tb;
-        } else {
-            if (event == SegmentEnd::Passed && nee_alternative) st.nee *= mu_v;
+            nee_factor *= tb;
         }
+        if (event == SegmentEnd::Passed && nee_alternative) st.nee *= nee_factor;
         st.f *= f_factor;
         st.uni *= p_factor;
         if (!st.template renormalize<CP>(c)) {

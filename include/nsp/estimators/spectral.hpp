@@ -1,8 +1,9 @@
 // nsp/estimators/spectral.hpp: path estimators over channels (THEORY 5.1, 5.3, 5.6).
 //
-// `SpectralPathEstimator<CP, St, A>` composes a channel policy CP (independent tracking, spectral
-// tracking, spectral MIS; path_pdf.hpp) with a path strategy St (unidirectional, NEE, or both
-// combined by null-scattering MIS; estimator.hpp) and an absorption policy A. Each path picks a
+// `SpectralPathEstimator<CP, St, H, A>` composes a channel policy CP (independent tracking,
+// spectral tracking, spectral MIS; path_pdf.hpp) with a path strategy St (unidirectional, NEE, or
+// both combined by null-scattering MIS; estimators/common.hpp), its heuristic H and an absorption
+// policy A. Each path picks a
 // sampling channel c* with probabilities q (ChannelSelection), tracks every segment with c*'s
 // majorant and keeps every channel's contribution and pdf in a ChannelPathState, so one formula
 // weighs the 2 x C techniques of spectral MIS + NEE:
@@ -18,9 +19,9 @@
 #include "../core/counter.hpp"
 #include "../core/rng.hpp"
 #include "../mis.hpp"
-#include "common.hpp"
 #include "../path_pdf.hpp"
 #include "../scene.hpp"
+#include "common.hpp"
 
 namespace nsp {
 
