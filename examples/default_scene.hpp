@@ -158,6 +158,53 @@ nsp::Lights<S> chromatic_lights(ChromaticSetup setup) {
     return lights;
 }
 
+// ---------------------------------------------------------------------------------------------
+// The sparse scene (issue: majorants that fit the medium): a thin rising plume and a few small
+// dense puffs filling about 3% of the same [-1, 1]^3 box, where one global majorant spends most
+// of its lookups on empty space and a grid majorant skips it.
+
+/// The sparse medium's extinction per unit density (grey, albedo kSigmaS / (kSigmaA + kSigmaS)).
+inline constexpr float kSparseExtinction = 60.f;
+
+/// The sparse medium's densities in [0, 1] on a kGridRes^3 grid over [-1, 1]^3 (x fastest): five
+/// puffs of radius 0.12 to 0.22 and a plume of radius 0.06 winding up from the lowest puff.
+inline std::vector<float> sparse_density() {
+    struct Puff { float x, y, z, r; };
+    constexpr std::array<Puff, 5> puffs{{{-0.55f, -0.6f, 0.1f, 0.22f}, {0.45f, -0.35f, -0.3f, 0.16f},
+                                         {0.1f, 0.5f, 0.35f, 0.18f}, {-0.4f, 0.45f, -0.45f, 0.12f},
+                                         {0.6f, 0.6f, 0.5f, 0.14f}}};
+    std::vector<float> d(std::size_t(kGridRes) * kGridRes * kGridRes);
+    for (int z = 0; z < kGridRes; ++z)
+        for (int y = 0; y < kGridRes; ++y)
+            for (int x = 0; x < kGridRes; ++x) {
+                const float px = -1.f + 2.f * (float(x) + 0.5f) / kGridRes;
+                const float py = -1.f + 2.f * (float(y) + 0.5f) / kGridRes;
+                const float pz = -1.f + 2.f * (float(z) + 0.5f) / kGridRes;
+                float shape = 0.f;
+                for (const Puff& p : puffs) {
+                    const float r = std::sqrt((px - p.x) * (px - p.x) + (py - p.y) * (py - p.y) + (pz - p.z) * (pz - p.z));
+                    shape = std::max(shape, 1.f - r / p.r);
+                }
+                // The plume: a tube of radius 0.06 around a curve rising from the first puff.
+                const float cx = -0.55f + 0.35f * std::sin(2.f * (py + 0.6f)), cz = 0.1f + 0.2f * (py + 0.6f);
+                const float rp = std::sqrt((px - cx) * (px - cx) + (pz - cz) * (pz - cz));
+                if (py > -0.6f && py < 0.9f) shape = std::max(shape, 0.5f * (1.f - rp / 0.06f));
+                const float n = value_noise(7.f * px + 3.f, 7.f * py, 7.f * pz - 2.f);
+                const float c = std::clamp(2.f * shape - 0.3f * n, 0.f, 1.f);
+                d[std::size_t(x) + std::size_t(kGridRes) * (std::size_t(y) + std::size_t(kGridRes) * std::size_t(z))] = c;
+            }
+    return d;
+}
+
+/// The sparse medium: sparse_density() with extinction kSparseExtinction and the default albedo.
+template <nsp::SpectralMode S>
+nsp::DenseGridMedium<S> make_sparse_medium() {
+    constexpr float albedo = kSigmaS / (kSigmaA + kSigmaS);
+    return {nsp::Box{nsp::Vec3(-1.f), nsp::Vec3(1.f)}, {kGridRes, kGridRes, kGridRes}, sparse_density(),
+            nsp::constant_coefficient<S>(kSparseExtinction * (1.f - albedo)),
+            nsp::constant_coefficient<S>(kSparseExtinction * albedo)};
+}
+
 /// The camera ray through normalised image coordinates (u, v) in [0, 1]^2, v up, square pixels
 /// for an image of aspect = width / height.
 inline nsp::Ray camera_ray(float u, float v, float aspect) {

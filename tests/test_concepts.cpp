@@ -30,7 +30,16 @@ static_assert(MajorantPolicy<GlobalMajorant<DenseGridMedium<Mono>>, DenseGridMed
 static_assert(MajorantPolicy<GlobalMajorant<DenseGridMedium<Rgb>>, DenseGridMedium<Rgb>>);
 static_assert(MajorantPolicy<GlobalMajorant<ExponentialMedium<Mono>>, ExponentialMedium<Mono>>);
 static_assert(MajorantPolicy<GlobalMajorant<ExponentialMedium<Rgb>>, ExponentialMedium<Rgb>>);
-static_assert(GlobalMajorant<HomogeneousMedium<Mono>>::bounds_density);
+static_assert(std::is_same_v<bound_policy_t<GlobalMajorant<HomogeneousMedium<Mono>>>, bound::Guaranteed>);
+static_assert(std::is_same_v<bound_policy_t<GlobalMajorant<HomogeneousMedium<Mono>, bound::Signed>>, bound::Signed>);
+// Grid majorants: grid-like media only (a homogeneous medium has no DDA to walk), grey or per channel.
+static_assert(RegionBoundedMedium<DenseGridMedium<Rgb>> && RegionBoundedMedium<ExponentialMedium<Hero<4>>>);
+static_assert(!RegionBoundedMedium<HomogeneousMedium<Rgb>>);
+static_assert(MajorantPolicy<GridMajorant<DenseGridMedium<Mono>>, DenseGridMedium<Mono>>);
+static_assert(MajorantPolicy<GridMajorant<DenseGridMedium<Rgb>, bound::Clamp>, DenseGridMedium<Rgb>>);
+static_assert(MajorantPolicy<ChannelGridMajorant<DenseGridMedium<Hero<4>>>, DenseGridMedium<Hero<4>>>);
+static_assert(!is_per_channel_majorant_v<GridMajorant<DenseGridMedium<Rgb>>, DenseGridMedium<Rgb>>);
+static_assert(is_per_channel_majorant_v<ChannelGridMajorant<DenseGridMedium<Rgb>>, DenseGridMedium<Rgb>>);
 static_assert(MajorantPolicy<ChannelMajorant<DenseGridMedium<Rgb>>, DenseGridMedium<Rgb>>);
 static_assert(MajorantPolicy<ChannelMajorant<DenseGridMedium<Hero<4>>>, DenseGridMedium<Hero<4>>>);
 static_assert(MajorantPolicy<GlobalMajorant<DenseGridMedium<Hero<4>>>, DenseGridMedium<Hero<4>>>);

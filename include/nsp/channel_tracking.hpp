@@ -27,13 +27,6 @@
 namespace nsp {
 
 namespace detail {
-/// A majorant value as a spectrum (a grey value in every channel).
-template <class Spec, class V>
-Spec broadcast(const V& v) noexcept {
-    if constexpr (std::is_same_v<V, float>) return Spec::Constant(v);
-    else return v;
-}
-
 /// exp(-(tau_c - ref)) per channel, with ref = min(tau_c*, min_c tau_c + 80): every factor is at
 /// most e^80 (no overflow) and the sampling channel's at least e^-80 (it never underflows). A
 /// common factor of all channels cancels in every ratio the state forms.
@@ -54,14 +47,15 @@ struct ChannelEventDensities {
     Spec null;
 };
 
-/// See ChannelEventDensities. Null probabilities are clamped at 0 where mu_n < 0 and the others
-/// renormalised, as in event_probabilities (THEORY 4).
+/// See ChannelEventDensities. Probabilities are |mu_x,c| / (mu_a,c + mu_s,c + |mu_n,c|), as in
+/// event_probabilities: where mu_n,c < 0 (bound::Signed) the null keeps a non-zero probability
+/// and the contribution mu_n,c carries the sign (THEORY 4).
 template <AbsorptionPolicy A, SpectralMode S>
 ChannelEventDensities<typename S::Spectrum> channel_event_densities(const Coefficients<S>& k,
                                                                     const typename S::Spectrum& mu) noexcept {
     using Spec = typename S::Spectrum;
     const Spec a = k.sigma_a.max(0.f), s = k.sigma_s.max(0.f), t = a + s;
-    const Spec n = (mu - t).max(0.f);
+    const Spec n = (mu - t).abs();
     const Spec denom = t + n;
     const Spec scale = (denom > 0.f).select(mu / denom, 0.f);
     if constexpr (A::as_event) return {a * scale, s * scale, n * scale};
@@ -76,7 +70,7 @@ EventProbabilities shared_event_probabilities(const Coefficients<S>& k, float mu
                                               const typename S::Spectrum& w) noexcept {
     using Spec = typename S::Spectrum;
     const Spec a = k.sigma_a.max(0.f), s = k.sigma_s.max(0.f);
-    const Spec n = (Spec::Constant(mu) - a - s).max(0.f);
+    const Spec n = (Spec::Constant(mu) - a - s).abs();
     float pa = 0.f, ps = 0.f, pn = 0.f;
     if constexpr (weighted) {
         const Spec aw = w.abs();
@@ -123,7 +117,7 @@ struct ChannelDeltaCollision {
     template <class V>
     bool operator()(float t, const Coefficients<S>& k, const V& mu_v, const V& tau_v) {
         constexpr bool grey = std::is_same_v<V, float>;
-        const Spec mu = detail::broadcast<Spec>(mu_v);
+        const Spec mu = detail::broadcast_majorant<Spec>(mu_v);
         // Every channel's density mu_bar_c P_x,c of each event: its own (own pdfs) or the one
         // shared by all channels (spectral tracking). The sampling channel's picks the event.
         ChannelEventDensities<Spec> d;
@@ -192,7 +186,7 @@ ChannelTrack track_channels_delta(const M& medium, const Maj& majorant, const Ra
     using RecT = std::remove_reference_t<Rec>;
     ChannelDeltaCollision<CP, A, S, R, RecT> cb{rng, rec, st, c, nee_alternative};
     const auto f = free_flight(medium, majorant, ray, 0.f, tmax, lambda, rng, counter, cb, kDefaultMaxCollisions, c);
-    if (f.aborted) return {SegmentEnd::Aborted, f.t};
+    if (f.aborted) return {aborted_end(f), f.t};
     if (f.stopped) return cb.out;
     if constexpr (is_per_channel_majorant_v<Maj, M>) {
         const auto tb = detail::relative_transmittance(f.tau_tail, c);
@@ -234,7 +228,7 @@ struct ChannelRatioCollision {
     template <class V>
     bool operator()(float t, const Coefficients<S>& k, const V& mu_v, const V& tau_v) {
         constexpr bool grey = std::is_same_v<V, float>;
-        const Spec mu = detail::broadcast<Spec>(mu_v);
+        const Spec mu = detail::broadcast_majorant<Spec>(mu_v);
         Spec f_factor = mu - k.sigma_t(), nee_factor = mu, uni_factor = Spec::Ones();
         if (uni_alternative) {
             if constexpr (CP::own_pdfs) {
@@ -290,7 +284,7 @@ ChannelShadow<typename M::Spectral> track_channels_ratio(const M& medium, const 
     const auto f = free_flight(medium, majorant, ray, 0.f, tmax, lambda, rng, counter, cb, kDefaultMaxCollisions, c);
     if (f.aborted) {
         cb.out.f.setZero();
-        cb.out.end = SegmentEnd::Aborted;
+        cb.out.end = aborted_end(f);
         return cb.out;
     }
     if (f.stopped) return cb.out;

@@ -10,6 +10,7 @@
 #include "estimator.hpp"
 #include "light.hpp"
 #include "majorant.hpp"
+#include "majorants/grid.hpp"
 #include "media/exponential.hpp"
 #include "media/grid.hpp"
 #include "media/homogeneous.hpp"

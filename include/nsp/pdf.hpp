@@ -84,11 +84,11 @@ double ratio_segment_log_pdf(const M&, const Maj& majorant, const Ray& ray, floa
 
 /// Channel c's probability of event `end` (Absorbed, Scattered, or Passed for a null) at a
 /// collision with coefficients k under channel c's majorant mu > 0, when channel c is tracked
-/// with its own event probabilities of policy A (negative nulls clamped at 0, THEORY 4).
+/// with its own event probabilities of policy A (|mu_x| / (mu_a + mu_s + |mu_n|), THEORY 4).
 template <AbsorptionPolicy A, SpectralMode S>
 double channel_event_probability(const Coefficients<S>& k, double mu, int c, SegmentEnd end) {
     const double a = std::max(0.0, double(k.sigma_a[c])), s = std::max(0.0, double(k.sigma_s[c]));
-    const double n = std::max(0.0, mu - a - s);
+    const double n = std::abs(mu - a - s);
     const double total = a + s + n;
     if (!(total > 0.0)) return 0.0;
     if (end == SegmentEnd::Passed) return n / total;

@@ -52,14 +52,16 @@ struct EventProbabilities {
 };
 
 /// The event probabilities delta tracking uses at a collision with coefficients `c` under
-/// majorant `mu_bar` > 0. One pdf serves all channels, driven by the channel means. Where the
-/// majorant does not bound the extinction the null probability is clamped at 0 and the others
-/// renormalised; the tracking weights then carry the sign (THEORY 1, 4.3).
+/// majorant `mu_bar` > 0. One pdf serves all channels, driven by the channel means. They are
+/// |mu_x| / (mu_a + mu_s + |mu_n|): mu_x / mu_bar where the majorant bounds the extinction, and
+/// where it does not (mu_n < 0, bound::Signed) still in [0, 1] with a null probability that is
+/// not 0, so the tracking weights mu_x / (mu_bar P_x) carry the sign and the estimate stays
+/// unbiased (THEORY 1, 4.3). Clamping P_n at 0 there would drop the negative null term.
 template <AbsorptionPolicy A, SpectralMode S>
 EventProbabilities event_probabilities(const Coefficients<S>& c, float mu_bar) noexcept {
     const float a = std::max(0.f, sampling_scalar(c.sigma_a));
     const float s = std::max(0.f, sampling_scalar(c.sigma_s));
-    const float n = std::max(0.f, mu_bar - a - s);
+    const float n = std::abs(mu_bar - a - s);
     const float inv = 1.f / (a + s + n);  // > 0 because mu_bar > 0
     if constexpr (A::as_event) return {a * inv, s * inv, n * inv};
     else return {0.f, (a + s) * inv, n * inv};
@@ -94,7 +96,8 @@ struct SegmentRecord {
 template <class V = float>
 struct FlightEnd {
     bool stopped = false;   ///< the callback stopped at `t`; otherwise the ray passed tmax
-    bool aborted = false;   ///< gave up after `max_collisions` tentative collisions
+    bool aborted = false;   ///< gave up after `max_collisions` tentative collisions, or rejected
+    bool rejected = false;  ///< bound::Reject found mu_t > mu_bar at `t` (then `aborted` is set too)
     float t = 0.f;          ///< the stopping distance
     V tau_tail{};           ///< majorant optical depth from the last collision to tmax if passed
 };
@@ -112,11 +115,45 @@ concept CollisionCallback = requires(F& f, float t, const Coefficients<S>& c, co
     { f(t, c, v, v) } -> std::same_as<bool>;
 };
 
+namespace detail {
+/// bound::Clamp: scales a lookup's coefficients, albedo kept, so that mu_t <= mu_bar in every
+/// channel (mu_bar grey or per channel).
+template <SpectralMode S, class V>
+void clamp_to_majorant(Coefficients<S>& k, const V& mu) noexcept {
+    using Spec = typename S::Spectrum;
+    const Spec t = k.sigma_t();
+    const Spec m = broadcast_majorant<Spec>(mu);
+    const Spec f = (t > m).select(m / t, Spec::Ones());
+    k.sigma_a *= f;
+    k.sigma_s *= f;
+}
+
+/// bound::Reject: true when mu_t exceeds mu_bar by more than rounding in some channel.
+template <SpectralMode S, class V>
+bool exceeds_majorant(const Coefficients<S>& k, const V& mu) noexcept {
+    using Spec = typename S::Spectrum;
+    return (k.sigma_t() > broadcast_majorant<Spec>(mu) * (1.f + kBoundSlack)).any();
+}
+
+/// Reports the DDA steps a majorant iterator took to a counter that records them.
+template <class It, class C>
+struct StepReport {
+    const It& it;
+    C& counter;
+    ~StepReport() {
+        if constexpr (requires(C& c, const It& i) { c.majorant_steps(i.steps()); }) counter.majorant_steps(it.steps());
+    }
+};
+}  // namespace detail
+
 /// Samples tentative collisions with density mu_bar(t) Tbar(tmin, t) along `ray` over
 /// [tmin, tmax], segment by segment, and calls `on_collision` at each (THEORY 4.1). With a
 /// per-channel majorant, `channel` is the sampling channel c*: distances are drawn with its
 /// majorant and every channel's optical depth is accumulated over the same stretches (THEORY
-/// 5.3). Counts one density lookup per tentative collision. Never throws.
+/// 5.3). The majorant's bound policy acts on each lookup before the callback sees it
+/// (bound::Clamp clamps it, bound::Reject ends the flight with `rejected`). Counts one density
+/// lookup per tentative collision, and the DDA steps of a grid majorant if the counter records
+/// them. Never throws.
 template <Medium M, MajorantPolicy<M> Maj, UniformRng R, LookupCounter C, class F>
     requires CollisionCallback<F, typename M::Spectral, MajorantValue<Maj, M>>
 FlightEnd<MajorantValue<Maj, M>> free_flight(const M& medium, const Maj& majorant, const Ray& ray, float tmin,
@@ -125,8 +162,10 @@ FlightEnd<MajorantValue<Maj, M>> free_flight(const M& medium, const Maj& majoran
                                              std::uint32_t max_collisions = kDefaultMaxCollisions,
                                              int channel = 0) {
     using V = MajorantValue<Maj, M>;
+    using B = bound_policy_t<Maj>;
     constexpr bool grey = std::is_same_v<V, float>;
     auto segments = majorant.iterate(ray, tmin, tmax, lambda);
+    const detail::StepReport<decltype(segments), C> report{segments, counter};
     V tau{};                    // majorant optical depth since the last tentative collision
     if constexpr (!grey) tau.setZero();
     // Adds the optical depth of a stretch of `len` on a segment (per channel: 0 * inf stays 0).
@@ -155,16 +194,24 @@ FlightEnd<MajorantValue<Maj, M>> free_flight(const M& medium, const Maj& majoran
             t += dt;
             if constexpr (grey) tau += e;
             else add_depth(seg->sigma_maj, dt);
-            if (++collisions > max_collisions) return {false, true, t, V{}};
+            if (++collisions > max_collisions) return {false, true, false, t, V{}};
             counter.lookup();
-            const auto coeff = medium.coefficients(ray.at(t), lambda);
+            auto coeff = medium.coefficients(ray.at(t), lambda);
+            if constexpr (std::is_same_v<B, bound::Clamp>) {
+                detail::clamp_to_majorant(coeff, seg->sigma_maj);
+            } else if constexpr (std::is_same_v<B, bound::Reject>) {
+                if (detail::exceeds_majorant(coeff, seg->sigma_maj)) {
+                    NSP_DEBUG_ASSERT(false, "bound::Reject: the extinction exceeds the majorant");
+                    return {false, true, true, t, V{}};
+                }
+            }
             const V tau_step = tau;
             if constexpr (grey) tau = 0.f;
             else tau.setZero();
-            if (!on_collision(t, coeff, seg->sigma_maj, tau_step)) return {true, false, t, V{}};
+            if (!on_collision(t, coeff, seg->sigma_maj, tau_step)) return {true, false, false, t, V{}};
         }
     }
-    return {false, false, tmax, tau};
+    return {false, false, false, tmax, tau};
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -177,7 +224,14 @@ enum class SegmentEnd : std::uint8_t {
     Absorbed,    ///< an absorption event at t (only with absorption::Event)
     Terminated,  ///< ratio tracking: every channel's weight fell below the smallest normal float (set to 0)
     Aborted,     ///< the collision limit was reached; the estimate is discarded (weight 0)
+    Rejected,    ///< bound::Reject met mu_t > mu_bar; the estimate is discarded (weight 0)
 };
+
+/// How an aborted flight ends a segment: Rejected (bound::Reject) or Aborted (collision limit).
+template <class V>
+SegmentEnd aborted_end(const FlightEnd<V>& f) noexcept {
+    return f.rejected ? SegmentEnd::Rejected : SegmentEnd::Aborted;
+}
 
 /// The outcome of delta tracking one segment.
 template <SpectralMode S>
@@ -224,7 +278,7 @@ struct DeltaCollision {
 /// The outcome of ratio tracking one segment.
 template <SpectralMode S>
 struct RatioTrack {
-    SegmentEnd end = SegmentEnd::Passed;  ///< Passed, Terminated (weight 0) or Aborted
+    SegmentEnd end = SegmentEnd::Passed;  ///< Passed, Terminated (weight 0), Aborted or Rejected
     typename S::Spectrum transmittance;   ///< prod_j mu_n,c(n_j) / mu_bar(n_j): unbiased estimate of T
     float null_pdf_product = 1.f;         ///< prod_j P_n(n_j) of delta tracking with policy A, if asked for
 };
@@ -263,7 +317,7 @@ DeltaTrack<typename M::Spectral> track_delta(const M& medium, const Maj& majoran
     using S = typename M::Spectral;
     DeltaCollision<A, S, R, std::remove_reference_t<Rec>> cb{rng, rec};
     const auto f = free_flight(medium, majorant, ray, 0.f, tmax, lambda, rng, counter, cb);
-    if (f.aborted) return {SegmentEnd::Aborted, f.t, S::Spectrum::Zero(), 1.f};
+    if (f.aborted) return {aborted_end(f), f.t, S::Spectrum::Zero(), 1.f};
     if (!f.stopped) {
         cb.out.end = SegmentEnd::Passed;
         cb.out.t = tmax;
@@ -282,7 +336,7 @@ RatioTrack<typename M::Spectral> track_ratio(const M& medium, const Maj& majoran
     using S = typename M::Spectral;
     RatioCollision<A, kNullRatio, S, std::remove_reference_t<Rec>> cb{rec};
     const auto f = free_flight(medium, majorant, ray, 0.f, tmax, lambda, rng, counter, cb);
-    if (f.aborted) return {SegmentEnd::Aborted, S::Spectrum::Zero(), 1.f};
+    if (f.aborted) return {aborted_end(f), S::Spectrum::Zero(), 1.f};
     if constexpr (std::remove_reference_t<Rec>::enabled)
         if (!f.stopped) rec.log_pdf -= f.tau_tail;
     return cb.out;

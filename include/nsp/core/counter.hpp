@@ -23,11 +23,14 @@ struct NoLookupCount {
     std::uint64_t count() const noexcept { return 0; }
 };
 
-/// Counts lookups in a plain integer (one per thread; sum them afterwards).
+/// Counts lookups in a plain integer (one per thread; sum them afterwards), and the DDA steps of
+/// grid majorants (free_flight reports them to any counter with `majorant_steps`).
 struct LookupCount {
     static constexpr bool enabled = true;
     std::uint64_t n = 0;
+    std::uint64_t steps = 0;  ///< grid-majorant cells crossed (DDA steps), skipped empty ones included
     void lookup() noexcept { ++n; }
+    void majorant_steps(std::uint64_t k) noexcept { steps += k; }
     std::uint64_t count() const noexcept { return n; }
 };
 

@@ -10,6 +10,15 @@
 #include <stdexcept>
 #include <string>
 
+/// Debug mode: NSP_DEBUG_ASSERT checks an invariant inside a kernel when NSP_DEBUG is defined or
+/// NDEBUG is not (a debug build), and compiles to nothing otherwise.
+#if defined(NSP_DEBUG) || !defined(NDEBUG)
+#include <cassert>
+#define NSP_DEBUG_ASSERT(cond, msg) assert((cond) && (msg))
+#else
+#define NSP_DEBUG_ASSERT(cond, msg) ((void)0)
+#endif
+
 namespace nsp {
 
 /// Thrown by constructors and loaders when an argument is outside what nsp allows.

@@ -7,6 +7,7 @@
 
 #include "../core/error.hpp"
 #include "../spectrum.hpp"
+#include "../tracking.hpp"
 
 namespace nsp {
 
@@ -56,7 +57,13 @@ enum class Status : std::uint8_t {
     Ok,         ///< a finite estimate
     Aborted,    ///< a flight hit the collision limit; that flight contributed 0 (rare, biased)
     NonFinite,  ///< the estimate was NaN or Inf and has been replaced by 0
+    Rejected,   ///< bound::Reject met mu_t > mu_bar on a flight; that flight contributed 0 (biased)
 };
+
+/// The status of a path one of whose flights ended with `end` (Ok unless Aborted or Rejected).
+inline Status flight_status(SegmentEnd end) noexcept {
+    return end == SegmentEnd::Aborted ? Status::Aborted : end == SegmentEnd::Rejected ? Status::Rejected : Status::Ok;
+}
 
 /// A radiance estimate and its status.
 template <SpectralMode S>

@@ -94,8 +94,8 @@ public:
         for (int depth = 0;;) {
             const LightHit hit = scene.lights.intersect(ray);
             const auto seg = track_delta<A>(scene.medium, scene.majorant, ray, hit.t, lambda, rng, counter);
-            if (seg.end == SegmentEnd::Aborted) {
-                status = Status::Aborted;
+            if (const Status fs = flight_status(seg.end); fs != Status::Ok) {
+                status = fs;
                 break;
             }
             beta *= seg.weight;
@@ -121,7 +121,8 @@ public:
             if (opts_.russian_roulette && depth >= opts_.rr_start_depth)
                 q = std::min(opts_.rr_max_survival, beta.abs().maxCoeff());
             if constexpr (St::samples_lights) {
-                if (next_event(scene, x, ray.d, q, lambda, rng, counter, beta, L)) status = Status::Aborted;
+                const Status ns = next_event(scene, x, ray.d, q, lambda, rng, counter, beta, L);
+                if (ns != Status::Ok) status = ns;
             }
             if (q < 1.f) {
                 if (!(rng.uniform() < q)) break;
@@ -145,18 +146,18 @@ private:
     /// Adds NEE's weighted contribution at real vertex x (arrived along wo) to L; returns true if
     /// its shadow flight was aborted.
     template <class Sc, UniformRng R, LookupCounter C>
-    bool next_event(const Sc& scene, const Vec3& x, const Vec3& wo, float survival,
+    Status next_event(const Sc& scene, const Vec3& x, const Vec3& wo, float survival,
                     const typename Sc::Spectral::Wavelengths& lambda, R& rng, C& counter,
                     const typename Sc::Spectrum& beta, typename Sc::Spectrum& L) const {
         const float u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
         const LightSample<typename Sc::Spectral> ls = scene.lights.sample(x, u0, u1, u2, lambda);
-        if (!(ls.pdf > 0.f)) return false;
+        if (!(ls.pdf > 0.f)) return Status::Ok;
         const Ray shadow{x, ls.wi};
-        if (ls.occludable_by_sphere && scene.lights.sphere_blocks(shadow, ls.distance)) return false;
+        if (ls.occludable_by_sphere && scene.lights.sphere_blocks(shadow, ls.distance)) return Status::Ok;
         const auto tr = track_ratio<A, St::null_pdfs>(scene.medium, scene.majorant, shadow,
                                                       ls.distance, lambda, rng, counter);
-        if (tr.end == SegmentEnd::Aborted) return true;
-        if (tr.end == SegmentEnd::Terminated) return false;
+        if (tr.end == SegmentEnd::Aborted || tr.end == SegmentEnd::Rejected) return flight_status(tr.end);
+        if (tr.end == SegmentEnd::Terminated) return Status::Ok;
         float w = 1.f;
         if constexpr (St::combines) {
             if (!ls.delta)  // a point light cannot be hit: NEE keeps weight 1
@@ -164,7 +165,7 @@ private:
                                           tr.null_pdf_product, ls.pdf);
         }
         L += beta * tr.transmittance * ls.radiance * (w * scene.phase.eval(wo, ls.wi) / ls.pdf);
-        return false;
+        return Status::Ok;
     }
 
     EstimatorOptions opts_;

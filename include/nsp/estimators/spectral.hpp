@@ -87,8 +87,8 @@ public:
             const bool nee_alternative = St::combines && !from_camera;
             const ChannelTrack seg = track_channels_delta<CP, A>(scene.medium, scene.majorant, ray, hit.t, lambda, c,
                                                                  st, nee_alternative, rng, counter);
-            if (seg.end == SegmentEnd::Aborted) {
-                status = Status::Aborted;
+            if (const Status fs = flight_status(seg.end); fs != Status::Ok) {
+                status = fs;
                 break;
             }
             if (seg.end == SegmentEnd::Passed) {
@@ -110,7 +110,8 @@ public:
             if (opts_.russian_roulette && depth >= opts_.rr_start_depth)
                 rr = std::min(opts_.rr_max_survival, channel_estimate<CP>(st.f, st.uni, q, c).abs().maxCoeff());
             if constexpr (St::samples_lights) {
-                if (next_event(scene, x, ray.d, rr, lambda, q, c, st, rng, counter, L)) status = Status::Aborted;
+                const Status ns = next_event(scene, x, ray.d, rr, lambda, q, c, st, rng, counter, L);
+                if (ns != Status::Ok) status = ns;
             }
             if (rr < 1.f && !(rng.uniform() < rr)) break;
             const float u1 = rng.uniform(), u2 = rng.uniform();
@@ -131,28 +132,28 @@ public:
 
 private:
     /// Adds NEE's contribution at real vertex x (arrived along wo, roulette survival rr) to L;
-    /// returns true if its shadow flight was aborted.
+    /// returns Aborted or Rejected if its shadow flight was, else Ok.
     template <class Sc, UniformRng R, LookupCounter C>
-    bool next_event(const Sc& scene, const Vec3& x, const Vec3& wo, float rr,
+    Status next_event(const Sc& scene, const Vec3& x, const Vec3& wo, float rr,
                     const typename Sc::Spectral::Wavelengths& lambda, const typename Sc::Spectrum& q, int c,
                     const ChannelPathState<typename Sc::Spectral>& st, R& rng, C& counter,
                     typename Sc::Spectrum& L) const {
         const float u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
         const LightSample<typename Sc::Spectral> ls = scene.lights.sample(x, u0, u1, u2, lambda);
-        if (!(ls.pdf > 0.f)) return false;
+        if (!(ls.pdf > 0.f)) return Status::Ok;
         const Ray shadow{x, ls.wi};
-        if (ls.occludable_by_sphere && scene.lights.sphere_blocks(shadow, ls.distance)) return false;
+        if (ls.occludable_by_sphere && scene.lights.sphere_blocks(shadow, ls.distance)) return Status::Ok;
         const bool uni_alternative = St::combines && !ls.delta;  // a point light cannot be hit
         const auto sh = track_channels_ratio<CP, A>(scene.medium, scene.majorant, shadow, ls.distance, lambda, c,
                                                     st.f, uni_alternative, rng, counter);
-        if (sh.end == SegmentEnd::Aborted) return true;
-        if (sh.end == SegmentEnd::Terminated) return false;
+        if (sh.end == SegmentEnd::Aborted || sh.end == SegmentEnd::Rejected) return flight_status(sh.end);
+        if (sh.end == SegmentEnd::Terminated) return Status::Ok;
         using Spectrum = typename Sc::Spectrum;
         Spectrum pdf = ls.pdf * sh.nee;
         if (uni_alternative) pdf += (rr * scene.phase.pdf(wo, ls.wi)) * sh.uni;
         const Spectrum f = st.f * sh.f * scene.phase.eval(wo, ls.wi);
         L += channel_estimate<CP, Spectrum>(f, st.uni * pdf, q, c) * ls.radiance;
-        return false;
+        return Status::Ok;
     }
 
     EstimatorOptions opts_;

@@ -6,6 +6,9 @@
 // transmittance estimators against it; it is heterogeneous, so majorants are loose somewhere.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
+
 #include "../medium.hpp"
 #include "validate.hpp"
 
@@ -69,6 +72,28 @@ public:
 
     /// The per-channel extinction bound as a coefficient (what ChannelMajorant stores).
     Coefficient extinction_bound_coefficient() const { return scale<Coefficient>(sigma_a_ + sigma_s_, max_density_); }
+
+    /// mu_t,c(p) = density(p) times this (what grid majorants scale their cells by).
+    Coefficient extinction_per_density() const { return sigma_a_ + sigma_s_; }
+
+    /// The largest density at any p in `region` (0 if it misses the box): the exponential is
+    /// monotone along the axis, so the largest corner value of the region clipped to the box,
+    /// with the region widened by 1e-5 of the box and the result padded by 1e-5 for rounding.
+    float density_bound(const Box& region) const noexcept {
+        Box r;
+        for (int a = 0; a < 3; ++a) {
+            const float pad = 1e-5f * (bounds_.hi[a] - bounds_.lo[a]);
+            r.lo[a] = std::max(region.lo[a], bounds_.lo[a]) - pad;
+            r.hi[a] = std::min(region.hi[a], bounds_.hi[a]) + pad;
+            if (r.lo[a] > r.hi[a]) return 0.f;
+        }
+        float m = 0.f;
+        for (int c = 0; c < 8; ++c) {
+            const Vec3 corner((c & 1) ? r.hi.x : r.lo.x, (c & 2) ? r.hi.y : r.lo.y, (c & 4) ? r.hi.z : r.lo.z);
+            m = std::max(m, d0_ * std::exp(k_ * glm::dot(corner - bounds_.lo, axis_)));
+        }
+        return m * (1.f + 1e-5f);
+    }
 
     /// The exact optical depth int mu_t dt over [t0, t1] of `ray` clipped to the box at
     /// wavelengths l, in double.

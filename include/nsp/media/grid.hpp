@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <utility>
 #include <vector>
@@ -101,6 +102,31 @@ public:
 
     /// The per-channel extinction bound as a coefficient (what ChannelMajorant stores).
     Coefficient extinction_bound_coefficient() const { return scale<Coefficient>(sigma_a_ + sigma_s_, max_density_); }
+
+    /// mu_t,c(p) = density(p) times this (what grid majorants scale their cells by).
+    Coefficient extinction_per_density() const { return sigma_a_ + sigma_s_; }
+
+    /// The largest density a lookup can return at any p in `region` (0 if it misses the box): the
+    /// largest voxel among those the trilinear lookups there read. The region is widened by 1/1000
+    /// of a voxel so that a point that rounds just outside it is still covered.
+    float density_bound(const Box& region) const noexcept {
+        int lo[3], hi[3];
+        for (int a = 0; a < 3; ++a) {
+            const float r0 = std::max(region.lo[a], bounds_.lo[a]), r1 = std::min(region.hi[a], bounds_.hi[a]);
+            if (r0 > r1) return 0.f;
+            const float x0 = (r0 - bounds_.lo[a]) * inv_extent_[a] * float(res_[a]) - 0.5f - 1e-3f;
+            const float x1 = (r1 - bounds_.lo[a]) * inv_extent_[a] * float(res_[a]) - 0.5f + 1e-3f;
+            lo[a] = std::clamp(int(std::floor(x0)), 0, res_[a] - 1);
+            hi[a] = std::clamp(int(std::floor(x1)) + 1, 0, res_[a] - 1);
+        }
+        float m = 0.f;
+        for (int z = lo[2]; z <= hi[2]; ++z)
+            for (int y = lo[1]; y <= hi[1]; ++y) {
+                const float* row = &density_[std::size_t(res_[0]) * (std::size_t(y) + std::size_t(res_[1]) * std::size_t(z))];
+                for (int x = lo[0]; x <= hi[0]; ++x) m = std::max(m, row[x]);
+            }
+        return m;
+    }
 
 private:
     Box bounds_;
