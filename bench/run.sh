@@ -2,8 +2,9 @@
 # Builds nsp_bench (Release) and runs, in one command:
 #   1. every benchmark, with repetitions in random interleaved order (medians, lookup-rate
 #      ratios, spectral estimators, the cost of each spectral mode on the grey cloud);
-#   2. the before/after Mono check in time: every Mono benchmark, run by this binary and by the
-#      binary of commit $NSP_BENCH_BEFORE (built once from a temporary git worktree, which is
+#   2. the before/after Mono check in time: every Mono benchmark under the global majorant (raw
+#      lookups, trackers, grey path estimators), run by this binary and by the binary of commit
+#      $NSP_BENCH_BEFORE (built once from a temporary git worktree, which is
 #      removed again) back to back, in several rounds (median of the paired ratios);
 #   3. the same check in work: bench/work_count.cpp built against both versions of include/,
 #      instructions per kernel under valgrind's callgrind (noise-free), lookups and checksums;
@@ -13,8 +14,10 @@
 # Release build with benchmarks); else ./build-bench, configured here. Environment:
 #   NSP_BENCH_REPS        repetitions of every benchmark in step 1 (default 5)
 #   NSP_BENCH_JOBS        build parallelism (default: nproc)
-#   NSP_BENCH_BEFORE      the "before" commit of step 2 (default d0f6439, the commit before the
-#                         chromatic work); empty skips step 2
+#   NSP_BENCH_BEFORE      the "before" commit of steps 2 and 3 (default 08dc9b7, the commit before
+#                         the majorant axis: |mu_n| event probabilities, bound-policy branches and
+#                         the DDA-step report in free_flight; d0f6439 was the commit before the
+#                         chromatic work); empty skips steps 2 and 3
 #   NSP_BENCH_BEFORE_BUILD where to build it (default <build>-before; kept, keyed by commit)
 #   NSP_BENCH_AB_ROUNDS   rounds of step 2 (default 6): pairs per benchmark
 #   CXX                   compiler of step 3 (default c++)
@@ -67,7 +70,7 @@ json=$build/bench/results.json
     --benchmark_out="$json" --benchmark_out_format=json "$@"
 
 # Steps 2 and 3: the before/after Mono check, against the binary of commit $NSP_BENCH_BEFORE.
-before=${NSP_BENCH_BEFORE-d0f6439}
+before=${NSP_BENCH_BEFORE-08dc9b7}
 ab=
 if [ -n "$before" ]; then
     if ! want=$(git rev-parse --verify --quiet "$before^{commit}"); then
@@ -99,12 +102,12 @@ if [ -n "$before" ]; then
         rm -rf "$ab"
         mkdir -p "$ab"
 
-        # Step 2: time. Every Mono benchmark the old binary has (raw lookups, trackers, path
-        # estimators), one repetition at a time in pairs: old and new binary back to back on the
+        # Step 2: time. Every Mono benchmark under the global majorant (raw lookups, trackers, path
+        # estimators; not the grid-majorant trackers, which the old binary lacks), one repetition at a time in pairs: old and new binary back to back on the
         # same benchmark (which goes first alternates), benchmarks in a new random order each
         # round. A pair is measured within about a second, so a change in the machine's load
         # between the two sides is rare; report.py takes the median of the pair ratios.
-        filter='^(BM_RawLookup(Chained)?<Mono.*|BM_Track<[A-Za-z]+, Mono.*|BM_Radiance/.*/mono/.*)$'
+        filter='^(BM_RawLookup(Chained)?<Mono.*|BM_Track<[A-Za-z]+, Mono(, (Cloud|Trivial)(, [A-Za-z]+)?)?>(/.*)?|BM_Radiance/.*/mono/.*)$'
         mapfile -t names < <("$build/bench/nsp_bench" --benchmark_list_tests --benchmark_filter="$filter")
         rounds=${NSP_BENCH_AB_ROUNDS:-6}
         for r in $(seq 1 "$rounds"); do
