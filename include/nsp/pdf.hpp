@@ -7,6 +7,8 @@
 #pragma once
 
 #include <cmath>
+#include <optional>
+#include <type_traits>
 #include <span>
 
 #include "majorant.hpp"
@@ -40,6 +42,28 @@ float majorant_at(const Maj& majorant, const Ray& ray, float t,
     return 0.f;
 }
 
+/// The majorant value (grey, or every channel's) of the segment covering distance t along
+/// `ray`, or std::nullopt where no segment covers t.
+template <Medium M, MajorantPolicy<M> Maj>
+std::optional<MajorantValue<Maj, M>> majorant_value_at(const Maj& majorant, const Ray& ray, float t,
+                                                       const typename M::Spectral::Wavelengths& lambda) {
+    auto it = majorant.iterate(ray, 0.f, kInf, lambda);
+    while (auto seg = it.next())
+        if (seg->t0 <= t && t < seg->t1) return seg->sigma_maj;
+    return std::nullopt;
+}
+
+/// The coefficients tracking sees at distance t along `ray`: the medium's, clamped to the
+/// majorant under bound::Clamp (free_flight does the same), so pdfs of clamped flights agree.
+template <Medium M, MajorantPolicy<M> Maj>
+Coefficients<typename M::Spectral> tracked_coefficients(const M& medium, const Maj& majorant, const Ray& ray,
+                                                        float t, const typename M::Spectral::Wavelengths& lambda) {
+    auto k = medium.coefficients(ray.at(t), lambda);
+    if constexpr (std::is_same_v<bound_policy_t<Maj>, bound::Clamp>)
+        if (const auto mu = majorant_value_at<M>(majorant, ray, t, lambda)) detail::clamp_to_majorant(k, *mu);
+    return k;
+}
+
 /// log pdf that delta tracking (policy A) from `ray.o` creates null vertices at `nulls`
 /// (increasing) and then either passes tmax (`end` = Passed) or has event `end` at `t_end`:
 /// prod_j mu_bar(n_j) Tbar(n_j-1, n_j) P_n(n_j) * [mu_bar(y) Tbar(n_m, y) P_end(y) or Tbar(n_m, tmax)].
@@ -51,13 +75,13 @@ double delta_segment_log_pdf(const M& medium, const Maj& majorant, const Ray& ra
     float prev = 0.f;
     for (const float t : nulls) {
         const float mu = majorant_at<M>(majorant, ray, t, lambda);
-        const auto p = event_probabilities<A>(medium.coefficients(ray.at(t), lambda), mu);
+        const auto p = event_probabilities<A>(tracked_coefficients(medium, majorant, ray, t, lambda), mu);
         lp += std::log(double(mu) * p.null) - majorant_optical_depth<M>(majorant, ray, prev, t, lambda);
         prev = t;
     }
     if (end == SegmentEnd::Passed) return lp - majorant_optical_depth<M>(majorant, ray, prev, tmax, lambda);
     const float mu = majorant_at<M>(majorant, ray, t_end, lambda);
-    const auto p = event_probabilities<A>(medium.coefficients(ray.at(t_end), lambda), mu);
+    const auto p = event_probabilities<A>(tracked_coefficients(medium, majorant, ray, t_end, lambda), mu);
     const float p_end = end == SegmentEnd::Absorbed ? p.absorb : p.scatter;
     return lp + std::log(double(mu) * p_end) - majorant_optical_depth<M>(majorant, ray, prev, t_end, lambda);
 }
@@ -107,7 +131,7 @@ double channel_delta_segment_log_pdf(const M& medium, const Maj& majorant, const
     float prev = 0.f;
     auto vertex = [&](float t, SegmentEnd e) {
         const double mu = majorant_at<M>(majorant, ray, t, lambda, c);
-        const double p = mu > 0.0 ? channel_event_probability<A>(medium.coefficients(ray.at(t), lambda), mu, c, e) : 0.0;
+        const double p = mu > 0.0 ? channel_event_probability<A>(tracked_coefficients(medium, majorant, ray, t, lambda), mu, c, e) : 0.0;
         lp += std::log(mu * p) - majorant_optical_depth<M>(majorant, ray, prev, t, lambda, c);
         prev = t;
     };

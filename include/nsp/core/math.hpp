@@ -44,7 +44,7 @@ struct Box {
     }
 
     /// The part of [tmin, tmax] inside the box (empty interval on a miss). Axis-parallel rays
-    /// are handled without 0 * inf.
+    /// and denormal direction components are handled without 0 * inf.
     Interval clip(const Ray& r, float tmin, float tmax) const noexcept {
         float t0 = tmin, t1 = tmax;
         for (int a = 0; a < 3; ++a) {
@@ -52,8 +52,9 @@ struct Box {
                 if (r.o[a] < lo[a] || r.o[a] > hi[a]) return {0.f, 0.f};
                 continue;
             }
-            const float inv = 1.f / r.d[a];
-            float tn = (lo[a] - r.o[a]) * inv, tf = (hi[a] - r.o[a]) * inv;
+            // Divide, not multiply by 1 / d: for a denormal d, 1 / d is inf and an origin on
+            // the face would give 0 * inf = NaN (found by the grid-majorant DDA tests).
+            float tn = (lo[a] - r.o[a]) / r.d[a], tf = (hi[a] - r.o[a]) / r.d[a];
             if (tn > tf) std::swap(tn, tf);
             t0 = std::max(t0, tn);
             t1 = std::min(t1, tf);

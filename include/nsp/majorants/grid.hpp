@@ -69,7 +69,9 @@ public:
                 while (i < res[a] - 1 && plane_t(a, i + 1) > t_) ++i;
                 while (i > 0 && plane_t(a, i) <= t_) --i;
                 next_[a] = plane_t(a, i);
-            } else {
+            } else {  // parallel: the cell holding o[a]; a ray on a face takes the higher cell
+                while (i < res[a] - 1 && r.o[a] >= plane(a, i + 1)) ++i;
+                while (i > 0 && r.o[a] < plane(a, i)) --i;
                 next_[a] = std::numeric_limits<float>::infinity();
             }
             cell_[a] = i;
@@ -99,8 +101,10 @@ public:
     std::uint32_t steps() const noexcept { return steps_; }
 
 private:
+    /// Plane k of axis a, lo + k h: the grid's cell faces.
+    float plane(int a, int k) const noexcept { return lo_[a] + float(k) * h_[a]; }
     /// Where the ray crosses plane k of axis a (d[a] != 0).
-    float plane_t(int a, int k) const noexcept { return (lo_[a] + float(k) * h_[a] - o_[a]) / d_[a]; }
+    float plane_t(int a, int k) const noexcept { return (plane(a, k) - o_[a]) / d_[a]; }
 
     float lo_[3]{}, h_[3]{}, o_[3]{}, d_[3]{}, next_[3]{};
     int res_[3]{}, cell_[3]{}, step_[3]{};
@@ -149,6 +153,7 @@ public:
     }
 
     float operator[](std::size_t i) const noexcept { return values_[i]; }
+    const float* data() const noexcept { return values_.data(); }
     std::array<int, 3> resolution() const noexcept { return res_; }
     std::size_t memory_bytes() const noexcept { return values_.size() * sizeof(float); }
     Box box() const noexcept { return box_; }
@@ -210,7 +215,7 @@ public:
 
     detail::GridSegmentIterator<float> iterate(const Ray& r, float tmin, float tmax,
                                                const typename M::Spectral::Wavelengths&) const noexcept {
-        return {&grid_[0], grid_.walk(r, tmin, tmax), unit_};
+        return {grid_.data(), grid_.walk(r, tmin, tmax), unit_};
     }
 
     /// The majorant of cell (x, y, z).
@@ -254,9 +259,15 @@ public:
 
     detail::GridSegmentIterator<Spectrum> iterate(const Ray& r, float tmin, float tmax,
                                                   const typename Spectral::Wavelengths& l) const noexcept {
-        return {&grid_[0], grid_.walk(r, tmin, tmax), Spectral::sample(unit_, l)};
+        return {grid_.data(), grid_.walk(r, tmin, tmax), Spectral::sample(unit_, l)};
     }
 
+    /// Every channel's majorant in cell (x, y, z) at wavelengths l.
+    Spectrum cell(int x, int y, int z, const typename Spectral::Wavelengths& l) const noexcept {
+        const auto r = grid_.resolution();
+        return Spectral::sample(unit_, l) *
+               grid_[std::size_t(x) + std::size_t(r[0]) * (std::size_t(y) + std::size_t(r[1]) * std::size_t(z))];
+    }
     std::array<int, 3> resolution() const noexcept { return grid_.resolution(); }
     Vec3 cell_size() const noexcept { return grid_.cell_size(); }
     /// Bytes of cell storage (one float per cell; the channels share it).

@@ -1,0 +1,88 @@
+// tests/support/majorants.hpp: the majorant axis of the generic suites. Each kind is a factory
+// for a medium M: the tight global majorant, grid majorants at a resolution that does not align
+// with any test grid's voxels, and non-bounding (scale 0.5) grid majorants under bound::Signed
+// (unbiased) and bound::Clamp (exact for the clamped medium).
+#pragma once
+
+#include <array>
+#include <string>
+#include <tuple>
+#include <type_traits>
+
+#include "common.hpp"
+
+namespace nsp_test {
+
+/// The grid resolution the suites use: coarse, non-cubic and not aligned with the 5 x 4 x 6
+/// voxels of MediumKind<DenseGridMedium>, so cells straddle voxels.
+inline constexpr std::array<int, 3> kTestGridRes{3, 4, 2};
+
+struct GlobalKind {
+    static constexpr const char* name = "global";
+    template <class M> using type = GlobalMajorant<M>;
+    template <class M> static type<M> make(const M& m) { return type<M>(m); }
+};
+struct ChannelKind {
+    static constexpr const char* name = "per-channel";
+    template <class M> using type = ChannelMajorant<M>;
+    template <class M> static type<M> make(const M& m) { return type<M>(m); }
+};
+struct GridKind {
+    static constexpr const char* name = "grid";
+    template <class M> using type = GridMajorant<M>;
+    template <class M> static type<M> make(const M& m) { return type<M>(m, kTestGridRes); }
+};
+struct ChannelGridKind {
+    static constexpr const char* name = "channel-grid";
+    template <class M> using type = ChannelGridMajorant<M>;
+    template <class M> static type<M> make(const M& m) { return type<M>(m, kTestGridRes); }
+};
+/// Half the grid bound, signed weights (policy a): unbiased.
+struct SignedGridKind {
+    static constexpr const char* name = "grid-signed-0.5";
+    template <class M> using type = GridMajorant<M, bound::Signed>;
+    template <class M> static type<M> make(const M& m) { return type<M>(m, kTestGridRes, 0.5f); }
+};
+struct SignedChannelGridKind {
+    static constexpr const char* name = "channel-grid-signed-0.5";
+    template <class M> using type = ChannelGridMajorant<M, bound::Signed>;
+    template <class M> static type<M> make(const M& m) { return type<M>(m, kTestGridRes, 0.5f); }
+};
+/// Half the grid bound, density clamped to it (policy b): biased towards the clamped medium.
+struct ClampGridKind {
+    static constexpr const char* name = "grid-clamp-0.5";
+    template <class M> using type = GridMajorant<M, bound::Clamp>;
+    template <class M> static type<M> make(const M& m) { return type<M>(m, kTestGridRes, 0.5f); }
+};
+
+/// True when majorant kind K can be built for medium M (grid kinds need a RegionBoundedMedium).
+template <class K, class M>
+inline constexpr bool kind_applies_v = requires(const M& m) { K::make(m); };
+
+namespace detail {
+template <class M, class K, class F>
+void call_if_applies(F& f, K k) {
+    if constexpr (kind_applies_v<K, M>) f(k);
+}
+}  // namespace detail
+
+/// Calls f(K{}) for every kind K in the tuple type Kinds that applies to medium M.
+template <class Kinds, class M, class F>
+void for_each_kind(F&& f) {
+    std::apply([&](auto... k) { (detail::call_if_applies<M>(f, k), ...); }, Kinds{});
+}
+
+/// The grey majorant kinds whose estimates are unbiased for the medium itself.
+using UnbiasedGreyKinds = std::tuple<GlobalKind, GridKind, SignedGridKind>;
+
+/// True when channel c's majorant is positive somewhere on [0, tmax] of `ray`.
+template <Medium M, class Maj>
+bool channel_has_majorant(const Maj& maj, const Ray& ray, float tmax, const typename M::Spectral::Wavelengths& l,
+                          int c) {
+    auto it = maj.iterate(ray, 0.f, tmax, l);
+    while (auto seg = it.next())
+        if (channel_of(seg->sigma_maj, c) > 0.f) return true;
+    return false;
+}
+
+}  // namespace nsp_test
