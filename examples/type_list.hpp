@@ -34,21 +34,13 @@ struct at_impl<list<Ts...>, I> {
 template <class L, std::size_t I>
 using at = typename at_impl<L, I>::type;
 
-/// The concatenation of lists Ls.
+/// The concatenation of lists Ls. A fold over `+` rather than a recursion over Ls: a product of
+/// the policy lists has about a thousand points, and filter concatenates one list per point,
+/// which a pairwise recursion would nest beyond the compiler's template depth.
+template <class... As, class... Bs>
+list<As..., Bs...> operator+(list<As...>, list<Bs...>);  // declared only: used in decltype
 template <class... Ls>
-struct concat_impl {
-    using type = list<>;
-};
-template <class... Ts>
-struct concat_impl<list<Ts...>> {
-    using type = list<Ts...>;
-};
-template <class... As, class... Bs, class... Rest>
-struct concat_impl<list<As...>, list<Bs...>, Rest...> {
-    using type = typename concat_impl<list<As..., Bs...>, Rest...>::type;
-};
-template <class... Ls>
-using concat = typename concat_impl<Ls...>::type;
+using concat = decltype((list<>{} + ... + Ls{}));
 
 /// list<T, Us...> for every list<Us...> in the list of lists Ls.
 template <class T, class Ls>
