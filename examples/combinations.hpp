@@ -9,6 +9,7 @@
 // nsp::SpectralPathEstimator with that channel policy.
 #pragma once
 
+#include <array>
 #include <string>
 #include <type_traits>
 
@@ -19,40 +20,102 @@
 
 namespace nsp_examples {
 
-/// Which of the two scenes of default_scene.hpp a render uses.
+/// Which of the three scenes of default_scene.hpp a render uses.
 enum class SceneKind {
     Cloud,      ///< the grey cloud (set-ups A, B)
     Chromatic,  ///< the chromatic cloud, extinction 1 : 4 : 16 (set-ups C1, C2)
+    Sparse,     ///< the sparse grey medium, a plume and five puffs (set-ups SA, SB: A's and B's lights)
 };
 
-/// The medium of both scenes: the procedural cloud on a dense grid (grey or chromatic
-/// coefficients; the type is the same, so the scene is a run-time choice).
+/// The run-time values of the majorant policies (flags --grid-res and --majorant-scale).
+struct MajorantSettings {
+    int grid_res = 16;   ///< cells per axis of the grid majorants
+    float scale = 0.5f;  ///< of the non-bounding majorants: the fraction of the bound they use
+};
+
+/// The medium of all three scenes: a density on a dense grid (the cloud with grey or chromatic
+/// coefficients, or the sparse plume and puffs; the type is the same, so the scene is a run-time
+/// choice).
 struct DenseGridCloud {
     static constexpr const char* name = "dense-grid";
     template <nsp::SpectralMode S>
     using type = nsp::DenseGridMedium<S>;
     template <nsp::SpectralMode S>
     static type<S> make(SceneKind scene) {
-        return scene == SceneKind::Cloud ? make_default_medium<S>() : make_chromatic_medium<S>();
+        switch (scene) {
+            case SceneKind::Chromatic: return make_chromatic_medium<S>();
+            case SceneKind::Sparse: return make_sparse_medium<S>();
+            default: return make_default_medium<S>();
+        }
     }
 };
 
-/// One constant grey majorant for the whole medium and every channel (the tightest the grid allows).
+/// One of four names by bound policy B (the row names of the non-bounding majorants).
+template <nsp::BoundPolicy B>
+constexpr const char* bound_name(const char* guaranteed, const char* signed_, const char* clamp, const char* reject) {
+    if constexpr (std::is_same_v<B, nsp::bound::Signed>) return signed_;
+    else if constexpr (std::is_same_v<B, nsp::bound::Clamp>) return clamp;
+    else if constexpr (std::is_same_v<B, nsp::bound::Reject>) return reject;
+    else return guaranteed;
+}
+
+// Every majorant policy states `per_channel` (segment values per channel: only the spectral
+// estimators with their own pdfs take it) and `bounding` (bound::Guaranteed; the others are
+// given a deliberately low majorant, MajorantSettings::scale times the bound).
+
+/// One constant grey majorant for the whole medium and every channel: under bound::Guaranteed the
+/// tightest the grid allows; under the other bound policies `scale` times it.
+template <nsp::BoundPolicy B = nsp::bound::Guaranteed>
 struct GlobalMajorantPolicy {
-    static constexpr const char* name = "global";
+    static constexpr const char* name = bound_name<B>("global", "global-signed", "global-clamp", "global-reject");
+    static constexpr bool per_channel = false;
+    static constexpr bool bounding = !B::allows_below;
     template <nsp::Medium M>
-    using type = nsp::GlobalMajorant<M>;
+    using type = nsp::GlobalMajorant<M, B>;
     template <nsp::Medium M>
-    static type<M> make(const M& medium) { return type<M>(medium); }
+    static type<M> make(const M& medium, const MajorantSettings& s) {
+        if constexpr (bounding) return (void)s, type<M>(medium);
+        else return type<M>(medium, s.scale * medium.max_extinction());
+    }
 };
 
 /// One constant majorant per channel, each channel's own extinction bound (THEORY 5.3).
 struct ChannelMajorantPolicy {
     static constexpr const char* name = "per-channel";
+    static constexpr bool per_channel = true;
+    static constexpr bool bounding = true;
     template <nsp::Medium M>
     using type = nsp::ChannelMajorant<M>;
     template <nsp::Medium M>
-    static type<M> make(const M& medium) { return type<M>(medium); }
+    static type<M> make(const M& medium, const MajorantSettings&) { return type<M>(medium); }
+};
+
+/// A grey voxel-grid majorant of MajorantSettings::grid_res^3 cells walked by a DDA: it follows the
+/// medium, so empty space costs DDA steps instead of null collisions. Non-bounding policies get
+/// `scale` times each cell's bound.
+template <nsp::BoundPolicy B = nsp::bound::Guaranteed>
+struct GridMajorantPolicy {
+    static constexpr const char* name = bound_name<B>("grid", "grid-signed", "grid-clamp", "grid-reject");
+    static constexpr bool per_channel = false;
+    static constexpr bool bounding = !B::allows_below;
+    template <nsp::Medium M>
+    using type = nsp::GridMajorant<M, B>;
+    template <nsp::Medium M>
+    static type<M> make(const M& medium, const MajorantSettings& s) {
+        return type<M>(medium, s.grid_res, bounding ? 1.f : s.scale);
+    }
+};
+
+/// A per-channel voxel-grid majorant: the grid's density bound times each channel's extinction
+/// per unit density (THEORY 5.3 with a grid).
+struct ChannelGridMajorantPolicy {
+    static constexpr const char* name = "channel-grid";
+    static constexpr bool per_channel = true;
+    static constexpr bool bounding = true;
+    template <nsp::Medium M>
+    using type = nsp::ChannelGridMajorant<M>;
+    template <nsp::Medium M>
+    static type<M> make(const M& medium, const MajorantSettings& s) { return type<M>(medium, s.grid_res); }
 };
 
 /// The channel policy of nsp::PathEstimator: one pdf driven by the channel means, grey majorant.
@@ -66,7 +129,9 @@ using Hero4 = nsp::Hero<4>;
 using SpectralModes = tl::list<nsp::Mono, nsp::Rgb, Hero4>;
 using ChannelPolicies = tl::list<Grey, nsp::channels::Independent, nsp::channels::SpectralTrackingMax,
                                  nsp::channels::SpectralTrackingAverage, nsp::channels::SpectralMis>;
-using Majorants = tl::list<GlobalMajorantPolicy, ChannelMajorantPolicy>;
+using Majorants = tl::list<GlobalMajorantPolicy<>, ChannelMajorantPolicy, GridMajorantPolicy<>, ChannelGridMajorantPolicy,
+                           GlobalMajorantPolicy<nsp::bound::Signed>, GlobalMajorantPolicy<nsp::bound::Clamp>,
+                           GridMajorantPolicy<nsp::bound::Signed>, GridMajorantPolicy<nsp::bound::Clamp>>;
 using Strategies = tl::list<nsp::strategy::Unidirectional, nsp::strategy::NextEvent,
                             nsp::strategy::DirectionalMis, nsp::strategy::NullScatteringMis>;
 using Heuristics = tl::list<nsp::mis::None, nsp::mis::Balance, nsp::mis::Power>;
@@ -75,19 +140,26 @@ using MediumKinds = tl::list<DenseGridCloud>;
 
 /// The library's static_asserts as a predicate on a point of the product, evaluated on the policy
 /// tags alone (nothing is instantiated for an invalid point):
-/// - PathEstimator (Grey): the grey majorant; MIS strategies take a combining heuristic, single
-///   strategies mis::None;
-/// - SpectralPathEstimator: a multi-channel mode; spectral tracking (one shared pdf) with the grey
+/// - PathEstimator (Grey): a grey majorant (global or grid); MIS strategies take a combining
+///   heuristic, single strategies mis::None;
+/// - SpectralPathEstimator: a multi-channel mode; spectral tracking (one shared pdf) with a grey
 ///   majorant only (the library's static_assert); no DirectionalMis; mis::None for single
 ///   strategies, mis::Balance for NullScatteringMis.
-/// and one choice of the examples, not the library's: independent tracking only with the
-/// per-channel majorant (with the grey one it is spectral tracking's sampling without its
-/// shared weights: every channel's free flight is the same, only the event probabilities differ,
-/// and it is not a baseline anyone uses). Spectral MIS takes either majorant: per-channel (each
-/// channel's own tight free-flight density; on the chromatic cloud, extinction 1 : 4 : 16, the
-/// channels' pdfs barely overlap and MIS gains little over independent tracking) or global (one
-/// shared free-flight density and per-channel event probabilities, so every channel's pdf is
-/// large where the others' are and the balance heuristic actually combines them).
+/// and choices of the examples, not the library's:
+/// - independent tracking only with a per-channel majorant (per-channel or channel-grid; with a
+///   grey one it is spectral tracking's sampling without its shared weights: every channel's free
+///   flight is the same, only the event probabilities differ, and it is not a baseline anyone
+///   uses). Spectral MIS takes every bounding majorant: per-channel ones (each channel's own tight
+///   free-flight density; on the chromatic cloud, extinction 1 : 4 : 16, the channels' pdfs
+///   barely overlap and MIS gains little over independent tracking) or grey ones (one shared
+///   free-flight density and per-channel event probabilities, so every channel's pdf is large
+///   where the others' are and the balance heuristic actually combines them).
+/// - the build: every point costs nsp_render about 1.5 s of compile time (-O3), and the full
+///   product of the eight majorants has 288 points against 96 with the first two. So the new
+///   majorants (grid, channel-grid and the non-bounding ones) come with absorption::Weight only
+///   (the absorb-event rows answer nothing about majorants that the absorb-weight ones do not),
+///   and the non-bounding ones (bound::Signed, Clamp) with PathEstimator in Mono only (what a low
+///   majorant costs in variance or bias is a question the grey medium answers).
 template <class Tuple>
 struct is_valid;
 template <class S, class CP, class Maj, class St, class H, class A, class Med>
@@ -96,9 +168,12 @@ struct is_valid<tl::list<S, CP, Maj, St, H, A, Med>> {
     static constexpr bool heuristic_fits =
         St::combines ? (grey ? H::combines : std::is_same_v<H, nsp::mis::Balance>) : !H::combines;
     static constexpr bool majorant_fits = [] {
-        if constexpr (grey) return std::is_same_v<Maj, GlobalMajorantPolicy>;
-        else if constexpr (!CP::own_pdfs) return std::is_same_v<Maj, GlobalMajorantPolicy>;
-        else if constexpr (!CP::mis_over_channels) return std::is_same_v<Maj, ChannelMajorantPolicy>;
+        constexpr bool first = std::is_same_v<Maj, GlobalMajorantPolicy<>> || std::is_same_v<Maj, ChannelMajorantPolicy>;
+        if constexpr (!first && !std::is_same_v<A, nsp::absorption::Weight>) return false;
+        else if constexpr (grey) return !Maj::per_channel && (Maj::bounding || S::channels == 1);
+        else if constexpr (!Maj::bounding) return false;
+        else if constexpr (!CP::own_pdfs) return !Maj::per_channel;
+        else if constexpr (!CP::mis_over_channels) return Maj::per_channel;
         else return true;
     }();
     static constexpr bool value = heuristic_fits && majorant_fits &&
@@ -141,12 +216,18 @@ struct Combination<tl::list<S, CP, Maj, St, H, A, Med>> {
         else return false;
     }();
 
-    /// Grey rows keep the names of the existing tables: "uni-nee-mis_balance_absorb-weight"
-    /// ("unidirectional_absorb-event" for single strategies). Spectral rows add the channel
-    /// policy and the majorant: "uni-nee-mis_spectral-mis_per-channel_balance_absorb-weight".
+    /// True for the grey estimator with the plain global majorant (the rows of the first tables).
+    static constexpr bool plain_global = !spectral && std::is_same_v<Maj, GlobalMajorantPolicy<>>;
+
+    /// Grey rows with the global majorant keep the names of the existing tables:
+    /// "uni-nee-mis_balance_absorb-weight" ("unidirectional_absorb-event" for single strategies);
+    /// other grey rows add the majorant: "uni-nee-mis_grid_balance_absorb-weight". Spectral rows
+    /// add the channel policy and the majorant:
+    /// "uni-nee-mis_spectral-mis_per-channel_balance_absorb-weight".
     static std::string name() {
         std::string n = St::name;
         if constexpr (spectral) n += std::string("_") + CP::name + "_" + Maj::name;
+        else if constexpr (!plain_global) n += std::string("_") + Maj::name;
         if constexpr (H::combines) n += std::string("_") + H::name;
         return n + "_" + A::name;
     }
@@ -158,12 +239,53 @@ using CombinationsOf = tl::transform<
     Combination, tl::filter<is_valid, tl::product<tl::list<S>, ChannelPolicies, Majorants, Strategies, Heuristics,
                                                   Absorptions, MediumKinds>>>;
 
-// Grey: (Unidirectional, NextEvent with None; two MIS strategies with Balance and Power) x 2
-// absorption policies, in every mode. Spectral: 5 (channel policy, majorant) pairs (independent
-// per-channel, spectral tracking max and average global, spectral MIS per-channel and global) x
-// (Unidirectional, NextEvent, NullScatteringMis with Balance) x 2 absorption policies, in Rgb and Hero.
-static_assert(tl::size<CombinationsOf<nsp::Mono>> == (2 + 2 * 2) * 2);
-static_assert(tl::size<CombinationsOf<nsp::Rgb>> == (2 + 2 * 2) * 2 + 5 * 3 * 2);
-static_assert(tl::size<CombinationsOf<Hero4>> == (2 + 2 * 2) * 2 + 5 * 3 * 2);
+// Grey: Unidirectional, NextEvent with None; two MIS strategies with Balance and Power: 6 per
+// absorption policy; with the global majorant both policies, with grid in every mode and the four
+// non-bounding ones (global and grid, signed and clamp) in Mono absorb-weight only. Spectral, in
+// Rgb and Hero: (Unidirectional, NextEvent, NullScatteringMis with Balance) with 5 (channel
+// policy, majorant) pairs of the first two majorants x 2 absorption policies (independent
+// per-channel, spectral tracking max and average global, spectral MIS per-channel and global),
+// and 5 pairs with the grid majorants x absorb-weight (independent channel-grid, spectral
+// tracking max and average grid, spectral MIS grid and channel-grid).
+static_assert(tl::size<CombinationsOf<nsp::Mono>> == 6 * 2 + 6 * (1 + 4));
+static_assert(tl::size<CombinationsOf<nsp::Rgb>> == 6 * 2 + 6 + 5 * 3 * 2 + 5 * 3);
+static_assert(tl::size<CombinationsOf<Hero4>> == 6 * 2 + 6 + 5 * 3 * 2 + 5 * 3);
+
+/// What the driver knows of one combination at run time: its names and traits as plain data, so
+/// that planning and --list loop over an array instead of instantiating code per combination
+/// (which costs compile time for nothing).
+struct CombinationInfo {
+    const char* mode;
+    const char* channels;
+    const char* majorant;
+    const char* strategy;
+    const char* heuristic;
+    const char* absorption;
+    const char* medium;
+    bool spectral;              ///< SpectralPathEstimator
+    bool plain_global;          ///< PathEstimator with the plain global majorant (names without majorant)
+    bool uses_selection;        ///< see Combination::uses_selection
+    bool bounding;              ///< the majorant bounds the extinction (bound::Guaranteed)
+    bool per_channel_majorant;  ///< per-channel or channel-grid
+    std::string (*name)();      ///< Combination::name
+};
+
+namespace detail {
+template <class L>
+struct infos_of;
+template <class... Cs>
+struct infos_of<tl::list<Cs...>> {
+    static constexpr std::array<CombinationInfo, sizeof...(Cs)> value{CombinationInfo{
+        Cs::Spectral::name, Cs::ChannelPolicy::name, Cs::MajorantKind::name, Cs::Strategy::name, Cs::Heuristic::name,
+        Cs::Absorption::name, Cs::MediumKind::name, Cs::spectral, Cs::plain_global, Cs::uses_selection,
+        Cs::MajorantKind::bounding, Cs::MajorantKind::per_channel, &Cs::name}...};
+};
+}  // namespace detail
+
+/// The run-time descriptions of CombinationsOf<S>, in order (element i is combination index i).
+template <class S>
+constexpr const auto& combination_infos() {
+    return detail::infos_of<CombinationsOf<S>>::value;
+}
 
 }  // namespace nsp_examples

@@ -1,12 +1,16 @@
 // examples/render.cpp: nsp_render, the example host renderer and the project's main job.
 //
-// Renders two scenes of examples/default_scene.hpp with the path estimators nsp offers, writes one
-// EXR per render and prints an efficiency table per light set-up and spectral mode (THEORY 7:
-// LTUV = density lookups per sample x variance of one sample):
+// Renders the three scenes of examples/default_scene.hpp with the path estimators nsp offers,
+// writes one EXR per render and prints an efficiency table per light set-up and spectral mode
+// (THEORY 7: LTUV = density lookups per sample x variance of one sample):
 // - the grey cloud in set-ups A and B (mono), with every nsp::PathEstimator;
 // - the chromatic cloud (extinction 1 : 4 : 16) in set-ups C1 and C2 (rgb and hero), with the
 //   spectral estimators (independent tracking, spectral tracking, spectral MIS) beside the
-//   grey-majorant baseline (THEORY 5.3).
+//   grey-majorant baseline (THEORY 5.3);
+// - the sparse medium in set-up SA (mono, set-up A's light), the global majorant against the grid
+//   majorant (THEORY 4) for each grey strategy.
+// The majorant is an axis of its own (--majorant): every table can compare majorants, the
+// non-bounding ones (bound::Signed, Clamp with a deliberately low majorant) included.
 // This file plans renders by name and prints the tables; the command-line choices become types
 // once, in render_combination<S> (render_job.hpp), whose render loops are monomorphic.
 #include <algorithm>
@@ -55,8 +59,27 @@ constexpr int kCloudWidth = 128, kCloudHeight = 128, kCloudSpp = 512;
 /// a default table's row is run 1 (seed 1) of the comparison.
 constexpr int kChromaticWidth = 32, kChromaticHeight = 32, kChromaticSpp = 128;
 
+/// The sparse medium: a global majorant spends most of its lookups on empty space here (extinction
+/// 60 in ~2% of the box), so a sample costs several times the grey cloud's; a smaller image keeps
+/// the main job's budget. The grid majorant's resolution is --grid-res (default 16: a neutral
+/// middle, not tuned to this medium).
+constexpr int kSparseWidth = 64, kSparseHeight = 64, kSparseSpp = 128;
+
 /// The estimators of the grey cloud by default: every PathEstimator (the existing table).
 const std::vector<std::string> kCloudEstimators{"grey"};
+/// The estimators of the sparse medium by default: each grey strategy once (absorb-weight, the
+/// balance heuristic for the MIS strategies); each with every majorant of --majorant.
+const std::vector<std::string> kSparseEstimators{
+    "unidirectional_grey_absorb-weight",
+    "ratio-nee_grey_absorb-weight",
+    "directional-mis_grey_balance_absorb-weight",
+    "uni-nee-mis_grey_balance_absorb-weight",
+};
+
+/// The majorants of each scene by default (--majorant overrides them for every scene).
+const std::vector<std::string> kCloudMajorants{"global"};
+const std::vector<std::string> kChromaticMajorants{"global", "per-channel"};
+const std::vector<std::string> kSparseMajorants{"global", "grid"};
 /// The estimators of the chromatic cloud by default (absorb-weight rows): the grey-majorant
 /// baseline with NEE MIS; each spectral channel policy unidirectional and with NEE MIS; spectral
 /// MIS also with NEE alone; with --selection both, spectral MIS + NEE and independent + NEE also
@@ -95,8 +118,11 @@ struct Options {
     std::string out = "out";
     bool write_exr = true;
     bool list = false;
-    std::vector<SceneKind> scenes{SceneKind::Cloud, SceneKind::Chromatic};
-    std::vector<std::string> setups{"A", "B", "C1", "C2"};
+    std::vector<SceneKind> scenes{SceneKind::Cloud, SceneKind::Chromatic, SceneKind::Sparse};
+    std::vector<std::string> setups{"A", "B", "C1", "C2", "SA"};
+    std::vector<std::string> majorants;  ///< majorant names (empty: the scene's defaults)
+    bool all_majorants = false;          ///< --majorant all: names without a row in a mode are no error
+    MajorantSettings majorant;           ///< --grid-res, --majorant-scale
     std::vector<std::string_view> modes;  ///< empty: mono for the cloud, rgb and hero for the chromatic cloud
     std::vector<std::string> estimators;  ///< filter tokens (empty: the scene's defaults)
     std::vector<SelectionRule> selections{SelectionRule::Uniform, SelectionRule::Luminance};
@@ -111,22 +137,45 @@ Default run (no flags): the grey cloud, set-ups A and B, mono, 128x128, 512 spp,
 PathEstimator (24 renders); then the chromatic cloud, set-ups C1 and C2, rgb and hero, 32x32,
 128 spp, the grey-majorant baseline uni-nee-mis_balance_absorb-weight and the spectral
 estimators listed under --estimators, uniform and luminance selection (absorb-weight; 15
-renders per set-up and mode, 60 in all), one run each. scripts/run-main.sh then adds the
-heavy-tail comparison: baseline against spectral MIS + NEE with each majorant, --runs 5 at
-32x32 with a 2048-spp reference image for the effective variance (the last example below).
+renders per set-up and mode, 60 in all), one run each; then the sparse medium, set-up SA, mono,
+64x64, 128 spp, each grey strategy (absorb-weight) with the global and the grid majorant (8
+renders). scripts/run-main.sh then adds the heavy-tail comparison: baseline against spectral
+MIS + NEE with each majorant, --runs 5 at 32x32 with a 2048-spp reference image for the
+effective variance (the last example below).
 
 usage: nsp_render [flags]
 
-  --scene S          cloud, chromatic or both (default both). cloud: the grey cloud (extinction
-                     20, albedo 0.9), set-ups A and B. chromatic: the same cloud with extinction
-                     5 : 20 : 80 in R : G : B (hero: a spectrum through those values), albedo
-                     0.95, set-ups C1 and C2
-  --setup LIST       comma-separated set-ups of the chosen scenes, from A, B, C1, C2, or 'all'
-                     (default; 'both' also means all). A: a small bright sphere light above the
-                     grey cloud (NEE should win); B: a large dim sphere light behind it
-                     (unidirectional should win); C1: a constant white environment around the
-                     chromatic cloud (unidirectional paths dominate); C2: set-up A's small light
-                     above the chromatic cloud (NEE matters)
+  --scene LIST       comma-separated scenes from cloud, chromatic, sparse; 'both' = cloud,chromatic;
+                     'all' = all three (default). cloud: the grey cloud (extinction 20, albedo
+                     0.9), set-ups A and B. chromatic: the same cloud with extinction 5 : 20 : 80
+                     in R : G : B (hero: a spectrum through those values), albedo 0.95, set-ups C1
+                     and C2. sparse: a thin plume and five small dense puffs filling ~2% of the
+                     box (grey, extinction 60, albedo 0.9), set-ups SA and SB
+  --setup LIST       comma-separated set-ups of the chosen scenes, from A, B, C1, C2, SA, SB, or
+                     'all' ('both' also means all; default: all but SB). A: a small bright
+                     sphere light above the grey cloud (NEE should win); B: a large dim sphere
+                     light behind it (unidirectional should win); C1: a constant white
+                     environment around the chromatic cloud (unidirectional paths dominate); C2:
+                     set-up A's small light above the chromatic cloud (NEE matters); SA, SB:
+                     set-up A's and B's lights around the sparse medium
+  --majorant LIST    comma-separated majorants, or 'all' (default: global for the cloud; global
+                     and per-channel for the chromatic cloud; global and grid for the sparse
+                     medium; a list given here applies to every scene). Bounding: global (one
+                     grey value, the medium's extinction bound), per-channel (each channel's own
+                     bound; rgb and hero), grid (a grey voxel grid of density bounds walked by a
+                     DDA, --grid-res), channel-grid (the same grid times each channel's
+                     extinction per unit density; rgb and hero). Non-bounding, deliberately
+                     low (--majorant-scale), mono and nsp::PathEstimator only: global-signed,
+                     grid-signed (bound::Signed: signed null weights, unbiased), global-clamp,
+                     grid-clamp (bound::Clamp: density clamped to the majorant, biased). The
+                     majorants other than global and per-channel are compiled with absorb-weight
+                     only (build time). Grey rows with another majorant than global name it,
+                     e.g. uni-nee-mis_grid_balance_absorb-weight; each table has a majorant
+                     column, and steps/spl (DDA steps per sample) where a grid is walked
+  --grid-res N       cells per axis of the grid majorants (default 16)
+  --majorant-scale S the non-bounding majorants' value as a fraction of the bound: global-*
+                     use S x the medium's largest extinction, grid-* S x each cell's bound
+                     (default 0.5)
   --spectral LIST    comma-separated spectral modes from mono, rgb, hero; 'both' = mono,rgb;
                      'all' = all three (default: mono for the cloud, rgb,hero for the chromatic
                      cloud; a list given here applies to both scenes). hero: 4 wavelengths per
@@ -138,12 +187,14 @@ usage: nsp_render [flags]
                      valid combination. Fields of a row's name: strategy (unidirectional,
                      ratio-nee, directional-mis, uni-nee-mis), channel policy (independent,
                      spectral-tracking-max, spectral-tracking-avg, spectral-mis), majorant
-                     (global, per-channel), heuristic (balance, power), absorption
+                     (global, per-channel, grid, ...), heuristic (balance, power), absorption
                      (absorb-event, absorb-weight), lum (luminance selection). Rows of
                      nsp::PathEstimator keep their names without channel policy and majorant
                      and also match 'grey' and 'global'; uniform-selection rows also match
                      'uniform'. Default for the cloud: grey (every PathEstimator). Default for
-                     the chromatic cloud:
+                     the sparse medium: unidirectional_grey_absorb-weight,
+                     ratio-nee_grey_absorb-weight, directional-mis_grey_balance_absorb-weight,
+                     uni-nee-mis_grey_balance_absorb-weight. Default for the chromatic cloud:
                        uni-nee-mis_grey_balance_absorb-weight (the grey-majorant baseline),
                        unidirectional_independent_absorb-weight_uniform,
                        uni-nee-mis_independent_absorb-weight,
@@ -186,10 +237,10 @@ usage: nsp_render [flags]
                      a tail missed in every pixel adds up there) and the ratios baseline /
                      spectral MIS + NEE of all three (not in mono tables; default: off)
   --spp N            samples per pixel, N >= 2 (default 512 for the cloud, 128 for the
-                     chromatic cloud); the variance per sample is estimated from the N samples
-                     of each pixel
+                     chromatic cloud and the sparse medium); the variance per sample is
+                     estimated from the N samples of each pixel
   --res WxH          image size in pixels (default 128x128 for the cloud, 32x32 for the
-                     chromatic cloud); also --width W, --height H
+                     chromatic cloud, 64x64 for the sparse medium); also --width W, --height H
   --threads N        worker threads (default: hardware concurrency)
   --seed N           random seed, an unsigned 64-bit integer (default 1); images do not depend
                      on --threads
@@ -208,6 +259,8 @@ usage: nsp_render [flags]
   --help             this text
 
 Examples: nsp_render --scene cloud --setup A --spp 256 --estimators uni-nee-mis_balance
+          nsp_render --scene sparse --majorant all --spp 32
+          nsp_render --scene cloud --majorant global,grid,global-signed,grid-clamp --spp 64
           nsp_render --scene chromatic --estimators all --spp 16 --res 32x32
           nsp_render --scene chromatic --runs 5 --res 32x32 --spp 128 --no-exr \
                      --reference-spp 2048 --selection uniform \
@@ -264,6 +317,13 @@ std::vector<std::string_view> mode_names() {
     return names;
 }
 
+/// The majorant policy names, in the order of Majorants.
+std::vector<std::string_view> majorant_names() {
+    std::vector<std::string_view> names;
+    tl::for_each<Majorants>([&]<class M>(std::type_identity<M>) { names.emplace_back(M::name); });
+    return names;
+}
+
 Options parse(int argc, char** argv) {
     Options o;
     std::vector<std::string_view> args(argv + 1, argv + argc);
@@ -317,21 +377,47 @@ Options parse(int argc, char** argv) {
             no_value();
             o.list = true;
         } else if (flag == "--scene") {
-            const std::string_view v = value();
-            if (v == "cloud") o.scenes = {SceneKind::Cloud};
-            else if (v == "chromatic") o.scenes = {SceneKind::Chromatic};
-            else if (v == "both") o.scenes = {SceneKind::Cloud, SceneKind::Chromatic};
-            else usage_error("--scene: '" + std::string(v) + "' is not one of cloud, chromatic, both");
+            o.scenes.clear();
+            auto add = [&](SceneKind k) {
+                if (std::find(o.scenes.begin(), o.scenes.end(), k) == o.scenes.end()) o.scenes.push_back(k);
+            };
+            for (const auto t : split(value(), ',')) {
+                if (t == "cloud") add(SceneKind::Cloud);
+                else if (t == "chromatic") add(SceneKind::Chromatic);
+                else if (t == "sparse") add(SceneKind::Sparse);
+                else if (t == "both") add(SceneKind::Cloud), add(SceneKind::Chromatic);
+                else if (t == "all") add(SceneKind::Cloud), add(SceneKind::Chromatic), add(SceneKind::Sparse);
+                else usage_error("--scene: '" + std::string(t) + "' is not one of cloud, chromatic, sparse, both, all");
+            }
         } else if (flag == "--setup") {
             o.setups.clear();
             for (const auto t : split(value(), ',')) {
-                if (t == "all" || t == "both") o.setups = {"A", "B", "C1", "C2"};
+                if (t == "all" || t == "both") o.setups = {"A", "B", "C1", "C2", "SA", "SB"};
                 else if (t == "A" || t == "a") o.setups.emplace_back("A");
                 else if (t == "B" || t == "b") o.setups.emplace_back("B");
                 else if (t == "C1" || t == "c1") o.setups.emplace_back("C1");
                 else if (t == "C2" || t == "c2") o.setups.emplace_back("C2");
-                else usage_error("--setup: '" + std::string(t) + "' is not one of A, B, C1, C2, all");
+                else if (t == "SA" || t == "sa") o.setups.emplace_back("SA");
+                else if (t == "SB" || t == "sb") o.setups.emplace_back("SB");
+                else usage_error("--setup: '" + std::string(t) + "' is not one of A, B, C1, C2, SA, SB, all");
             }
+        } else if (flag == "--majorant") {
+            const auto known = majorant_names();
+            o.majorants.clear();
+            for (const auto t : split(value(), ',')) {
+                if (t == "all") o.majorants.assign(known.begin(), known.end()), o.all_majorants = true;
+                else if (std::find(known.begin(), known.end(), t) != known.end()) o.majorants.emplace_back(t);
+                else {
+                    std::string list;
+                    for (const auto k : known) list += std::string(k) + ", ";
+                    usage_error("--majorant: '" + std::string(t) + "' is not one of " + list + "all");
+                }
+            }
+            if (o.majorants.empty()) usage_error("--majorant needs at least one name");
+        } else if (flag == "--grid-res") {
+            o.majorant.grid_res = parse_number<int>(flag, value(), 1, 1024);
+        } else if (flag == "--majorant-scale") {
+            o.majorant.scale = parse_number<float>(flag, value(), 1e-3f, 1e3f);
         } else if (flag == "--spectral") {
             const auto known = mode_names();
             o.modes.clear();
@@ -379,54 +465,63 @@ struct Candidate {
     std::string name;                 ///< e.g. uni-nee-mis_spectral-mis_per-channel_balance_absorb-weight_lum
     std::vector<std::string> fields;  ///< the name's '_'-separated fields and the implied ones (grey, global, uniform)
     std::string channels;             ///< the channel policy ("grey" for PathEstimator)
+    std::string majorant;             ///< the majorant policy's name (global, grid, grid-signed, ...)
+    std::string key;                  ///< the name without the majorant: rows that differ only in it share it
+    bool bounding = true;             ///< false for the non-bounding majorants (bound::Signed, Clamp)
+    bool per_channel_majorant = false;  ///< per-channel or channel-grid
     std::string strategy;
     std::string absorption;
     bool uses_selection = false;
 };
 
-/// Every row spectral mode S offers with selection rules `rules`, in list order (a row that
+/// The run-time descriptions of every combination of spectral mode `mode`, in index order.
+std::vector<CombinationInfo> infos(std::string_view mode) {
+    std::vector<CombinationInfo> out;
+    tl::for_each<SpectralModes>([&]<class S>(std::type_identity<S>) {
+        if (mode == S::name) out.assign(combination_infos<S>().begin(), combination_infos<S>().end());
+    });
+    return out;
+}
+
+/// Every row spectral mode `mode` offers with selection rules `rules`, in list order (a row that
 /// uses the selection once per rule, the luminance one right after the uniform one).
-template <class S>
-std::vector<Candidate> candidates_of(const std::vector<SelectionRule>& rules) {
+std::vector<Candidate> candidates(std::string_view mode, const std::vector<SelectionRule>& rules) {
     std::vector<Candidate> out;
     std::size_t index = 0;
-    tl::for_each<CombinationsOf<S>>([&]<class C>(std::type_identity<C>) {
+    for (const CombinationInfo& info : infos(mode)) {
         Candidate c;
         c.index = index++;
-        c.channels = C::ChannelPolicy::name;
-        c.strategy = C::Strategy::name;
-        c.absorption = C::Absorption::name;
-        c.uses_selection = C::uses_selection;
-        c.name = C::name();
-        for (const auto f : split(c.name, '_')) c.fields.emplace_back(f);
-        if constexpr (!C::spectral) {
-            c.fields.emplace_back("grey");
-            c.fields.emplace_back("global");
+        c.channels = info.channels;
+        c.majorant = info.majorant;
+        c.bounding = info.bounding;
+        c.per_channel_majorant = info.per_channel_majorant;
+        c.strategy = info.strategy;
+        c.absorption = info.absorption;
+        c.uses_selection = info.uses_selection;
+        c.name = info.name();
+        for (const auto f : split(c.name, '_')) {
+            c.fields.emplace_back(f);
+            if (f != c.majorant) c.key += (c.key.empty() ? "" : "_") + std::string(f);
         }
-        if (!C::uses_selection) {
+        if (!info.spectral) c.fields.emplace_back("grey");
+        if (info.plain_global) c.fields.emplace_back("global");
+        if (!info.uses_selection) {
             out.push_back(c);
-            return;
+            continue;
         }
         for (const SelectionRule r : rules) {
             Candidate s = c;
             s.selection = r;
             if (r == SelectionRule::Luminance) {
                 s.name += "_lum";
+                s.key += "_lum";
                 s.fields.emplace_back("lum");
             } else {
                 s.fields.emplace_back("uniform");
             }
             out.push_back(std::move(s));
         }
-    });
-    return out;
-}
-
-std::vector<Candidate> candidates(std::string_view mode, const std::vector<SelectionRule>& rules) {
-    std::vector<Candidate> out;
-    tl::for_each<SpectralModes>([&]<class S>(std::type_identity<S>) {
-        if (mode == S::name) out = candidates_of<S>(rules);
-    });
+    }
     return out;
 }
 
@@ -450,29 +545,39 @@ std::vector<TablePlan> plan(const Options& o) {
     std::vector<TablePlan> tables;
     std::vector<std::string> all_tokens = o.estimators;
     std::vector<bool> used(all_tokens.size(), false);
+    std::vector<bool> majorant_used(o.majorants.size(), false);
     for (const SceneKind kind : o.scenes) {
-        const bool cloud = kind == SceneKind::Cloud;
+        const bool chromatic = kind == SceneKind::Chromatic, sparse = kind == SceneKind::Sparse;
         std::vector<SceneChoice> choices;
         for (const auto& s : o.setups) {
-            if (cloud && (s == "A" || s == "B")) choices.push_back({kind, s == "A" ? LightSetup::A : LightSetup::B});
-            if (!cloud && (s == "C1" || s == "C2"))
+            if (kind == SceneKind::Cloud && (s == "A" || s == "B"))
+                choices.push_back({kind, s == "A" ? LightSetup::A : LightSetup::B});
+            if (chromatic && (s == "C1" || s == "C2"))
                 choices.push_back({kind, LightSetup::A, s == "C1" ? ChromaticSetup::Env : ChromaticSetup::Small});
+            if (sparse && (s == "SA" || s == "SB")) choices.push_back({kind, s == "SA" ? LightSetup::A : LightSetup::B});
         }
         std::vector<std::string_view> modes = o.modes;
         if (modes.empty()) {
-            if (cloud) modes = {nsp::Mono::name};
-            else modes = {nsp::Rgb::name, Hero4::name};
+            if (chromatic) modes = {nsp::Rgb::name, Hero4::name};
+            else modes = {nsp::Mono::name};
         }
         const std::vector<std::string>& tokens =
-            !o.estimators.empty() ? o.estimators : (cloud ? kCloudEstimators : kChromaticEstimators);
+            !o.estimators.empty() ? o.estimators
+                                  : (chromatic ? kChromaticEstimators : sparse ? kSparseEstimators : kCloudEstimators);
+        const std::vector<std::string>& majorants =
+            !o.majorants.empty() ? o.majorants
+                                 : (chromatic ? kChromaticMajorants : sparse ? kSparseMajorants : kCloudMajorants);
         for (const SceneChoice& choice : choices) {
             for (const auto mode : modes) {
                 TablePlan t{choice, mode,
-                            o.width.value_or(cloud ? kCloudWidth : kChromaticWidth),
-                            o.height.value_or(cloud ? kCloudHeight : kChromaticHeight),
-                            o.spp.value_or(cloud ? kCloudSpp : kChromaticSpp),
+                            o.width.value_or(chromatic ? kChromaticWidth : sparse ? kSparseWidth : kCloudWidth),
+                            o.height.value_or(chromatic ? kChromaticHeight : sparse ? kSparseHeight : kCloudHeight),
+                            o.spp.value_or(chromatic ? kChromaticSpp : sparse ? kSparseSpp : kCloudSpp),
                             {}};
                 for (const Candidate& c : candidates(mode, o.selections)) {
+                    const auto maj = std::find(majorants.begin(), majorants.end(), c.majorant);
+                    if (maj == majorants.end()) continue;
+                    if (!o.majorants.empty()) majorant_used[std::size_t(maj - majorants.begin())] = true;
                     bool any = false;
                     for (std::size_t k = 0; k < tokens.size(); ++k) {
                         if (!matches(c, tokens[k])) continue;
@@ -487,8 +592,12 @@ std::vector<TablePlan> plan(const Options& o) {
     }
     for (std::size_t k = 0; k < all_tokens.size(); ++k)
         if (!used[k])
-            usage_error("--estimators: '" + all_tokens[k] + "' matches no row of the chosen scenes, set-ups and "
-                        "spectral modes (see --list)");
+            usage_error("--estimators: '" + all_tokens[k] + "' matches no row of the chosen scenes, set-ups, "
+                        "spectral modes and majorants (see --list)");
+    for (std::size_t k = 0; k < o.majorants.size(); ++k)
+        if (!majorant_used[k] && !o.all_majorants)
+            usage_error("--majorant: '" + o.majorants[k] + "' has no row in the chosen spectral modes (see --list: "
+                        "per-channel majorants need rgb or hero, the non-bounding ones mono)");
     if (tables.empty()) usage_error("nothing to render: --scene and --setup choose no set-up in common");
     return tables;
 }
@@ -649,8 +758,13 @@ double print_rows(const TablePlan& t, const Options& o, const std::vector<Row>& 
     std::size_t width = 36;
     for (const Row& r : rows) width = std::max(width, r.c.name.size());
     const int wn = int(width);
-    std::printf("%-*s %5s %8s %11s %11s %11s %11s %9s", wn, "estimator", "spp", "seconds", "lookups/spl", "var/spl",
-                "LTUV", "cpu-s*var", "LTUV/best");
+    // DDA steps per sample: only where a row walks a grid majorant.
+    const bool steps = std::any_of(rows.begin(), rows.end(), [](const Row& r) {
+        return r.c.majorant.find("grid") != std::string::npos;
+    });
+    std::printf("%-*s %-13s %5s %8s %11s", wn, "estimator", "majorant", "spp", "seconds", "lookups/spl");
+    if (steps) std::printf(" %9s", "steps/spl");
+    std::printf(" %11s %11s %11s %9s", "var/spl", "LTUV", "cpu-s*var", "LTUV/best");
     if (o.runs > 1) std::printf(" %19s", "var/spl min..max");
     const bool effective = std::any_of(rows.begin(), rows.end(), [](const Row& r) { return !r.effective.empty(); });
     if (effective) std::printf(" %11s %11s %11s", "eff var/spl", "eff LTUV", "img eff var");
@@ -658,10 +772,11 @@ double print_rows(const TablePlan& t, const Options& o, const std::vector<Row>& 
     for (const Row& r : rows) {
         const double ltuv = m.ltuv(r);
         const bool measured = ltuv > 0.0 && std::isfinite(best);
-        std::printf("%-*s %5d %8.2f %11s %11s %11s %11s %9s", wn, r.c.name.c_str(), t.spp,
+        std::printf("%-*s %-13s %5d %8.2f %11s", wn, r.c.name.c_str(), r.c.majorant.c_str(), t.spp,
                     r.median([](const RenderStats& s) { return s.wall_seconds; }),
-                    num(r.median([](const RenderStats& s) { return s.lookups_per_sample(); })).c_str(),
-                    num(m.var(r)).c_str(), num(ltuv).c_str(),
+                    num(r.median([](const RenderStats& s) { return s.lookups_per_sample(); })).c_str());
+        if (steps) std::printf(" %9s", num(r.median([](const RenderStats& s) { return s.steps_per_sample(); })).c_str());
+        std::printf(" %11s %11s %11s %9s", num(m.var(r)).c_str(), num(ltuv).c_str(),
                     num(r.median([&](const RenderStats& s) { return m.time_variance(s); })).c_str(),
                     measured ? num(ltuv / best).c_str() : "n/a");
         if (o.runs > 1) {
@@ -697,20 +812,83 @@ std::pair<double, int> mean_gap(const Row& a, const Row& b) {
     return worst;
 }
 
-/// Footer lines every table shares: medians, status counts, rarely nonzero rows.
+/// What the majorants of a table's rows are, when any is not the plain global or per-channel one.
+void print_majorant_notes(const Options& o, const std::vector<Row>& rows) {
+    const auto any = [&](auto pred) { return std::any_of(rows.begin(), rows.end(), pred); };
+    if (any([](const Row& r) { return r.c.majorant.find("grid") != std::string::npos; })) {
+        const long long n = o.majorant.grid_res;
+        std::printf("grid majorants (grid, channel-grid, grid-*): %lldx%lldx%lld cells over the medium's box "
+                    "(--grid-res), %lld KiB, each cell the density bound over it, walked by a DDA. steps/spl: DDA "
+                    "steps (cells crossed, empty ones included) per sample; lookups/spl counts density lookups "
+                    "only.\n", n, n, n, n * n * n * 4 / 1024);
+    }
+    if (any([](const Row& r) { return !r.c.bounding; }))
+        std::printf("non-bounding majorants (*-signed, *-clamp): %g x the bound (--majorant-scale), below the "
+                    "extinction where the medium is dense. signed (bound::Signed): negative null weights, "
+                    "unbiased; clamp (bound::Clamp): the density clamped to the majorant, biased by design.\n",
+                    double(o.majorant.scale));
+}
+
+/// Rows that differ only in their majorant, against the same estimator with the table's reference
+/// majorant of the same kind: per-channel for per-channel majorants, grid for the non-bounding
+/// grids (when rendered), global otherwise. Prints the cost and variance ratios and how far apart
+/// the image means are (they must agree for any unbiased pair; bound::Clamp is biased by design).
+void print_majorant_comparison(const std::vector<Row>& rows, const Metrics& m) {
+    bool header = false;
+    for (const Row& r : rows) {
+        auto same_estimator = [&](const std::string& majorant) {
+            return std::find_if(rows.begin(), rows.end(), [&](const Row& x) {
+                return x.c.key == r.c.key && x.c.majorant == majorant;
+            });
+        };
+        std::string base_name = r.c.per_channel_majorant ? "per-channel" : "global";
+        if (r.c.majorant.starts_with("grid-") && same_estimator("grid") != rows.end()) base_name = "grid";
+        if (r.c.majorant == base_name) continue;
+        const auto b = same_estimator(base_name);
+        if (b == rows.end()) continue;
+        if (!header)
+            std::printf("majorants compared (ratio = row / same estimator with the reference majorant; < 1: the "
+                        "row is cheaper or less noisy):\n");
+        header = true;
+        const auto med = [](const Row& x, auto f) { return x.median(f); };
+        const auto ratio = [](double a, double b) { return b > 0.0 && std::isfinite(a / b) ? num(a / b) : "n/a"; };
+        const auto lookups = [](const RenderStats& s) { return s.lookups_per_sample(); };
+        const auto cpu = [](const RenderStats& s) { return s.cpu_seconds_per_sample(); };
+        const auto [z, c] = mean_gap(r, *b);
+        const bool few = r.nonzero() < kFewNonzero || b->nonzero() < kFewNonzero;
+        const char* verdict = few ? " (too few nonzero samples to compare)"
+                              : r.c.majorant.ends_with("clamp") ? (z > kMeanGap ? " (clamp: biased by design)" : "")
+                              : z > kMeanGap ? " (TOO FAR APART: a bias or a heavy tail)"
+                                             : "";
+        std::printf("  %s vs %s, %s: lookups/spl %s, cpu-s/spl %s, var/spl %s, LTUV %s, cpu-s*var %s; image "
+                    "means %.1f standard errors apart%s%s\n",
+                    r.c.majorant.c_str(), base_name.c_str(), r.c.key.c_str(),
+                    ratio(med(r, lookups), med(*b, lookups)).c_str(), ratio(med(r, cpu), med(*b, cpu)).c_str(),
+                    ratio(m.var(r), m.var(*b)).c_str(), ratio(m.ltuv(r), m.ltuv(*b)).c_str(),
+                    ratio(r.median([&](const RenderStats& s) { return m.time_variance(s); }),
+                          b->median([&](const RenderStats& s) { return m.time_variance(s); }))
+                        .c_str(),
+                    z, r.c.channels != "grey" ? (std::string(" in ") + "RGB"[c]).c_str() : "",
+                    verdict);
+    }
+}
+
+/// Footer lines every table shares: medians, status counts, majorants, rarely nonzero rows.
 void print_common_footer(const Options& o, const std::vector<Row>& rows) {
     if (o.runs > 1)
         std::printf("seconds, lookups/spl, var/spl, LTUV, cpu-s*var: MEDIAN over %d runs (seeds %llu..%llu), "
                     "LTUV/best from the median LTUV; min..max: var/spl over the runs; mean: over the runs.\n",
                     o.runs, (unsigned long long)o.seed, (unsigned long long)(o.seed + std::uint64_t(o.runs) - 1));
-    std::uint64_t aborted = 0, nonfinite = 0;
+    std::uint64_t aborted = 0, nonfinite = 0, rejected = 0;
     for (const Row& r : rows)
         for (const RenderStats& s : r.runs) {
             aborted += s.aborted;
             nonfinite += s.nonfinite;
+            rejected += s.rejected;
         }
-    std::printf("paths with status Aborted: %llu, NonFinite: %llu\n", (unsigned long long)aborted,
-                (unsigned long long)nonfinite);
+    std::printf("paths with status Aborted: %llu, NonFinite: %llu, Rejected: %llu\n", (unsigned long long)aborted,
+                (unsigned long long)nonfinite, (unsigned long long)rejected);
+    print_majorant_notes(o, rows);
     if (o.lights.point)
         std::printf("note: the point light (--point) is reachable by next-event estimation only, so the "
                     "unidirectional rows leave out its light and their mean is lower\n");
@@ -726,7 +904,8 @@ void print_common_footer(const Options& o, const std::vector<Row>& rows) {
 
 void print_cloud_table(const TablePlan& t, const Options& o, const std::vector<Row>& rows) {
     const Metrics m{false};
-    std::printf("\nSet-up %s (%.*s, %dx%d, %d spp, %d threads%s)\n", t.scene.name(), int(t.mode.size()),
+    std::printf("\nSet-up %s (%s%.*s, %dx%d, %d spp, %d threads%s)\n", t.scene.name(),
+                t.scene.kind == SceneKind::Sparse ? "sparse medium, " : "", int(t.mode.size()),
                 t.mode.data(), t.width, t.height, t.spp, o.threads,
                 o.runs > 1 ? (", " + std::to_string(o.runs) + " runs").c_str() : "");
     print_rows(t, o, rows, m);
@@ -739,10 +918,12 @@ void print_cloud_table(const TablePlan& t, const Options& o, const std::vector<R
     std::printf("LTUV = lookups/spl x var/spl; cpu-s*var = thread CPU seconds per sample x var/spl; lower is "
                 "better. mean: image mean (should agree across rows).\n");
     print_common_footer(o, rows);
+    print_majorant_comparison(rows, m);
     // THEORY 7's claim, on the absorb-weight rows when present.
     const auto* uni = find_row(rows, "unidirectional_absorb-weight");
     const auto* nee = find_row(rows, "ratio-nee_absorb-weight");
     const auto* mis = find_row(rows, "uni-nee-mis_balance_absorb-weight");
+    if (uni && m.ltuv(*uni) <= 0.0) return;  // unidirectional never found the light: no ratio
     if (uni && nee) std::printf("ratio-nee / unidirectional LTUV: %s", num(m.ltuv(*nee) / m.ltuv(*uni)).c_str());
     if (uni && nee && mis)
         std::printf("; uni-nee-mis_balance / best single strategy: %s",
@@ -776,6 +957,7 @@ void print_chromatic_table(const TablePlan& t, const Options& o, const std::vect
     std::printf("Rows without a channel policy are nsp::PathEstimator with the grey (global) majorant; _lum: "
                 "luminance channel selection, otherwise uniform.\n");
     print_common_footer(o, rows);
+    print_majorant_comparison(rows, m);
     if (reference) {
         double smallest = std::numeric_limits<double>::infinity();
         for (const Row& r : rows)
@@ -905,25 +1087,26 @@ void print_chromatic_table(const TablePlan& t, const Options& o, const std::vect
 }
 
 void list_combinations() {
-    std::printf("%-5s %-21s %-11s %-15s %-9s %-13s %-10s %s\n", "mode", "channels", "majorant", "strategy",
+    std::printf("%-5s %-21s %-13s %-15s %-9s %-13s %-10s %s\n", "mode", "channels", "majorant", "strategy",
                 "heuristic", "absorption", "medium", "name");
     std::size_t total = 0;
-    tl::for_each<SpectralModes>([&]<class S>(std::type_identity<S>) {
-        tl::for_each<CombinationsOf<S>>([]<class C>(std::type_identity<C>) {
-            std::printf("%-5s %-21s %-11s %-15s %-9s %-13s %-10s %s\n", C::Spectral::name, C::ChannelPolicy::name,
-                        C::MajorantKind::name, C::Strategy::name, C::Heuristic::name, C::Absorption::name,
-                        C::MediumKind::name, C::name().c_str());
-        });
-        std::printf("  %s: %zu combinations\n", S::name, tl::size<CombinationsOf<S>>);
-        total += tl::size<CombinationsOf<S>>;
-    });
-    std::printf("%zu valid combinations. channels 'grey' is nsp::PathEstimator (grey majorant; a heuristic on a "
-                "single strategy and mis::None on an MIS strategy are rejected); the others are "
-                "nsp::SpectralPathEstimator, only in multi-channel modes: independent tracking with the per-channel "
-                "majorant, spectral tracking with the global one, spectral-mis with either; no directional-mis; "
-                "mis::None for "
-                "single strategies, balance for uni-nee-mis. Independent and spectral-mis rows are rendered once "
-                "per --selection rule (luminance rows end in _lum).\n", total);
+    for (const auto mode : mode_names()) {
+        const std::vector<CombinationInfo> all = infos(mode);
+        for (const CombinationInfo& c : all)
+            std::printf("%-5s %-21s %-13s %-15s %-9s %-13s %-10s %s\n", c.mode, c.channels, c.majorant, c.strategy,
+                        c.heuristic, c.absorption, c.medium, c.name().c_str());
+        std::printf("  %.*s: %zu combinations\n", int(mode.size()), mode.data(), all.size());
+        total += all.size();
+    }
+    std::printf("%zu valid combinations. channels 'grey' is nsp::PathEstimator (a grey majorant: global or grid, "
+                "and in mono also the non-bounding global-signed, global-clamp, grid-signed, grid-clamp; a "
+                "heuristic on a single strategy and mis::None on an MIS strategy are rejected); the others are "
+                "nsp::SpectralPathEstimator, only in multi-channel modes: independent tracking with a per-channel "
+                "majorant (per-channel, channel-grid), spectral tracking with a grey one (global, grid), "
+                "spectral-mis with any of the four; no directional-mis; mis::None for single strategies, balance "
+                "for uni-nee-mis. Majorants other than global and per-channel: absorb-weight only (build time). "
+                "Independent and spectral-mis rows are rendered once per --selection rule (luminance rows end in "
+                "_lum).\n", total);
 }
 
 RenderStats render_in_mode(std::string_view mode, std::size_t index, const RenderRequest& rq, std::vector<float>& rgb) {
@@ -962,6 +1145,7 @@ int run(const Options& o) {
         rq.threads = o.threads;
         rq.seed = seed;
         rq.estimator = o.estimator;
+        rq.majorant = o.majorant;
         return rq;
     };
     for (const TablePlan& t : tables) {
@@ -1007,7 +1191,7 @@ int run(const Options& o) {
             }
             rows.push_back(std::move(row));
         }
-        if (t.scene.kind == SceneKind::Cloud) print_cloud_table(t, o, rows);
+        if (t.scene.kind != SceneKind::Chromatic) print_cloud_table(t, o, rows);
         else print_chromatic_table(t, o, rows, reference ? &*reference : nullptr);
         std::fflush(stdout);
     }

@@ -20,15 +20,20 @@
 
 namespace nsp_examples {
 
-/// One light set-up of one scene: A or B of the grey cloud, C1 or C2 of the chromatic cloud.
+/// One light set-up of one scene: A or B of the grey cloud, C1 or C2 of the chromatic cloud, SA or
+/// SB of the sparse medium (set-up A's or B's lights).
 struct SceneChoice {
     SceneKind kind = SceneKind::Cloud;
-    LightSetup cloud = LightSetup::A;              ///< with SceneKind::Cloud
+    LightSetup cloud = LightSetup::A;                ///< with SceneKind::Cloud and SceneKind::Sparse
     ChromaticSetup chromatic = ChromaticSetup::Env;  ///< with SceneKind::Chromatic
 
-    /// "A", "B", "C1" or "C2".
+    /// "A", "B", "C1", "C2", "SA" or "SB".
     const char* name() const {
-        return kind == SceneKind::Cloud ? nsp_examples::name(cloud) : nsp_examples::name(chromatic);
+        switch (kind) {
+            case SceneKind::Chromatic: return nsp_examples::name(chromatic);
+            case SceneKind::Sparse: return cloud == LightSetup::A ? "SA" : "SB";
+            default: return nsp_examples::name(cloud);
+        }
     }
 };
 
@@ -50,6 +55,7 @@ struct RenderRequest {
     SceneChoice scene;
     LightOverrides lights;
     SelectionRule selection = SelectionRule::Uniform;  ///< ignored by combinations without uses_selection
+    MajorantSettings majorant;  ///< grid resolution and the non-bounding majorants' scale
     int width = 0, height = 0, spp = 0, threads = 1;
     std::uint64_t seed = 1;
     nsp::EstimatorOptions estimator;
@@ -64,7 +70,8 @@ struct RenderStats {
     double cpu_seconds = 0.0;             ///< summed over worker threads
     std::uint64_t samples = 0;
     std::uint64_t lookups = 0;            ///< density lookups, summed over threads
-    std::uint64_t aborted = 0, nonfinite = 0;
+    std::uint64_t steps = 0;              ///< DDA steps of grid majorants, summed over threads
+    std::uint64_t aborted = 0, nonfinite = 0, rejected = 0;  ///< paths by nsp::Status
     std::uint64_t nonzero = 0;            ///< samples with a nonzero estimate
     double variance_of_mean = 0.0;             ///< mean over pixels of the sample variance of the channel mean
     std::array<double, 3> channel_variance{};  ///< per channel: mean over pixels of its sample variance
@@ -78,6 +85,7 @@ struct RenderStats {
         return (channel_variance[0] + channel_variance[1] + channel_variance[2]) / 3.0;
     }
     double lookups_per_sample() const { return double(lookups) / double(samples); }
+    double steps_per_sample() const { return double(steps) / double(samples); }
     double cpu_seconds_per_sample() const { return cpu_seconds / double(samples); }
 };
 

@@ -51,7 +51,7 @@ struct Welford {
 /// Per-thread accumulators, summed after the join.
 struct ThreadTotals {
     nsp::LookupCount counter;
-    std::uint64_t aborted = 0, nonfinite = 0, nonzero = 0;
+    std::uint64_t aborted = 0, nonfinite = 0, rejected = 0, nonzero = 0;
     double variance_of_mean_sum = 0.0, cpu_seconds = 0.0;
     std::array<double, 3> variance_sum{}, mean_sum{};
 };
@@ -115,12 +115,13 @@ Eigen::Array3d to_linear_rgb(const typename S::Spectrum& L, const typename S::Wa
     else return Eigen::Array3d::Constant(double(L[0]));
 }
 
-/// The scene of combination C in `choice`, with the lights the flags add or replace.
+/// The scene of combination C in `choice`, with the lights the flags add or replace and the
+/// majorant built with `settings`.
 template <class C>
-typename C::Scene make_scene(const SceneChoice& choice, const LightOverrides& o) {
+typename C::Scene make_scene(const SceneChoice& choice, const LightOverrides& o, const MajorantSettings& settings) {
     using S = typename C::Spectral;
-    nsp::Lights<S> lights = choice.kind == SceneKind::Cloud ? default_lights<S>(choice.cloud)
-                                                            : chromatic_lights<S>(choice.chromatic);
+    nsp::Lights<S> lights = choice.kind == SceneKind::Chromatic ? chromatic_lights<S>(choice.chromatic)
+                                                                : default_lights<S>(choice.cloud);
     if (o.sphere) {
         const auto& s = *o.sphere;
         lights.set(nsp::SphereLight<S>{nsp::Vec3(s[0], s[1], s[2]), s[3], nsp::constant_coefficient<S>(s[4])});
@@ -131,7 +132,7 @@ typename C::Scene make_scene(const SceneChoice& choice, const LightOverrides& o)
     }
     if (o.env) lights.set(nsp::EnvironmentLight<S>{nsp::constant_coefficient<S>(*o.env)});
     auto medium = C::MediumKind::template make<S>(choice.kind);
-    auto majorant = C::MajorantKind::make(medium);
+    auto majorant = C::MajorantKind::make(medium, settings);
     return typename C::Scene(std::move(medium), std::move(majorant), nsp::HenyeyGreensteinPhase(kPhaseG),
                              std::move(lights));
 }
@@ -189,6 +190,7 @@ RenderStats render(const typename C::Scene& scene, const RenderRequest& rq, std:
                     }
                     if (r.status == nsp::Status::Aborted) ++t.aborted;
                     else if (r.status == nsp::Status::NonFinite) ++t.nonfinite;
+                    else if (r.status == nsp::Status::Rejected) ++t.rejected;
                     if ((r.value != 0.f).any()) ++t.nonzero;
                     const Eigen::Array3d c = to_linear_rgb<S>(r.value, lambda);
                     sum += c;
@@ -226,8 +228,10 @@ RenderStats render(const typename C::Scene& scene, const RenderRequest& rq, std:
     std::array<double, 3> var_channel{}, mean{};
     for (const ThreadTotals& t : totals) {
         st.lookups += t.counter.count();
+        st.steps += t.counter.steps;
         st.aborted += t.aborted;
         st.nonfinite += t.nonfinite;
+        st.rejected += t.rejected;
         st.nonzero += t.nonzero;
         st.cpu_seconds += t.cpu_seconds;
         var_mean += t.variance_of_mean_sum;
@@ -256,7 +260,7 @@ template <nsp::SpectralMode S>
 RenderStats render_combination(std::size_t index, const RenderRequest& request, std::vector<float>& rgb) {
     RenderStats stats;
     const bool found = tl::with_index<CombinationsOf<S>>(index, [&]<class C>(std::type_identity<C>) {
-        const auto scene = detail::make_scene<C>(request.scene, request.lights);
+        const auto scene = detail::make_scene<C>(request.scene, request.lights, request.majorant);
         stats = detail::render<C>(scene, request, rgb);
     });
     if (!found) throw std::out_of_range("render_combination: no combination " + std::to_string(index));
