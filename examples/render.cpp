@@ -61,9 +61,9 @@ constexpr int kChromaticWidth = 32, kChromaticHeight = 32, kChromaticSpp = 128;
 
 /// The sparse medium: a global majorant spends most of its lookups on empty space here (extinction
 /// 60 in ~2% of the box), so a sample costs several times the grey cloud's; a smaller image keeps
-/// the main job's budget. The grid majorant's resolution is --grid-res (default 16: a neutral
+/// the main job's budget (~20 s for the 8 renders on 2 cores). The grid majorant's resolution is --grid-res (default 16: a neutral
 /// middle, not tuned to this medium).
-constexpr int kSparseWidth = 64, kSparseHeight = 64, kSparseSpp = 128;
+constexpr int kSparseWidth = 64, kSparseHeight = 64, kSparseSpp = 256;
 
 /// The estimators of the grey cloud by default: every PathEstimator (the existing table).
 const std::vector<std::string> kCloudEstimators{"grey"};
@@ -138,7 +138,7 @@ PathEstimator (24 renders); then the chromatic cloud, set-ups C1 and C2, rgb and
 128 spp, the grey-majorant baseline uni-nee-mis_balance_absorb-weight and the spectral
 estimators listed under --estimators, uniform and luminance selection (absorb-weight; 15
 renders per set-up and mode, 60 in all), one run each; then the sparse medium, set-up SA, mono,
-64x64, 128 spp, each grey strategy (absorb-weight) with the global and the grid majorant (8
+64x64, 256 spp, each grey strategy (absorb-weight) with the global and the grid majorant (8
 renders). scripts/run-main.sh then adds the heavy-tail comparison: baseline against spectral
 MIS + NEE with each majorant, --runs 5 at 32x32 with a 2048-spp reference image for the
 effective variance (the last example below).
@@ -237,7 +237,7 @@ usage: nsp_render [flags]
                      a tail missed in every pixel adds up there) and the ratios baseline /
                      spectral MIS + NEE of all three (not in mono tables; default: off)
   --spp N            samples per pixel, N >= 2 (default 512 for the cloud, 128 for the
-                     chromatic cloud and the sparse medium); the variance per sample is
+                     chromatic cloud, 256 for the sparse medium); the variance per sample is
                      estimated from the N samples of each pixel
   --res WxH          image size in pixels (default 128x128 for the cloud, 32x32 for the
                      chromatic cloud, 64x64 for the sparse medium); also --width W, --height H

@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # Fresh-machine command 1: set up, build nsp_render (only that target: the tests and benchmarks
 # are run-tests.sh's business), and run the main job. Without arguments:
-#  1. nsp_render's default run: the grey cloud (set-ups A, B) with every estimator and the
-#     chromatic cloud (set-ups C1, C2, rgb and hero, 32x32) with the spectral estimators; EXRs in
-#     ./out, one efficiency table per set-up and mode;
+#  1. nsp_render's default run: the grey cloud (set-ups A, B) with every estimator, the
+#     chromatic cloud (set-ups C1, C2, rgb and hero, 32x32) with the spectral estimators, and the
+#     sparse medium (set-up SA, mono, 64x64, 256 spp) with each grey strategy under the global
+#     and the grid majorant; EXRs in ./out, one efficiency table per set-up and mode;
 #  2. the heavy-tail comparison: the grey-majorant baseline against spectral MIS + NEE (per-channel
 #     and global majorant, uniform selection) on the chromatic cloud, 5 runs each at 32x32. The
 #     baseline's variance is practically infinite: in a typical run it misses the rare huge
@@ -12,7 +13,7 @@
 #     set-up and mode with a third, finite-variance estimator (spectral tracking + NEE, other
 #     seeds) and reports each run's effective variance per sample: spp x the mean squared
 #     error against the reference, minus the reference's own noise.
-# Renders in about 200 s on 2 quiet cores (with the build up to date).
+# Renders in about 210 s on 2 quiet cores (with the build up to date).
 # With arguments, runs nsp_render once with them instead (see build/examples/nsp_render --help).
 set -euo pipefail
 cd "$(dirname "$0")/.."
