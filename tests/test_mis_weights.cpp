@@ -4,7 +4,7 @@
 #include <span>
 #include <string>
 
-#include "common.hpp"
+#include "majorants.hpp"
 
 namespace {
 
@@ -55,12 +55,12 @@ TEST_CASE_TEMPLATE_DEFINE("MIS weights of unidirectional and NEE sum to 1 for on
     for (int seed = 0; seed < 3; ++seed) {
         const M medium = make_medium<M>(box, 0.8f + 0.7f * float(seed), spec<S>(0.3f, 0.1f, 0.6f),
                                         spec<S>(0.7f, 1.2f, 0.4f), std::uint64_t(seed + 10));
-        const GlobalMajorant<M> tight(medium);
-        for (const float looseness : {1.f, 2.f}) {
-            const GlobalMajorant<M> maj(medium, tight.value() * looseness);
+        // The majorant axis: the global majorant, tight and 2.x loose, and every other grey
+        // model and bound policy that applies to M (grid; Signed and Clamp below the extinction).
+        auto run = [&](const auto& maj, const std::string& maj_name) {
             for (int i = 0; i < 200; ++i) {
                 CAPTURE(seed);
-                CAPTURE(looseness);
+                CAPTURE(maj_name);
                 CAPTURE(i);
                 // A real vertex x reached along wo; NEE's light sample fixes the direction and the
                 // light vertex; the unidirectional segment along it is drawn by delta tracking.
@@ -97,7 +97,7 @@ TEST_CASE_TEMPLATE_DEFINE("MIS weights of unidirectional and NEE sum to 1 for on
                 float prev = 0.f;
                 for (const float t : nulls) {
                     const float tau = float(majorant_optical_depth<M>(maj, ray, prev, t, lambda));
-                    REQUIRE(nee(t, medium.coefficients(ray.at(t), lambda), majorant_at<M>(maj, ray, t, lambda), tau));
+                    REQUIRE(nee(t, tracked_coefficients(medium, maj, ray, t, lambda), majorant_at<M>(maj, ray, t, lambda), tau));
                     prev = t;
                 }
                 REQUIRE(double(nee.out.null_pdf_product) == doctest::Approx(p_nulls).epsilon(1e-4));
@@ -120,7 +120,11 @@ TEST_CASE_TEMPLATE_DEFINE("MIS weights of unidirectional and NEE sum to 1 for on
                                                                log_track, log_ratio);
                 }
             }
-        }
+        };
+        const GlobalMajorant<M> tight(medium);
+        run(tight, "global");
+        run(GlobalMajorant<M>(medium, tight.value() * 2.f), "global-loose");
+        for_each_kind<PdfGreyKinds, M>([&](auto kind) { run(decltype(kind)::make(medium), decltype(kind)::name); });
     }
     CHECK(passed_with_nulls > 20);  // the non-trivial case (prod P_n != 1) was exercised
 }

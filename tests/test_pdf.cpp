@@ -2,9 +2,10 @@
 // evaluation of the same vertices (pdf.hpp), and the null-probability products that
 // null-scattering MIS uses equal the ratio of the two segment pdfs (THEORY 4, 5.1, 6).
 #include <span>
+#include <string>
 #include <type_traits>
 
-#include "common.hpp"
+#include "majorants.hpp"
 
 namespace {
 
@@ -29,12 +30,12 @@ TEST_CASE_TEMPLATE_DEFINE("tracking reports the log pdf of its vertices; null pr
     for (int seed = 0; seed < 4; ++seed) {
         const M medium = make_medium<M>(box, 0.5f + float(seed), spec<S>(0.3f, 0.1f, 0.6f),
                                         spec<S>(0.7f, 1.2f, 0.4f), std::uint64_t(seed + 1));
-        const GlobalMajorant<M> tight(medium);
-        for (const float looseness : {1.f, 2.5f}) {
-            const GlobalMajorant<M> maj(medium, tight.value() * looseness);
+        // The majorant axis: the global majorant, tight and 2.5x loose, and every other grey
+        // model and bound policy that applies to M (grid; Signed and Clamp below the extinction).
+        auto run = [&](const auto& maj, const std::string& maj_name) {
             for (int i = 0; i < 250; ++i) {
                 CAPTURE(seed);
-                CAPTURE(looseness);
+                CAPTURE(maj_name);
                 CAPTURE(i);
                 const Ray ray{random_point(rng, around), random_direction(rng)};
                 const float tmax = i % 3 == 0 ? kInf : 4.f * rng.uniform();
@@ -84,7 +85,11 @@ TEST_CASE_TEMPLATE_DEFINE("tracking reports the log pdf of its vertices; null pr
                     ++ratio_terminated;
                 }
             }
-        }
+        };
+        const GlobalMajorant<M> tight(medium);
+        run(tight, "global");
+        run(GlobalMajorant<M>(medium, tight.value() * 2.5f), "global-loose");
+        for_each_kind<PdfGreyKinds, M>([&](auto kind) { run(decltype(kind)::make(medium), decltype(kind)::name); });
     }
     // The test must have exercised every branch it checks.
     CHECK(delta_passed_with_nulls > 20);

@@ -37,6 +37,12 @@ struct ChannelGridKind {
     template <class M> using type = ChannelGridMajorant<M>;
     template <class M> static type<M> make(const M& m) { return type<M>(m, kTestGridRes); }
 };
+/// Half the global bound, signed weights (policy a): unbiased; applies to every medium.
+struct SignedGlobalKind {
+    static constexpr const char* name = "global-signed-0.5";
+    template <class M> using type = GlobalMajorant<M, bound::Signed>;
+    template <class M> static type<M> make(const M& m) { return type<M>(m, 0.5f * m.max_extinction()); }
+};
 /// Half the grid bound, signed weights (policy a): unbiased.
 struct SignedGridKind {
     static constexpr const char* name = "grid-signed-0.5";
@@ -71,6 +77,10 @@ template <class Kinds, class M, class F>
 void for_each_kind(F&& f) {
     std::apply([&](auto... k) { (detail::call_if_applies<M>(f, k), ...); }, Kinds{});
 }
+
+/// The grey majorant kinds the pdf suites run over besides the global majorant: every model and
+/// every bound policy whose pdfs are evaluated independently (Reject only discards).
+using PdfGreyKinds = std::tuple<SignedGlobalKind, GridKind, SignedGridKind, ClampGridKind>;
 
 /// The grey majorant kinds whose estimates are unbiased for the medium itself.
 using UnbiasedGreyKinds = std::tuple<GlobalKind, GridKind, SignedGridKind>;
