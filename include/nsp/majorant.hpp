@@ -1,10 +1,12 @@
-// nsp/majorant.hpp: majorant policies, piecewise-constant bounds walked segment by segment.
+// nsp/majorant.hpp: majorant policies, piecewise-constant bounds walked segment by segment, and
+// the bound policies that say what tracking does where a majorant lies below the extinction.
 //
-// The free-flight loop (tracking.hpp) iterates over majorant segments from the start, so a grid
-// majorant walked by a DDA (ROADMAP 3) is a new model of this concept, not a new loop. A segment
-// carries either one grey value (`float`) or one value per channel (the mode's Spectrum): free
-// flight samples with the sampling channel's value, and the other channels' pdfs of the same
-// vertices are evaluated from theirs (THEORY 5.3).
+// The free-flight loop (tracking.hpp) iterates over majorant segments from the start, so every
+// majorant model is an iterator over segments: one segment for the global and per-channel
+// majorants here, one per grid cell for the voxel-grid majorants of majorants/grid.hpp (walked
+// by a DDA). A segment carries either one grey value (`float`) or one value per channel (the
+// mode's Spectrum): free flight samples with the sampling channel's value, and the other
+// channels' pdfs of the same vertices are evaluated from theirs (THEORY 5.3).
 #pragma once
 
 #include <cmath>
