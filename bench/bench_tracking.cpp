@@ -12,9 +12,15 @@
 // Two diagnostics explain the ratio: chained raw lookups (latency, no overlap) and tracking
 // through a homogeneous medium (the loop's own cost). bench/report.py prints the ratios.
 //
+// Grid majorants: delta and ratio tracking on the same cloud and rays under a GridMajorant of 8,
+// 16 and 64 cells per axis (Mono): the DDA loop's lookup rate next to the raw rate and the
+// global majorant's (bench/report.py, majorant column); steps/call counts the cells the DDA
+// crossed per tracked ray.
+//
 // Every tracker also runs in Hero<4> on the same grey cloud (coefficients tabulated over
 // wavelength, four wavelengths drawn per tracked ray): with Mono and Rgb, what each spectral mode
 // costs on a medium that does not need it (bench/RESULTS.md, "cost of each spectral mode").
+#include <type_traits>
 #include <vector>
 
 #include <benchmark/benchmark.h>
@@ -140,6 +146,21 @@ struct Trivial {
     }
 };
 
+/// The default cloud (Mono) under a GridMajorant of R cells per axis, built once.
+template <int R>
+struct CloudGrid {
+    template <nsp::SpectralMode S>
+    static const auto& medium() { return Cloud::medium<S>(); }
+    template <nsp::SpectralMode S>
+    static const auto& majorant() {
+        static const nsp::GridMajorant<std::remove_cvref_t<decltype(medium<S>())>> maj(medium<S>(), R);
+        return maj;
+    }
+};
+using CloudGrid8 = CloudGrid<8>;
+using CloudGrid16 = CloudGrid<16>;
+using CloudGrid64 = CloudGrid<64>;
+
 /// One tracked ray per iteration, cycling through tracking_rays(); the generator runs on across
 /// iterations, so every pass over the set draws new collisions. Hero mode draws each ray's
 /// wavelengths from the same generator.
@@ -158,6 +179,9 @@ void BM_Track(benchmark::State& state) {
         i = (i + 1) & kSetMask;
     }
     report_lookups(state, counter, "lookups/call");
+    if constexpr (requires { counter.steps; })
+        if (counter.steps > 0)
+            state.counters["steps/call"] = benchmark::Counter(double(counter.steps), benchmark::Counter::kAvgIterations);
 }
 
 BENCHMARK_TEMPLATE(BM_Track, DeltaEvent, Mono)->MinTime(kMinTime);
@@ -175,6 +199,14 @@ BENCHMARK_TEMPLATE(BM_Track, DeltaWeight, Hero4)->MinTime(kMinTime);
 BENCHMARK_TEMPLATE(BM_Track, RatioPlain, Hero4)->MinTime(kMinTime);
 BENCHMARK_TEMPLATE(BM_Track, RatioNullEvent, Hero4)->MinTime(kMinTime);
 BENCHMARK_TEMPLATE(BM_Track, RatioNullWeight, Hero4)->MinTime(kMinTime);
+
+// The DDA loop: the same cloud and rays under grid majorants (Mono).
+BENCHMARK_TEMPLATE(BM_Track, DeltaWeight, Mono, CloudGrid8)->MinTime(kMinTime);
+BENCHMARK_TEMPLATE(BM_Track, DeltaWeight, Mono, CloudGrid16)->MinTime(kMinTime);
+BENCHMARK_TEMPLATE(BM_Track, DeltaWeight, Mono, CloudGrid64)->MinTime(kMinTime);
+BENCHMARK_TEMPLATE(BM_Track, RatioPlain, Mono, CloudGrid8)->MinTime(kMinTime);
+BENCHMARK_TEMPLATE(BM_Track, RatioPlain, Mono, CloudGrid16)->MinTime(kMinTime);
+BENCHMARK_TEMPLATE(BM_Track, RatioPlain, Mono, CloudGrid64)->MinTime(kMinTime);
 
 // Diagnostic: the loop's own cost, on the trivial medium.
 BENCHMARK_TEMPLATE(BM_Track, DeltaWeight, Mono, Trivial)->MinTime(kMinTime);

@@ -128,18 +128,21 @@ def report_raw_and_tracking(md, runs, med):
             overhead.append([tracker, MODE_LABEL.get(mode, mode), f"{row['lookups/call']:.1f}",
                              f"{rate / 1e6:.1f}", f"{ns(row) / row['lookups/call']:.1f}"])
             continue
+        grid = re.fullmatch(r"CloudGrid(\d+)", media or "")
+        majorant = f"grid {grid.group(1)}" if grid else "global"
+        steps = f"{row['steps/call']:.1f}" if "steps/call" in row else "-"
         r_tracked = rate / raw.get((mode, "tracked"), float("nan"))
         r_uniform = rate / raw.get((mode, "uniform"), float("nan"))
         r_chained = rate / raw.get((mode, "chained (latency)"), float("nan"))
         ok = "yes" if min(r_tracked, r_uniform) >= TARGET else "NO"
-        rows.append([tracker, MODE_LABEL.get(mode, mode), f"{ns(row):.0f}", f"{row['lookups/call']:.1f}",
+        rows.append([tracker, MODE_LABEL.get(mode, mode), majorant, f"{ns(row):.0f}", f"{row['lookups/call']:.1f}", steps,
                      f"{rate / 1e6:.1f}", f"{ns(row) / row['lookups/call']:.1f}",
                      f"{r_tracked:.2f}", f"{r_uniform:.2f}", f"{r_chained:.2f}", ok,
-                     cv(runs[name], "lookups/s"), (MODE_ORDER.get(mode, 9), tracker)])
+                     cv(runs[name], "lookups/s"), (MODE_ORDER.get(mode, 9), tracker, int(grid.group(1)) if grid else 0)])
     if rows:
         title(md, f"Tracking loop vs raw lookups (target: ratio >= {TARGET})")
         rows.sort(key=lambda r: r[-1])
-        table(md, ["tracker", "mode", "ns/call", "lookups/call", "M lookups/s", "ns/lookup",
+        table(md, ["tracker", "mode", "majorant", "ns/call", "lookups/call", "DDA steps/call", "M lookups/s", "ns/lookup",
                    "/raw tracked", "/raw uniform", "/raw chained", f">= {TARGET}", "cv"], [r[:-1] for r in rows])
     if overhead:
         title(md, "Diagnostic: the loop alone (homogeneous medium, same majorant and rays)")
