@@ -61,6 +61,8 @@ CHROMA_ORDER = ["channel-global"] + [f"channel-grid{r}" for r in (1, 4, 8, 16, 3
 def fmt(x, digits=3):
     if x == 0:
         return "0"
+    if abs(x) >= 1e5:
+        return f"{x:.2e}"
     if abs(x) >= 1000:
         return f"{x:.0f}"
     return f"{x:.{digits}g}"
@@ -92,9 +94,10 @@ def markdown(rows):
                 r = [medium, label, fmt(b["lookups/sample"]), fmt(b["null/sample"]), fmt(b["real/sample"]),
                      fmt(b["ratio_stops/sample"]), fmt(b["steps/sample"]), f"{b['ns/sample']:.0f}", fmt(b["var"]), fmt(b["LTUV"]),
                      fmt(b["ns*var"]), f"{b['lookups/sample'] / base['lookups/sample']:.3f}",
-                     f"{b['ns*var'] / base['ns*var']:.3f}"]
+                     fmt(b["ns*var"] / base["ns*var"])]
                 if grey:
-                    r += [f"{rmse_equal_time(b, base['ns/sample']):.4f}", f"{b['bias2']:.2e}", f"{b['mean_z']:.1f}",
+                    rm = rmse_equal_time(b, base['ns/sample'])
+                    r += [f"{rm:.4f}" if rm < 100 else fmt(rm), f"{b['bias2']:.2e}", f"{b['mean_z']:.1f}",
                           fmt(b["bad/sample"])]
                 else:
                     z = (b["img_mean"] - base["img_mean"]) / math.hypot(b["img_mean_se"], base["img_mean_se"]) \
