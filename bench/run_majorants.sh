@@ -3,7 +3,7 @@
 # bench/bench_majorants.cpp with 5 repetitions in random interleaved order (fixed iteration
 # counts; the counters are the same in every repetition, times are medians), writes
 # bench/majorants.json and plots it to bench/majorants.png (bench/plot_majorants.py, matplotlib).
-# About 4 minutes on 2 cores (the 4096-spp reference images take ~30 s of it).
+# About 3-4.5 minutes on 2 cores (the 4096-spp reference images take ~30 s of it).
 #
 # Build directory: $NSP_BENCH_BUILD if set, else ./build-bench (configured here if needed).
 # Environment: NSP_BENCH_REPS (default 5), NSP_BENCH_JOBS (default nproc). Extra arguments go to
