@@ -501,7 +501,9 @@ std::vector<Candidate> candidates(std::string_view mode, const std::vector<Selec
         c.name = info.name();
         for (const auto f : split(c.name, '_')) {
             c.fields.emplace_back(f);
-            if (f != c.majorant) c.key += (c.key.empty() ? "" : "_") + std::string(f);
+            if (f == c.majorant) continue;
+            if (!c.key.empty()) c.key += '_';  // not "_" + std::string(f): GCC 12 warns (-Wrestrict, bug 105329)
+            c.key += f;
         }
         if (!info.spectral) c.fields.emplace_back("grey");
         if (info.plain_global) c.fields.emplace_back("global");
@@ -851,7 +853,7 @@ void print_majorant_comparison(const std::vector<Row>& rows, const Metrics& m) {
                         "row is cheaper or less noisy):\n");
         header = true;
         const auto med = [](const Row& x, auto f) { return x.median(f); };
-        const auto ratio = [](double a, double b) { return b > 0.0 && std::isfinite(a / b) ? num(a / b) : "n/a"; };
+        const auto ratio = [](double x, double y) { return y > 0.0 && std::isfinite(x / y) ? num(x / y) : "n/a"; };
         const auto lookups = [](const RenderStats& s) { return s.lookups_per_sample(); };
         const auto cpu = [](const RenderStats& s) { return s.cpu_seconds_per_sample(); };
         const auto [z, c] = mean_gap(r, *b);
