@@ -174,6 +174,11 @@ FlightEnd<MajorantValue<Maj, M>> free_flight(const M& medium, const Maj& majoran
         else tau += (mu > 0.f).select(mu * len, 0.f);
     };
     std::uint32_t collisions = 0;
+    // The majorant optical depth left to the next tentative collision (< 0: draw a new one). A
+    // step that leaves a segment carries what it did not use into the next segment instead of
+    // drawing again: the same exponential distribution, one log and one random number less per
+    // grid cell crossed.
+    float e = -1.f;
     while (auto seg = segments.next()) {
         const float mu_bar = channel_of(seg->sigma_maj, channel);
         if (!(mu_bar > 0.f)) {  // nothing to collide with on this segment
@@ -185,15 +190,17 @@ FlightEnd<MajorantValue<Maj, M>> free_flight(const M& medium, const Maj& majoran
             // Exponential step: E = -ln(1 - u) majorant optical depths. logf, not log1pf: 1 - u is
             // exact for u on Pcg32's 2^-24 grid, so E agrees with -log1pf(-u) within 1 ulp (within
             // 2^-24 for finer u), and glibc's log1pf took 30% of this loop (bench/RESULTS.md).
-            const float e = -std::log(1.f - rng.uniform());
+            if (!(e > 0.f)) e = -std::log(1.f - rng.uniform());
             const float dt = e / mu_bar;
             if (!(dt < seg->t1 - t)) {  // the step leaves the segment (also catches inf)
                 add_depth(seg->sigma_maj, seg->t1 - t);
+                e -= mu_bar * (seg->t1 - t);  // <= 0 after rounding at the boundary: draw anew
                 break;
             }
             t += dt;
             if constexpr (grey) tau += e;
             else add_depth(seg->sigma_maj, dt);
+            e = -1.f;
             if (++collisions > max_collisions) return {false, true, false, t, V{}};
             counter.lookup();
             auto coeff = medium.coefficients(ray.at(t), lambda);

@@ -56,6 +56,9 @@ public:
             h_[a] = cell[a];
             o_[a] = r.o[a];
             d_[a] = r.d[a];
+            // 1 / d is finite for a normal d: multiply then (a division per cell crossed was a
+            // third of a DDA step); a denormal d keeps the division (1 / d would be inf).
+            inv_[a] = std::abs(r.d[a]) >= std::numeric_limits<float>::min() ? 1.f / r.d[a] : 0.f;
             res_[a] = res[a];
             const float p = r.o[a] + r.d[a] * t_;
             int i = int(std::floor((p - box.lo[a]) / cell[a]));
@@ -104,9 +107,11 @@ private:
     /// Plane k of axis a, lo + k h: the grid's cell faces.
     float plane(int a, int k) const noexcept { return lo_[a] + float(k) * h_[a]; }
     /// Where the ray crosses plane k of axis a (d[a] != 0).
-    float plane_t(int a, int k) const noexcept { return (plane(a, k) - o_[a]) / d_[a]; }
+    float plane_t(int a, int k) const noexcept {
+        return inv_[a] != 0.f ? (plane(a, k) - o_[a]) * inv_[a] : (plane(a, k) - o_[a]) / d_[a];
+    }
 
-    float lo_[3]{}, h_[3]{}, o_[3]{}, d_[3]{}, next_[3]{};
+    float lo_[3]{}, h_[3]{}, o_[3]{}, d_[3]{}, inv_[3]{}, next_[3]{};
     int res_[3]{}, cell_[3]{}, step_[3]{};
     float t_ = 0.f, t_end_ = 0.f;
     std::uint32_t steps_ = 0;
