@@ -151,11 +151,12 @@ private:
 
 /// Wraps a majorant iterator. free_flight returns from inside its segment loop exactly when the
 /// collision callback stopped the flight (or it was aborted: bad/sample); a flight that passes
-/// runs the iterator to its end. A stopped flight of L lookups that left X segments before the
-/// one it stopped in drew X + 2L random numbers if it was delta tracking (one step and one event
-/// choice per collision: it stopped at a real collision) and X + L if it was ratio tracking (no
-/// event choice: every collision null, stopped because the weight reached 0). The destructor
-/// tells the two apart.
+/// runs the iterator to its end. A stopped flight of L lookups drew 2L random numbers if it was
+/// delta tracking (one step and one event choice per collision: it stopped at a real collision)
+/// and L if it was ratio tracking (no event choice: every collision null, stopped because the
+/// weight reached 0); a step that leaves a segment carries its remaining optical depth into the
+/// next one (29dc1a3) and draws nothing, except after a rounding to <= 0 at the boundary (then the
+/// flight is left unclassified and counted). The destructor tells the two apart.
 template <class I>
 class CountingIterator {
 public:
@@ -165,15 +166,14 @@ public:
     CountingIterator& operator=(const CountingIterator&) = delete;
     ~CountingIterator() {
         if (ended_) return;
-        const std::uint64_t l = *t_->lookups - lookups0_, u = t_->uniforms - uniforms0_ - (segments_ - 1);
+        const std::uint64_t l = *t_->lookups - lookups0_, u = t_->uniforms - uniforms0_;
         if (l > 0 && u == 2 * l) ++t_->real;
         else if (l > 0 && u == l) ++t_->ratio_stops;
         else ++t_->unclassified;
     }
     auto next() noexcept {
         auto s = it_.next();
-        if (s) ++segments_;
-        else ended_ = true;
+        if (!s) ended_ = true;
         return s;
     }
     std::uint32_t steps() const noexcept
@@ -185,7 +185,7 @@ public:
 private:
     I it_;
     Tally* t_;
-    std::uint64_t uniforms0_, lookups0_, segments_ = 0;
+    std::uint64_t uniforms0_, lookups0_;
     bool ended_ = false;
 };
 
