@@ -52,12 +52,9 @@ inline float value_noise(float x, float y, float z) {
     return v;
 }
 
-/// The cloud's densities in [0, 1] on a kGridRes^3 grid over [-1, 1]^3 (x fastest).
-inline std::vector<float> default_cloud_density() {
-    struct Blob { float x, y, z, r; };
-    // Body, head and two ears: a rough rabbit silhouette.
-    constexpr std::array<Blob, 4> blobs{{{0.f, -0.3f, 0.f, 0.6f}, {0.15f, 0.25f, 0.f, 0.35f},
-                                         {0.05f, 0.7f, 0.f, 0.14f}, {0.3f, 0.68f, 0.f, 0.14f}}};
+/// density(x, y, z) at every voxel centre of a kGridRes^3 grid over [-1, 1]^3 (x fastest).
+template <class F>
+std::vector<float> sample_voxel_centres(F&& density) {
     std::vector<float> d(std::size_t(kGridRes) * kGridRes * kGridRes);
     for (int z = 0; z < kGridRes; ++z)
         for (int y = 0; y < kGridRes; ++y)
@@ -65,20 +62,31 @@ inline std::vector<float> default_cloud_density() {
                 const float px = -1.f + 2.f * (float(x) + 0.5f) / kGridRes;
                 const float py = -1.f + 2.f * (float(y) + 0.5f) / kGridRes;
                 const float pz = -1.f + 2.f * (float(z) + 0.5f) / kGridRes;
-                float shape = 0.f;
-                for (const Blob& b : blobs) {
-                    const float r = std::sqrt((px - b.x) * (px - b.x) + (py - b.y) * (py - b.y) + (pz - b.z) * (pz - b.z));
-                    shape = std::max(shape, 1.f - r / b.r);
-                }
-                const float n = 0.6f * value_noise(4.f * px + 10.f, 4.f * py, 4.f * pz) +
-                                0.4f * value_noise(9.f * px, 9.f * py + 5.f, 9.f * pz);
-                // Squaring keeps a dense core but spreads the densities over [0, 1], so the global
-                // majorant is loose over most of the cloud and tracking meets many null collisions.
-                const float c = std::clamp(3.f * shape - 0.6f * n, 0.f, 1.f);
-                const float v = c * c;
-                d[std::size_t(x) + std::size_t(kGridRes) * (std::size_t(y) + std::size_t(kGridRes) * std::size_t(z))] = v;
+                d[std::size_t(x) + std::size_t(kGridRes) * (std::size_t(y) + std::size_t(kGridRes) * std::size_t(z))] =
+                    density(px, py, pz);
             }
     return d;
+}
+
+/// The cloud's densities in [0, 1] on a kGridRes^3 grid over [-1, 1]^3 (x fastest).
+inline std::vector<float> default_cloud_density() {
+    struct Blob { float x, y, z, r; };
+    // Body, head and two ears: a rough rabbit silhouette.
+    constexpr std::array<Blob, 4> blobs{{{0.f, -0.3f, 0.f, 0.6f}, {0.15f, 0.25f, 0.f, 0.35f},
+                                         {0.05f, 0.7f, 0.f, 0.14f}, {0.3f, 0.68f, 0.f, 0.14f}}};
+    return sample_voxel_centres([&](float px, float py, float pz) {
+        float shape = 0.f;
+        for (const Blob& b : blobs) {
+            const float r = std::sqrt((px - b.x) * (px - b.x) + (py - b.y) * (py - b.y) + (pz - b.z) * (pz - b.z));
+            shape = std::max(shape, 1.f - r / b.r);
+        }
+        const float n = 0.6f * value_noise(4.f * px + 10.f, 4.f * py, 4.f * pz) +
+                        0.4f * value_noise(9.f * px, 9.f * py + 5.f, 9.f * pz);
+        // Squaring keeps a dense core but spreads the densities over [0, 1], so the global
+        // majorant is loose over most of the cloud and tracking meets many null collisions.
+        const float c = std::clamp(3.f * shape - 0.6f * n, 0.f, 1.f);
+        return c * c;
+    });
 }
 
 /// Default medium coefficients per unit density: extinction 20, albedo 0.9 (grey).
@@ -173,27 +181,19 @@ inline std::vector<float> sparse_density() {
     constexpr std::array<Puff, 5> puffs{{{-0.55f, -0.6f, 0.1f, 0.22f}, {0.45f, -0.35f, -0.3f, 0.16f},
                                          {0.1f, 0.5f, 0.35f, 0.18f}, {-0.4f, 0.45f, -0.45f, 0.12f},
                                          {0.6f, 0.6f, 0.5f, 0.14f}}};
-    std::vector<float> d(std::size_t(kGridRes) * kGridRes * kGridRes);
-    for (int z = 0; z < kGridRes; ++z)
-        for (int y = 0; y < kGridRes; ++y)
-            for (int x = 0; x < kGridRes; ++x) {
-                const float px = -1.f + 2.f * (float(x) + 0.5f) / kGridRes;
-                const float py = -1.f + 2.f * (float(y) + 0.5f) / kGridRes;
-                const float pz = -1.f + 2.f * (float(z) + 0.5f) / kGridRes;
-                float shape = 0.f;
-                for (const Puff& p : puffs) {
-                    const float r = std::sqrt((px - p.x) * (px - p.x) + (py - p.y) * (py - p.y) + (pz - p.z) * (pz - p.z));
-                    shape = std::max(shape, 1.f - r / p.r);
-                }
-                // The plume: a tube of radius 0.06 around a curve rising from the first puff.
-                const float cx = -0.55f + 0.35f * std::sin(2.f * (py + 0.6f)), cz = 0.1f + 0.2f * (py + 0.6f);
-                const float rp = std::sqrt((px - cx) * (px - cx) + (pz - cz) * (pz - cz));
-                if (py > -0.6f && py < 0.9f) shape = std::max(shape, 0.5f * (1.f - rp / 0.06f));
-                const float n = value_noise(7.f * px + 3.f, 7.f * py, 7.f * pz - 2.f);
-                const float c = std::clamp(2.f * shape - 0.3f * n, 0.f, 1.f);
-                d[std::size_t(x) + std::size_t(kGridRes) * (std::size_t(y) + std::size_t(kGridRes) * std::size_t(z))] = c;
-            }
-    return d;
+    return sample_voxel_centres([&](float px, float py, float pz) {
+        float shape = 0.f;
+        for (const Puff& p : puffs) {
+            const float r = std::sqrt((px - p.x) * (px - p.x) + (py - p.y) * (py - p.y) + (pz - p.z) * (pz - p.z));
+            shape = std::max(shape, 1.f - r / p.r);
+        }
+        // The plume: a tube of radius 0.06 around a curve rising from the first puff.
+        const float cx = -0.55f + 0.35f * std::sin(2.f * (py + 0.6f)), cz = 0.1f + 0.2f * (py + 0.6f);
+        const float rp = std::sqrt((px - cx) * (px - cx) + (pz - cz) * (pz - cz));
+        if (py > -0.6f && py < 0.9f) shape = std::max(shape, 0.5f * (1.f - rp / 0.06f));
+        const float n = value_noise(7.f * px + 3.f, 7.f * py, 7.f * pz - 2.f);
+        return std::clamp(2.f * shape - 0.3f * n, 0.f, 1.f);
+    });
 }
 
 /// The sparse medium: sparse_density() with extinction kSparseExtinction and the default albedo.

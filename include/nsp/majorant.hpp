@@ -90,16 +90,17 @@ void require_majorant_value(float value, float bound, const char* what, const ch
     }
 }
 
-/// Rejects a majorant scale for policy B: it must be finite, >= 1 under bound::Guaranteed and
-/// > 0 under the others.
+/// Returns a majorant scale allowed for policy B, or throws: it must be finite, >= 1 under
+/// bound::Guaranteed and > 0 under the others.
 template <class B>
-void require_majorant_scale(float scale, const char* what) {
+float require_majorant_scale(float scale, const char* what) {
     if (!std::isfinite(scale) || !(scale > 0.f))
         fail(what, " = ", scale, " is not allowed: it must be finite and > 0");
     if constexpr (!B::allows_below)
         if (scale < 1.f)
             fail(what, " = ", scale, " is below 1: bound::Guaranteed requires mu_bar >= mu_t everywhere "
                  "(bound::Signed, Clamp or Reject allow a scale below 1)");
+    return scale;
 }
 }  // namespace detail
 
@@ -257,7 +258,9 @@ public:
     /// Each channel's extinction bound times `scale`; throws InvalidArgument if one is not
     /// finite or `scale` is not allowed.
     explicit ChannelMajorant(const M& medium, float scale = 1.f)
-        : bounds_(medium.bounds()), bound_(nsp::scale(medium.extinction_bound_coefficient(), checked(scale))) {
+        : bounds_(medium.bounds()),
+          bound_(nsp::scale(medium.extinction_bound_coefficient(),
+                            detail::require_majorant_scale<B>(scale, "ChannelMajorant scale"))) {
         detail::require_finite_nonnegative(max_value(bound_), "ChannelMajorant: the medium's extinction bound");
     }
 
@@ -271,11 +274,6 @@ public:
     }
 
 private:
-    static float checked(float scale) {
-        detail::require_majorant_scale<B>(scale, "ChannelMajorant scale");
-        return scale;
-    }
-
     Box bounds_;
     typename Spectral::Coefficient bound_;
 };

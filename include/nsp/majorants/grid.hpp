@@ -158,6 +158,10 @@ public:
     }
 
     float operator[](std::size_t i) const noexcept { return values_[i]; }
+    /// The value of cell (x, y, z).
+    float at(int x, int y, int z) const noexcept {
+        return values_[std::size_t(x) + std::size_t(res_[0]) * (std::size_t(y) + std::size_t(res_[1]) * std::size_t(z))];
+    }
     const float* data() const noexcept { return values_.data(); }
     std::array<int, 3> resolution() const noexcept { return res_; }
     std::size_t memory_bytes() const noexcept { return values_.size() * sizeof(float); }
@@ -213,7 +217,7 @@ public:
     /// Throws InvalidArgument on a resolution outside [1, 4096] per axis (2^28 cells in all), a
     /// scale the policy does not allow, or a medium whose bounds are not finite.
     GridMajorant(const M& medium, std::array<int, 3> resolution, float scale = 1.f)
-        : grid_(medium, resolution, checked(scale), "GridMajorant"),
+        : grid_(medium, resolution, detail::require_majorant_scale<B>(scale, "GridMajorant scale"), "GridMajorant"),
           unit_(max_value(medium.extinction_per_density())) {}
     GridMajorant(const M& medium, int resolution, float scale = 1.f)
         : GridMajorant(medium, {resolution, resolution, resolution}, scale) {}
@@ -224,22 +228,13 @@ public:
     }
 
     /// The majorant of cell (x, y, z).
-    float cell(int x, int y, int z) const noexcept { return grid_[index(x, y, z)] * unit_; }
+    float cell(int x, int y, int z) const noexcept { return grid_.at(x, y, z) * unit_; }
     std::array<int, 3> resolution() const noexcept { return grid_.resolution(); }
     Vec3 cell_size() const noexcept { return grid_.cell_size(); }
     /// Bytes of cell storage (one float per cell).
     std::size_t memory_bytes() const noexcept { return grid_.memory_bytes(); }
 
 private:
-    static float checked(float scale) {
-        detail::require_majorant_scale<B>(scale, "GridMajorant scale");
-        return scale;
-    }
-    std::size_t index(int x, int y, int z) const noexcept {
-        const auto r = grid_.resolution();
-        return std::size_t(x) + std::size_t(r[0]) * (std::size_t(y) + std::size_t(r[1]) * std::size_t(z));
-    }
-
     detail::MajorantGrid<M> grid_;
     float unit_;
 };
@@ -257,7 +252,7 @@ public:
 
     /// Throws as GridMajorant does.
     ChannelGridMajorant(const M& medium, std::array<int, 3> resolution, float scale = 1.f)
-        : grid_(medium, resolution, checked(scale), "ChannelGridMajorant"),
+        : grid_(medium, resolution, detail::require_majorant_scale<B>(scale, "ChannelGridMajorant scale"), "ChannelGridMajorant"),
           unit_(medium.extinction_per_density()) {}
     ChannelGridMajorant(const M& medium, int resolution, float scale = 1.f)
         : ChannelGridMajorant(medium, {resolution, resolution, resolution}, scale) {}
@@ -269,9 +264,7 @@ public:
 
     /// Every channel's majorant in cell (x, y, z) at wavelengths l.
     Spectrum cell(int x, int y, int z, const typename Spectral::Wavelengths& l) const noexcept {
-        const auto r = grid_.resolution();
-        return Spectral::sample(unit_, l) *
-               grid_[std::size_t(x) + std::size_t(r[0]) * (std::size_t(y) + std::size_t(r[1]) * std::size_t(z))];
+        return Spectral::sample(unit_, l) * grid_.at(x, y, z);
     }
     std::array<int, 3> resolution() const noexcept { return grid_.resolution(); }
     Vec3 cell_size() const noexcept { return grid_.cell_size(); }
@@ -279,10 +272,6 @@ public:
     std::size_t memory_bytes() const noexcept { return grid_.memory_bytes(); }
 
 private:
-    static float checked(float scale) {
-        detail::require_majorant_scale<B>(scale, "ChannelGridMajorant scale");
-        return scale;
-    }
 
     detail::MajorantGrid<M> grid_;
     typename Spectral::Coefficient unit_;
