@@ -52,7 +52,7 @@ using namespace nsp_examples;
 // Defaults
 
 /// The grey cloud keeps the resolution and sample count of the existing table.
-constexpr int kCloudWidth = 128, kCloudHeight = 128, kCloudSpp = 512;
+constexpr int kCloudWidth = 128, kCloudHeight = 128, kCloudSpp = 256;
 /// The chromatic cloud: its tracking costs several times the grey cloud's lookups per sample, and
 /// scripts/run-main.sh (the grey cloud's ~100 s, these 4 tables, the heavy-tail comparison with its
 /// reference images) must render in about 200 s on 2 cores. The size of the comparison, so that
@@ -133,15 +133,15 @@ constexpr const char* kHelp = R"(nsp_render: render the default cloud scenes wit
 efficiency table per light set-up and spectral mode (LTUV = density lookups per sample x
 variance per sample; lower is better).
 
-Default run (no flags): the grey cloud, set-ups A and B, mono, 128x128, 512 spp, every
+Default run (no flags): the grey cloud, set-ups A and B, mono, 128x128, 256 spp, every
 PathEstimator (24 renders); then the chromatic cloud, set-ups C1 and C2, rgb and hero, 32x32,
 128 spp, the grey-majorant baseline uni-nee-mis_balance_absorb-weight and the spectral
 estimators listed under --estimators, uniform and luminance selection (absorb-weight; 15
 renders per set-up and mode, 60 in all), one run each; then the sparse medium, set-up SA, mono,
 64x64, 256 spp, each grey strategy (absorb-weight) with the global and the grid majorant (8
 renders). scripts/run-main.sh then adds the heavy-tail comparison: baseline against spectral
-MIS + NEE with each majorant, --runs 5 at 32x32 with a 2048-spp reference image for the
-effective variance (the last example below).
+MIS + NEE with each majorant, --runs 3 at 32x32 with a 2048-spp reference image for the
+effective variance (the last example below, there with --runs 5).
 
 usage: nsp_render [flags]
 
@@ -236,7 +236,7 @@ usage: nsp_render [flags]
                      reference's)^2 - the same reference term; 3 degrees of freedom per run, but
                      a tail missed in every pixel adds up there) and the ratios baseline /
                      spectral MIS + NEE of all three (not in mono tables; default: off)
-  --spp N            samples per pixel, N >= 2 (default 512 for the cloud, 128 for the
+  --spp N            samples per pixel, N >= 2 (default 256 for the cloud, 128 for the
                      chromatic cloud, 256 for the sparse medium); the variance per sample is
                      estimated from the N samples of each pixel
   --res WxH          image size in pixels (default 128x128 for the cloud, 32x32 for the

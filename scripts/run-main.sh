@@ -6,14 +6,14 @@
 #     sparse medium (set-up SA, mono, 64x64, 256 spp) with each grey strategy under the global
 #     and the grid majorant; EXRs in ./out, one efficiency table per set-up and mode;
 #  2. the heavy-tail comparison: the grey-majorant baseline against spectral MIS + NEE (per-channel
-#     and global majorant, uniform selection) on the chromatic cloud, 5 runs each at 32x32. The
+#     and global majorant, uniform selection) on the chromatic cloud, 3 runs each at 32x32. The
 #     baseline's variance is practically infinite: in a typical run it misses the rare huge
 #     samples, so its sample variance understates its error and even the median over runs of
 #     var/spl cannot rank it. --reference-spp 2048 therefore first renders a reference image per
 #     set-up and mode with a third, finite-variance estimator (spectral tracking + NEE, other
 #     seeds) and reports each run's effective variance per sample: spp x the mean squared
 #     error against the reference, minus the reference's own noise.
-# Renders in about 210 s on 2 quiet cores (with the build up to date).
+# Renders in about 200 s on 2 cores (measured 2026-11-30, build up to date).
 # With arguments, runs nsp_render once with them instead (see build/examples/nsp_render --help).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -27,8 +27,8 @@ start=$SECONDS
 build/examples/nsp_render --out out
 echo
 echo "Heavy-tail comparison: grey-majorant baseline vs spectral MIS + NEE (per-channel and global"
-echo "majorant), 5 runs, effective variance against a 2048-spp reference"
-build/examples/nsp_render --scene chromatic --runs 5 --res 32x32 --spp 128 --no-exr \
+echo "majorant), 3 runs, effective variance against a 2048-spp reference"
+build/examples/nsp_render --scene chromatic --runs 3 --res 32x32 --spp 128 --no-exr \
     --reference-spp 2048 --selection uniform \
     --estimators uni-nee-mis_grey_balance_absorb-weight,uni-nee-mis_spectral-mis_absorb-weight
 echo
