@@ -124,7 +124,8 @@ struct ChannelDeltaCollision {
         if constexpr (CP::own_pdfs) {
             d = channel_event_densities<A, S>(k, mu);
         } else {
-            static_assert(grey, "nsp: spectral tracking shares one pdf and needs a grey majorant (GlobalMajorant)");
+            static_assert(grey, "nsp: spectral tracking shares one pdf and needs a grey majorant "
+                                "(GlobalMajorant or GridMajorant)");
             const EventProbabilities p = shared_event_probabilities<A, CP::throughput_weighted, S>(k, mu_v, st.f);
             d = {Spec::Constant(mu_v * p.absorb), Spec::Constant(mu_v * p.scatter), Spec::Constant(mu_v * p.null)};
         }

@@ -81,7 +81,7 @@ public:
                                                    R& rng, C& counter) const {
         static_assert(!is_per_channel_majorant_v<typename Sc::MajorantType, typename Sc::MediumType>,
                       "nsp::PathEstimator drives every channel with one pdf and needs a grey majorant "
-                      "(GlobalMajorant); per-channel majorants go with nsp::SpectralPathEstimator");
+                      "(GlobalMajorant or GridMajorant); per-channel majorants go with nsp::SpectralPathEstimator");
         using Spectrum = typename Sc::Spectrum;
         Spectrum L = Spectrum::Zero(), beta = Spectrum::Ones();
         Status status = Status::Ok;
