@@ -7,6 +7,7 @@
 #include "core/error.hpp"
 #include "core/math.hpp"
 #include "core/rng.hpp"
+#include "equiangular.hpp"
 #include "estimator.hpp"
 #include "light.hpp"
 #include "majorant.hpp"
