@@ -31,17 +31,6 @@ double majorant_optical_depth(const Maj& majorant, const Ray& ray, float a, floa
     return tau;
 }
 
-/// The majorant mu_bar at distance t along `ray` (0 where no segment covers t), of channel `c`
-/// for a per-channel majorant.
-template <Medium M, MajorantPolicy<M> Maj>
-float majorant_at(const Maj& majorant, const Ray& ray, float t,
-                  const typename M::Spectral::Wavelengths& lambda, int c = 0) {
-    auto it = majorant.iterate(ray, 0.f, kInf, lambda);
-    while (auto seg = it.next())
-        if (seg->t0 <= t && t < seg->t1) return channel_of(seg->sigma_maj, c);
-    return 0.f;
-}
-
 /// The majorant value (grey, or every channel's) of the segment covering distance t along
 /// `ray`, or std::nullopt where no segment covers t.
 template <Medium M, MajorantPolicy<M> Maj>
@@ -51,6 +40,15 @@ std::optional<MajorantValue<Maj, M>> majorant_value_at(const Maj& majorant, cons
     while (auto seg = it.next())
         if (seg->t0 <= t && t < seg->t1) return seg->sigma_maj;
     return std::nullopt;
+}
+
+/// The majorant mu_bar at distance t along `ray` (0 where no segment covers t), of channel `c`
+/// for a per-channel majorant.
+template <Medium M, MajorantPolicy<M> Maj>
+float majorant_at(const Maj& majorant, const Ray& ray, float t,
+                  const typename M::Spectral::Wavelengths& lambda, int c = 0) {
+    const auto mu = majorant_value_at<M>(majorant, ray, t, lambda);
+    return mu ? channel_of(*mu, c) : 0.f;
 }
 
 /// The coefficients tracking sees at distance t along `ray`: the medium's, clamped to the

@@ -157,7 +157,6 @@ public:
         return {box_, res_, cell_, r, box_.clip(r, tmin, tmax)};
     }
 
-    float operator[](std::size_t i) const noexcept { return values_[i]; }
     /// The value of cell (x, y, z).
     float at(int x, int y, int z) const noexcept {
         return values_[std::size_t(x) + std::size_t(res_[0]) * (std::size_t(y) + std::size_t(res_[1]) * std::size_t(z))];
