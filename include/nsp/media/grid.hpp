@@ -1,4 +1,5 @@
-// nsp/media/grid.hpp: a dense voxel grid of densities over a box, looked up trilinearly.
+// nsp/media/grid.hpp: a dense voxel grid of densities over a box, looked up trilinearly, and the
+// lookup and region bound that every dense voxel grid shares (the emission grid of media/emissive.hpp).
 #pragma once
 
 #include <algorithm>
@@ -12,6 +13,70 @@
 #include "validate.hpp"
 
 namespace nsp {
+
+namespace detail {
+
+/// The trilinear lookup of a dense voxel grid `v` of resolution `res` over `box` (`inv_extent` =
+/// 1 / (box.hi - box.lo)): values at voxel centres, clamped at the faces, zero outside the box.
+/// Voxel (x, y, z) is v[x + nx * (y + ny * z)]. Shared by DenseGridMedium and EmissionGrid.
+inline float trilinear_lookup(const float* v, const std::array<int, 3>& res, const Box& box,
+                              const Vec3& inv_extent, const Vec3& p) noexcept {
+    if (!box.contains(p)) return 0.f;
+    const Vec3 u = (p - box.lo) * inv_extent;
+    int i0[3], i1[3];
+    float f[3];
+    for (int a = 0; a < 3; ++a) {
+        const float x = u[a] * float(res[a]) - 0.5f;
+        // floor(x) by truncation and a fix-up: x lies in [-0.5, res - 0.5], where this gives
+        // the same index and fraction as std::floor without its slow non-SSE4.1 sequence.
+        int i = int(x);
+        float fl = float(i);
+        if (fl > x) {
+            --i;
+            fl -= 1.f;
+        }
+        f[a] = x - fl;
+        i0[a] = std::clamp(i, 0, res[a] - 1);
+        i1[a] = std::clamp(i + 1, 0, res[a] - 1);
+    }
+    auto at = [&](int x, int y, int z) {
+        return v[std::size_t(x) + std::size_t(res[0]) * (std::size_t(y) + std::size_t(res[1]) * std::size_t(z))];
+    };
+    // Plain a + f (b - a): std::lerp's exactness branches cost 16% of tracking, and the
+    // result may exceed max(a, b) by one rounding at most, which tracking tolerates (a
+    // negative null coefficient of that size is weighted, not clamped away).
+    auto lerp = [](float a, float b, float t) { return a + t * (b - a); };
+    const float c00 = lerp(at(i0[0], i0[1], i0[2]), at(i1[0], i0[1], i0[2]), f[0]);
+    const float c10 = lerp(at(i0[0], i1[1], i0[2]), at(i1[0], i1[1], i0[2]), f[0]);
+    const float c01 = lerp(at(i0[0], i0[1], i1[2]), at(i1[0], i0[1], i1[2]), f[0]);
+    const float c11 = lerp(at(i0[0], i1[1], i1[2]), at(i1[0], i1[1], i1[2]), f[0]);
+    return lerp(lerp(c00, c10, f[1]), lerp(c01, c11, f[1]), f[2]);
+}
+
+/// The largest value trilinear_lookup (same grid) can return at any p in `region` (0 if it
+/// misses the box): the largest voxel among those the lookups there read. The region is widened
+/// by 1/1000 of a voxel so that a point that rounds just outside it is still covered.
+inline float voxel_bound(const float* v, const std::array<int, 3>& res, const Box& box,
+                         const Vec3& inv_extent, const Box& region) noexcept {
+    int lo[3], hi[3];
+    for (int a = 0; a < 3; ++a) {
+        const float r0 = std::max(region.lo[a], box.lo[a]), r1 = std::min(region.hi[a], box.hi[a]);
+        if (r0 > r1) return 0.f;
+        const float x0 = (r0 - box.lo[a]) * inv_extent[a] * float(res[a]) - 0.5f - 1e-3f;
+        const float x1 = (r1 - box.lo[a]) * inv_extent[a] * float(res[a]) - 0.5f + 1e-3f;
+        lo[a] = std::clamp(int(std::floor(x0)), 0, res[a] - 1);
+        hi[a] = std::clamp(int(std::floor(x1)) + 1, 0, res[a] - 1);
+    }
+    float m = 0.f;
+    for (int z = lo[2]; z <= hi[2]; ++z)
+        for (int y = lo[1]; y <= hi[1]; ++y) {
+            const float* row = &v[std::size_t(res[0]) * (std::size_t(y) + std::size_t(res[1]) * std::size_t(z))];
+            for (int x = lo[0]; x <= hi[0]; ++x) m = std::max(m, row[x]);
+        }
+    return m;
+}
+
+}  // namespace detail
 
 /// A dense density grid: mu_a(p) = density(p) * sigma_a_scale, mu_s(p) = density(p) *
 /// sigma_s_scale, density(p) trilinear between voxel centres (clamped at the faces), zero
@@ -55,36 +120,7 @@ public:
 
     /// The trilinearly interpolated density at p (zero outside the box).
     float density(const Vec3& p) const noexcept {
-        if (!bounds_.contains(p)) return 0.f;
-        const Vec3 u = (p - bounds_.lo) * inv_extent_;
-        int i0[3], i1[3];
-        float f[3];
-        for (int a = 0; a < 3; ++a) {
-            const float x = u[a] * float(res_[a]) - 0.5f;
-            // floor(x) by truncation and a fix-up: x lies in [-0.5, res - 0.5], where this gives
-            // the same index and fraction as std::floor without its slow non-SSE4.1 sequence.
-            int i = int(x);
-            float fl = float(i);
-            if (fl > x) {
-                --i;
-                fl -= 1.f;
-            }
-            f[a] = x - fl;
-            i0[a] = std::clamp(i, 0, res_[a] - 1);
-            i1[a] = std::clamp(i + 1, 0, res_[a] - 1);
-        }
-        auto at = [&](int x, int y, int z) {
-            return density_[std::size_t(x) + std::size_t(res_[0]) * (std::size_t(y) + std::size_t(res_[1]) * std::size_t(z))];
-        };
-        // Plain a + f (b - a): std::lerp's exactness branches cost 16% of tracking, and the
-        // result may exceed max(a, b) by one rounding at most, which tracking tolerates (a
-        // negative null coefficient of that size is weighted, not clamped away).
-        auto lerp = [](float a, float b, float t) { return a + t * (b - a); };
-        const float c00 = lerp(at(i0[0], i0[1], i0[2]), at(i1[0], i0[1], i0[2]), f[0]);
-        const float c10 = lerp(at(i0[0], i1[1], i0[2]), at(i1[0], i1[1], i0[2]), f[0]);
-        const float c01 = lerp(at(i0[0], i0[1], i1[2]), at(i1[0], i0[1], i1[2]), f[0]);
-        const float c11 = lerp(at(i0[0], i1[1], i1[2]), at(i1[0], i1[1], i1[2]), f[0]);
-        return lerp(lerp(c00, c10, f[1]), lerp(c01, c11, f[1]), f[2]);
+        return detail::trilinear_lookup(density_.data(), res_, bounds_, inv_extent_, p);
     }
 
     /// One density lookup, scaled per channel.
@@ -110,22 +146,7 @@ public:
     /// largest voxel among those the trilinear lookups there read. The region is widened by 1/1000
     /// of a voxel so that a point that rounds just outside it is still covered.
     float density_bound(const Box& region) const noexcept {
-        int lo[3], hi[3];
-        for (int a = 0; a < 3; ++a) {
-            const float r0 = std::max(region.lo[a], bounds_.lo[a]), r1 = std::min(region.hi[a], bounds_.hi[a]);
-            if (r0 > r1) return 0.f;
-            const float x0 = (r0 - bounds_.lo[a]) * inv_extent_[a] * float(res_[a]) - 0.5f - 1e-3f;
-            const float x1 = (r1 - bounds_.lo[a]) * inv_extent_[a] * float(res_[a]) - 0.5f + 1e-3f;
-            lo[a] = std::clamp(int(std::floor(x0)), 0, res_[a] - 1);
-            hi[a] = std::clamp(int(std::floor(x1)) + 1, 0, res_[a] - 1);
-        }
-        float m = 0.f;
-        for (int z = lo[2]; z <= hi[2]; ++z)
-            for (int y = lo[1]; y <= hi[1]; ++y) {
-                const float* row = &density_[std::size_t(res_[0]) * (std::size_t(y) + std::size_t(res_[1]) * std::size_t(z))];
-                for (int x = lo[0]; x <= hi[0]; ++x) m = std::max(m, row[x]);
-            }
-        return m;
+        return detail::voxel_bound(density_.data(), res_, bounds_, inv_extent_, region);
     }
 
 private:
