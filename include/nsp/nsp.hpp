@@ -12,6 +12,7 @@
 #include "light.hpp"
 #include "majorant.hpp"
 #include "majorants/grid.hpp"
+#include "media/emissive.hpp"
 #include "media/exponential.hpp"
 #include "media/grid.hpp"
 #include "media/homogeneous.hpp"
