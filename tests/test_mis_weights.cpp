@@ -3,6 +3,7 @@
 // products the two samplers report equal the independent evaluation (THEORY 5.1, 5.2, 5.6).
 #include <span>
 #include <string>
+#include <vector>
 
 #include "majorants.hpp"
 
@@ -130,6 +131,103 @@ TEST_CASE_TEMPLATE_DEFINE("MIS weights of unidirectional and NEE sum to 1 for on
 }
 
 TEST_CASE_TEMPLATE_APPLY(mis_weights, AllCombos);
+
+TEST_CASE_TEMPLATE_DEFINE("three-technique weights (tracking + NEE, tracking + hit, equiangular + NEE) sum to 1",
+                          C, eq_weights) {
+    // One path: a real vertex x at distance t on a segment with nulls before it, then a light
+    // vertex. Tracking's side reports p_eq / p_track from the delta tracker's own products, the
+    // equiangular side p_track / p_eq from ratio tracking's products for the same nulls; both must
+    // equal the independent log pdfs of pdf.hpp, and the three weights, each computed from its
+    // own side, must sum to 1 for every heuristic and roulette survival (THEORY 5.4, 5.6).
+    using S = typename C::Spectral;
+    using M = typename C::Medium;
+    using A = typename C::Absorption;
+    const typename S::Wavelengths lambda{};
+    const Box box{Vec3(-1.f), Vec3(1.f)};
+    int with_nulls = 0;
+    Pcg32 rng(18, 8);
+    const M medium = make_medium<M>(box, 1.1f, spec<S>(0.3f, 0.1f, 0.6f), spec<S>(0.7f, 1.2f, 0.4f), 21);
+    auto run = [&](const auto& maj, const std::string& maj_name) {
+        for (int i = 0; i < 300; ++i) {
+            CAPTURE(maj_name);
+            CAPTURE(i);
+            const Vec3 o = random_point(rng, box), target = random_point(rng, box);
+            const Ray ray{o, random_direction(rng)};
+            const Interval in = box.clip(ray, 0.f, kInf);
+            const EquiangularSampler eq(ray, target, in.t0, in.t1);
+            SegmentRecord rec;
+            NoLookupCount none;
+            const auto d = track_delta<A>(medium, maj, ray, kInf, lambda, rng, none, rec);
+            if (d.end != SegmentEnd::Scattered) continue;
+            std::vector<float> nulls(rec.t.begin(), rec.t.end() - 1);  // the last vertex is x
+            with_nulls += !nulls.empty();
+            // Independent pdfs: tracking's nulls and real vertex; equiangular's density times the
+            // ratio-tracking pdf of the same nulls up to t.
+            const double log_track = delta_segment_log_pdf<A>(medium, maj, ray, kInf, lambda, nulls,
+                                                              SegmentEnd::Scattered, d.t);
+            const double log_eq = std::log(double(eq.pdf(d.t))) + ratio_segment_log_pdf(medium, maj, ray, d.t, lambda, nulls);
+            const float eq_over_track = equiangular_over_tracking(eq.pdf(d.t), d.null_pdf_product, d.event_density);
+            REQUIRE(double(eq_over_track) == doctest::Approx(std::exp(log_eq - log_track)).epsilon(2e-4));
+            // The equiangular side: ratio tracking's callback over the same nulls.
+            NoRecord no_record;
+            RatioCollision<A, true, S, NoRecord> rt{no_record};
+            float prev = 0.f;
+            for (const float t : nulls) {
+                const float tau = float(majorant_optical_depth<M>(maj, ray, prev, t, lambda));
+                REQUIRE(rt(t, tracked_coefficients(medium, maj, ray, t, lambda), majorant_at<M>(maj, ray, t, lambda), tau));
+                prev = t;
+            }
+            const float mu_x = majorant_value_at_point<M>(maj, ray, d.t, lambda);
+            const float track_over_eq = tracking_over_equiangular<A>(
+                eq.pdf(d.t), rt.out.null_pdf_product, tracked_coefficients(medium, maj, ray, d.t, lambda), mu_x);
+            REQUIRE(double(track_over_eq) == doctest::Approx(std::exp(log_track - log_eq)).epsilon(2e-4));
+            // The light segment: hitting over NEE, s = q p_w prod P_n / p_l (any positive value
+            // the two sides share; the uni/NEE suite above checks how it is formed).
+            for (const float s : {0.f, 0.03f, 1.f, 40.f}) {
+                auto sum = [&](const auto& h) {
+                    // Tracking's side (reference p_track,NEE = 1) and equiangular's (p_eq,NEE = 1).
+                    const double tn = equiangular_mis_weight(h, VertexTechnique::TrackNee, 1.f, s, eq_over_track);
+                    const double th = equiangular_mis_weight(h, VertexTechnique::TrackHit, 1.f, s, eq_over_track);
+                    const double en = equiangular_mis_weight(h, VertexTechnique::EquiangularNee, track_over_eq,
+                                                             track_over_eq * s, 1.f);
+                    return tn + th + en;
+                };
+                CAPTURE(s);
+                CHECK(sum(mis::Balance{}) == doctest::Approx(1.0).epsilon(1e-3));
+                CHECK(sum(mis::Power{2.f}) == doctest::Approx(1.0).epsilon(1e-3));
+            }
+        }
+    };
+    const GlobalMajorant<M> tight(medium);
+    run(tight, "global");
+    run(GlobalMajorant<M>(medium, tight.value() * 2.f), "global-loose");  // nulls in homogeneous media too
+    for_each_kind<PdfGreyKinds, M>([&](auto kind) { run(decltype(kind)::make(medium), decltype(kind)::name); });
+    CHECK(with_nulls > 20);
+}
+
+TEST_CASE_TEMPLATE_APPLY(eq_weights, AllCombos);
+
+TEST_CASE("weight_among: weights of one path sum to 1, limits without NaN") {
+    const mis::Balance b;
+    const mis::Power p2(2.f);
+    for (const float a : {0.f, 1e-30f, 0.2f, 1.f, 7.f, 1e30f, kInf})
+        for (const float c : {0.f, 1e-20f, 0.5f, 3.f, 1e35f, kInf}) {
+            CAPTURE(a);
+            CAPTURE(c);
+            for (const float one : {1.f}) {
+                const double sb = double(mis::weight_among(b, one, a, c)) + mis::weight_among(b, a, one, c) +
+                                  mis::weight_among(b, c, one, a);
+                const double sp = double(mis::weight_among(p2, one, a, c)) + mis::weight_among(p2, a, one, c) +
+                                  mis::weight_among(p2, c, one, a);
+                CHECK(sb == doctest::Approx(1.0).epsilon(1e-6));
+                CHECK(sp == doctest::Approx(1.0).epsilon(1e-6));
+            }
+        }
+    CHECK(mis::weight_among(b, 1.f, 3.f) == doctest::Approx(b.weight(3.f)));
+    CHECK(mis::weight_among(p2, 2.f, 3.f) == doctest::Approx(p2.weight(1.5f)));
+    CHECK(mis::weight_among(b, 0.f, 0.f) == 0.f);
+    CHECK(mis::weight_among(b, kInf, kInf, 1.f) == 0.5f);
+}
 
 TEST_CASE("heuristics: w(r) + w(1/r) = 1, w(0) = 1, w(inf) = 0") {
     const mis::Balance b;

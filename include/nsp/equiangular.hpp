@@ -1,7 +1,7 @@
 // nsp/equiangular.hpp: equiangular distance sampling toward a point (Kulla and Fajardo 2012,
-// THEORY 5.4): the distance sampler and its pdf, the first piece of equiangular sampling in
-// heterogeneous media (the nulls before the sampled vertex are ratio-tracked; the MIS ratio
-// against unidirectional tracking is analytic).
+// THEORY 5.4): the distance sampler and its pdf. The path estimators (estimators/path.hpp,
+// strategy::EquiangularNextEvent and strategy::EquiangularMis) draw real vertices with it,
+// ratio-track the nulls before them and weigh them against tracking with the analytic ratio.
 #pragma once
 
 #include <algorithm>
@@ -26,6 +26,9 @@ struct DistanceSample {
 /// infinite. Never throws; a stretch with t1 <= t0 gives pdf 0.
 class EquiangularSampler {
 public:
+    /// An empty sampler (pdf 0 everywhere).
+    EquiangularSampler() = default;
+
     EquiangularSampler(const Ray& ray, const Vec3& c, float t0, float t1, float min_distance = 1e-4f) noexcept
         : t0_(t0), t1_(t1) {
         const Vec3 oc = c - ray.o;
@@ -60,7 +63,7 @@ private:
         return d_ / ((theta1_ - theta0_) * (d_ * d_ + x * x));
     }
 
-    float t0_, t1_;
+    float t0_ = 0.f, t1_ = 0.f;
     float delta_ = 0.f, d_ = 1.f, theta0_ = 0.f, theta1_ = 0.f;
     bool valid_ = false;
 };

@@ -84,6 +84,14 @@ public:
     const std::optional<SphereLight<S>>& sphere() const noexcept { return sphere_; }
     const std::optional<EnvironmentLight<S>>& environment() const noexcept { return env_; }
 
+    /// Where equiangular sampling aims (THEORY 5.4): the point light, else the sphere light's
+    /// centre, else nothing.
+    std::optional<Vec3> equiangular_target() const noexcept {
+        if (point_) return point_->position;
+        if (sphere_) return sphere_->center;
+        return std::nullopt;
+    }
+
     /// Number of lights NEE chooses from.
     int count() const noexcept { return int(point_.has_value()) + int(sphere_.has_value()) + int(env_.has_value()); }
 

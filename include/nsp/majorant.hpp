@@ -225,6 +225,11 @@ public:
     /// The majorant value.
     float value() const noexcept { return value_; }
 
+    /// The majorant at point p: the value inside the medium's box, 0 outside (as `iterate` clips).
+    float value_at(const Vec3& p, const typename M::Spectral::Wavelengths&) const noexcept {
+        return bounds_.contains(p) ? value_ : 0.f;
+    }
+
     /// One segment: [tmin, tmax] clipped to the medium's box.
     SingleSegmentIterator<float> iterate(const Ray& r, float tmin, float tmax,
                                          const typename M::Spectral::Wavelengths&) const noexcept {

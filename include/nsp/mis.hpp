@@ -7,10 +7,13 @@
 
 #include <cmath>
 #include <concepts>
+#include <limits>
 
 #include "core/error.hpp"
 
 namespace nsp::mis {
+
+inline constexpr float kInfPower = std::numeric_limits<float>::infinity();
 
 /// No MIS: the estimator uses one strategy alone. Only single-strategy estimators accept it.
 struct None {
@@ -24,6 +27,8 @@ struct Balance {
     static constexpr const char* name = "balance";
     /// Weight of the sampling strategy given r = p_other / p_this >= 0 (r = inf gives 0).
     float weight(float r) const noexcept { return r < kHuge ? 1.f / (1.f + r) : 0.f; }
+    /// The heuristic's power of a pdf ratio, r itself: weights are power(p_this) / sum power(p_i).
+    float power(float r) const noexcept { return r; }
     static constexpr float kHuge = 1e30f;
 };
 
@@ -45,16 +50,43 @@ public:
         const float rb = std::pow(r, beta_);
         return rb < Balance::kHuge ? 1.f / (1.f + rb) : 0.f;
     }
+    /// r^beta: weights are power(p_this) / sum power(p_i).
+    float power(float r) const noexcept { return std::pow(r, beta_); }
 
 private:
     float beta_;
 };
 
-/// A heuristic that combines strategies: `weight(r)` in [0, 1], with weight(r) + weight(1/r) = 1.
+/// A heuristic that combines strategies: `weight(r)` in [0, 1], with weight(r) + weight(1/r) = 1,
+/// and `power(r)` >= 0, multiplicative (power(a b) = power(a) power(b)), with which the weight of
+/// one technique among several is power(p_this) / sum_i power(p_i) (see `weight_among`).
 template <class H>
 concept CombiningHeuristic = H::combines && requires(const H& h, float r) {
     { h.weight(r) } -> std::same_as<float>;
+    { h.power(r) } -> std::same_as<float>;
 };
+
+/// The weight of one technique among several from the ratios of every technique's pdf to one
+/// common reference pdf: `r_this` for the technique that sampled the path, `r_others` for the
+/// rest (THEORY 5.4: tracking + NEE, tracking + hit, equiangular + NEE). The weights of all
+/// techniques of one path, each computed with its own r_this, sum to 1. Powers that overflow
+/// are handled as limits: an infinite power takes the whole weight (shared between equal
+/// infinities), a zero r_this gets 0. Never NaN for ratios in [0, inf]; a NaN ratio gives NaN,
+/// which the estimator reports as Status::NonFinite.
+template <class H, class... R>
+float weight_among(const H& h, float r_this, R... r_others) noexcept {
+    const float p = h.power(r_this);
+    if (!(p > 0.f)) return 0.f;
+    const float powers[] = {h.power(r_others)...};
+    double sum = p;  // finite float powers cannot overflow a double sum
+    int infinite = p == kInfPower ? 1 : 0;
+    for (const float q : powers) {
+        sum += double(q);
+        infinite += q == kInfPower ? 1 : 0;
+    }
+    if (infinite > 0) return p == kInfPower ? 1.f / float(infinite) : 0.f;
+    return float(double(p) / sum);
+}
 
 /// Any heuristic policy, including None.
 template <class H>

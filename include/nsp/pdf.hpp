@@ -42,6 +42,24 @@ std::optional<MajorantValue<Maj, M>> majorant_value_at(const Maj& majorant, cons
     return std::nullopt;
 }
 
+/// The majorant at the point ray.at(t): one cell lookup when the policy has
+/// `value_at(point, lambda)` (GlobalMajorant, GridMajorant, ChannelGridMajorant), else the segment
+/// walk of majorant_value_at (zero where no segment covers t). The two differ only on the measure-
+/// zero set of cell faces, so estimators that need mu_bar at a vertex they did not track (an
+/// equiangular or emission sample) use this.
+template <Medium M, MajorantPolicy<M> Maj>
+MajorantValue<Maj, M> majorant_value_at_point(const Maj& majorant, const Ray& ray, float t,
+                                              const typename M::Spectral::Wavelengths& lambda) {
+    if constexpr (requires { { majorant.value_at(ray.at(t), lambda) } -> std::convertible_to<MajorantValue<Maj, M>>; }) {
+        return majorant.value_at(ray.at(t), lambda);
+    } else {
+        if (const auto mu = majorant_value_at<M>(majorant, ray, t, lambda)) return *mu;
+        MajorantValue<Maj, M> zero{};
+        if constexpr (!std::is_same_v<MajorantValue<Maj, M>, float>) zero.setZero();
+        return zero;
+    }
+}
+
 /// The majorant mu_bar at distance t along `ray` (0 where no segment covers t), of channel `c`
 /// for a per-channel majorant.
 template <Medium M, MajorantPolicy<M> Maj>

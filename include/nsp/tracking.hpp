@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <limits>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "core/counter.hpp"
@@ -247,17 +248,28 @@ struct DeltaTrack {
     float t = 0.f;                     ///< distance of the real collision, or tmax
     typename S::Spectrum weight;       ///< product of per-vertex f/p factors (1 on grey media with a bounding majorant)
     float null_pdf_product = 1.f;      ///< prod_j P_n(n_j): the ratio p_track / p_ratio of the nulls (THEORY 5.1)
+    float event_density = 0.f;         ///< mu_bar(t) P_event(t) at a real collision: its pdf over Tbar (THEORY 5.4)
+};
+
+/// Visits nothing (the default of `DeltaCollision`).
+struct NoVisit {
+    static constexpr bool enabled = false;
 };
 
 /// Delta (Woodcock) tracking (THEORY 4.3): at each collision choose absorb / scatter / null with
 /// the probabilities of `event_probabilities<A>`; per-channel weights are mu_x,c / (mu_bar P_x).
-template <AbsorptionPolicy A, SpectralMode S, UniformRng R, class Rec>
+/// A visitor with `enabled` is called at every tentative collision before its event is chosen,
+/// as `visit(t, coefficients, mu_bar, weight, null_pdf_product)` with the weight and null-pdf
+/// product of the nulls before it (the collision estimator of emission, THEORY 5.7, uses it).
+template <AbsorptionPolicy A, SpectralMode S, UniformRng R, class Rec, class Visit = NoVisit>
 struct DeltaCollision {
     R& rng;
     Rec& rec;
+    Visit visit{};
     DeltaTrack<S> out{SegmentEnd::Passed, 0.f, S::Spectrum::Ones(), 1.f};
 
     bool operator()(float t, const Coefficients<S>& c, float mu_bar, float tau) {
+        if constexpr (Visit::enabled) visit(t, c, mu_bar, out.weight, out.null_pdf_product);
         const EventProbabilities p = event_probabilities<A>(c, mu_bar);
         const float u = rng.uniform();
         float p_event;
@@ -277,6 +289,7 @@ struct DeltaCollision {
             return true;
         }
         out.t = t;
+        out.event_density = mu_bar * p_event;
         if constexpr (Rec::enabled) rec.vertex(t, std::log(double(mu_bar) * p_event) - tau);
         return false;
     }
@@ -314,15 +327,15 @@ struct RatioCollision {
     }
 };
 
-/// Delta-tracks `ray` over [0, tmax] inside the medium. A `Passed` result means the ray reached
-/// tmax; its weight is then the transmittance weight of the nulls (1 on grey bounded media).
-template <AbsorptionPolicy A, Medium M, MajorantPolicy<M> Maj, UniformRng R, LookupCounter C,
+/// Delta-tracks `ray` over [0, tmax] as `track_delta` does, calling `visit` at every tentative
+/// collision (see DeltaCollision).
+template <AbsorptionPolicy A, Medium M, MajorantPolicy<M> Maj, UniformRng R, LookupCounter C, class Visit,
           class Rec = NoRecord>
-DeltaTrack<typename M::Spectral> track_delta(const M& medium, const Maj& majorant, const Ray& ray,
-                                             float tmax, const typename M::Spectral::Wavelengths& lambda,
-                                             R& rng, C& counter, Rec&& rec = Rec{}) {
+DeltaTrack<typename M::Spectral> track_delta_visiting(const M& medium, const Maj& majorant, const Ray& ray,
+                                                      float tmax, const typename M::Spectral::Wavelengths& lambda,
+                                                      R& rng, C& counter, Visit visit, Rec&& rec = Rec{}) {
     using S = typename M::Spectral;
-    DeltaCollision<A, S, R, std::remove_reference_t<Rec>> cb{rng, rec};
+    DeltaCollision<A, S, R, std::remove_reference_t<Rec>, Visit> cb{rng, rec, std::move(visit)};
     const auto f = free_flight(medium, majorant, ray, 0.f, tmax, lambda, rng, counter, cb);
     if (f.aborted) return {aborted_end(f), f.t, S::Spectrum::Zero(), 1.f};
     if (!f.stopped) {
@@ -331,6 +344,16 @@ DeltaTrack<typename M::Spectral> track_delta(const M& medium, const Maj& majoran
         if constexpr (std::remove_reference_t<Rec>::enabled) rec.log_pdf -= f.tau_tail;
     }
     return cb.out;
+}
+
+/// Delta-tracks `ray` over [0, tmax] inside the medium. A `Passed` result means the ray reached
+/// tmax; its weight is then the transmittance weight of the nulls (1 on grey bounded media).
+template <AbsorptionPolicy A, Medium M, MajorantPolicy<M> Maj, UniformRng R, LookupCounter C,
+          class Rec = NoRecord>
+DeltaTrack<typename M::Spectral> track_delta(const M& medium, const Maj& majorant, const Ray& ray,
+                                             float tmax, const typename M::Spectral::Wavelengths& lambda,
+                                             R& rng, C& counter, Rec&& rec = Rec{}) {
+    return track_delta_visiting<A>(medium, majorant, ray, tmax, lambda, rng, counter, NoVisit{}, rec);
 }
 
 /// Ratio-tracks `ray` over [0, tmax]: an unbiased per-channel transmittance estimate, and with

@@ -16,25 +16,48 @@ namespace strategy {
 struct Unidirectional {
     static constexpr const char* name = "unidirectional";
     static constexpr bool samples_lights = false, hits_lights = true, combines = false, null_pdfs = false;
+    static constexpr bool equiangular = false;
 };
 /// Next-event estimation with ratio-tracking transmittance; hits count only for camera rays.
 struct NextEvent {
     static constexpr const char* name = "ratio-nee";
     static constexpr bool samples_lights = true, hits_lights = false, combines = false, null_pdfs = false;
+    static constexpr bool equiangular = false;
 };
 /// Unidirectional + NEE weighted by direction pdfs only (THEORY 5.2).
 struct DirectionalMis {
     static constexpr const char* name = "directional-mis";
     static constexpr bool samples_lights = true, hits_lights = true, combines = true, null_pdfs = false;
+    static constexpr bool equiangular = false;
 };
 /// Unidirectional + NEE weighted by null-scattering path pdfs (THEORY 5.1).
 struct NullScatteringMis {
     static constexpr const char* name = "uni-nee-mis";
     static constexpr bool samples_lights = true, hits_lights = true, combines = true, null_pdfs = true;
+    static constexpr bool equiangular = false;
+};
+/// Equiangular sampling + NEE (THEORY 5.4): on every segment of the path (the camera ray
+/// included) a real vertex drawn with the equiangular pdf toward the point light (else the
+/// sphere light's centre), the nulls before it ratio-tracked, and NEE from it; tracked vertices
+/// only continue the path. Lights count when hit only on camera rays. Without a point or sphere
+/// light there is nothing to aim at and it is NextEvent.
+struct EquiangularNextEvent {
+    static constexpr const char* name = "equiangular-nee";
+    static constexpr bool samples_lights = true, hits_lights = false, combines = false, null_pdfs = false;
+    static constexpr bool equiangular = true;
+};
+/// Unidirectional + NEE + equiangular: the last real vertex before a light drawn by tracking or
+/// by equiangular sampling, the light reached by NEE or (from a tracked vertex) by hitting it;
+/// the three techniques weighted by their null-scattering path pdfs (THEORY 5.1, 5.4).
+struct EquiangularMis {
+    static constexpr const char* name = "uni-nee-eq-mis";
+    static constexpr bool samples_lights = true, hits_lights = true, combines = true, null_pdfs = true;
+    static constexpr bool equiangular = true;
 };
 }  // namespace strategy
 
-/// A path strategy: which techniques it runs and whether it combines them with MIS.
+/// A path strategy: which techniques it runs (light sampling, light hits, equiangular vertices)
+/// and whether it combines them with MIS, weighing by null-scattering path pdfs or not.
 template <class T>
 concept PathStrategy = requires {
     { T::name } -> std::convertible_to<const char*>;
@@ -42,6 +65,7 @@ concept PathStrategy = requires {
     { T::hits_lights } -> std::convertible_to<bool>;
     { T::combines } -> std::convertible_to<bool>;
     { T::null_pdfs } -> std::convertible_to<bool>;
+    { T::equiangular } -> std::convertible_to<bool>;
 };
 
 /// Run-time settings of a path estimator.

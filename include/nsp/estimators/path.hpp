@@ -1,22 +1,35 @@
 // nsp/estimators/path.hpp: the grey path estimator (THEORY 4, 5.1, 5.2, 5.6): one pdf for every
 // channel (event probabilities from the channel means under one grey majorant).
 //
-// One path loop serves all four strategies; they differ only where `if constexpr` on the
+// One path loop serves all six strategies; they differ only where `if constexpr` on the
 // strategy's traits says so:
 // - Unidirectional: delta tracking, emission found by hitting lights;
 // - NextEvent: light sampling with ratio-tracking transmittance at every real vertex;
 // - DirectionalMis: both, weighted by the direction pdfs alone (Novak 2014, Kutz 2017);
-// - NullScatteringMis: both, weighted by the full null-scattering path pdfs (THEORY 5.1).
+// - NullScatteringMis: both, weighted by the full null-scattering path pdfs (THEORY 5.1);
+// - EquiangularNextEvent: on every segment a real vertex drawn toward the point light
+//   (equiangular, THEORY 5.4) with NEE from it;
+// - EquiangularMis: tracking + NEE, tracking + hit and equiangular + NEE, by their path pdfs.
+// An emissive medium (media/emissive.hpp) adds emission the same way: collected at every
+// tentative collision where the strategy counts hits, sampled by NEE toward the volume where it
+// samples lights, weighted by the analytic ratio of the two where it combines (THEORY 5.7). A
+// medium without emission compiles none of that code.
 // Exact for Mono and grey media; on chromatic media the per-channel weights multiply along a
 // path, which is what estimators/spectral.hpp is for.
 #pragma once
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
+#include <optional>
+#include <type_traits>
 
 #include "../core/counter.hpp"
 #include "../core/rng.hpp"
+#include "../equiangular.hpp"
+#include "../media/emissive.hpp"
 #include "../mis.hpp"
+#include "../pdf.hpp"
 #include "../scene.hpp"
 #include "../tracking.hpp"
 #include "common.hpp"
@@ -51,6 +64,57 @@ float next_event_weight(const H& h, float survival, float phase_pdf, float null_
                         float light_pdf) noexcept {
     return h.weight(unidirectional_pdf<St>(survival, phase_pdf, null_pdf_product) / light_pdf);
 }
+/// The three techniques that can produce a path's last real vertex x and its light vertex y
+/// when equiangular sampling is on (THEORY 5.4).
+enum class VertexTechnique : std::uint8_t {
+    TrackNee,        ///< x by tracking, y by NEE
+    TrackHit,        ///< x by tracking, y by tracking from x (hitting the light)
+    EquiangularNee,  ///< x by equiangular sampling (nulls before it ratio-tracked), y by NEE
+};
+
+/// p_equiangular / p_tracking of a real vertex that delta tracking drew at distance t, from the
+/// equiangular density there, the nulls' prod P_n and mu_bar(t) P_s(t) (DeltaTrack's
+/// `event_density`). The shared factors (prefix, Tbar, mu_bar at the nulls) cancel; inf if the
+/// tracking pdf underflowed to 0.
+inline float equiangular_over_tracking(float eq_pdf, float null_pdf_product, float event_density) noexcept {
+    return eq_pdf / (null_pdf_product * event_density);
+}
+
+/// p_tracking / p_equiangular of a real scattering vertex drawn by equiangular sampling with
+/// density `eq_pdf` > 0, whose nulls ratio tracking drew with delta-tracking product
+/// `null_pdf_product`, coefficients `c` and majorant `mu_bar` there: prod P_n mu_bar P_s / p_eq
+/// (THEORY 5.4). 0 where tracking cannot collide (mu_bar = 0).
+template <AbsorptionPolicy A, SpectralMode S>
+float tracking_over_equiangular(float eq_pdf, float null_pdf_product, const Coefficients<S>& c, float mu_bar) noexcept {
+    if (!(mu_bar > 0.f)) return 0.f;
+    return null_pdf_product * mu_bar * event_probabilities<A>(c, mu_bar).scatter / eq_pdf;
+}
+
+/// The MIS weight of technique `which` for one path, from the three techniques' pdfs relative to
+/// any common reference (`track_nee`, `track_hit` = 0 for a point light, `eq_nee`). The three
+/// weights of one path sum to 1.
+template <mis::CombiningHeuristic H>
+float equiangular_mis_weight(const H& h, VertexTechnique which, float track_nee, float track_hit, float eq_nee) noexcept {
+    switch (which) {
+        case VertexTechnique::TrackNee: return mis::weight_among(h, track_nee, track_hit, eq_nee);
+        case VertexTechnique::TrackHit: return mis::weight_among(h, track_hit, track_nee, eq_nee);
+        default: return mis::weight_among(h, eq_nee, track_nee, track_hit);
+    }
+}
+
+/// For volume emission at a point y at squared distance `dist2` from the real vertex x the
+/// segment left from: the collision estimator's pdf over NEE's toward the volume (THEORY 5.7),
+/// p_uni / p_nee = q p_w [prod P_n] mu_bar(y) / (dist2 p_V(y)), with roulette survival q and phase
+/// pdf p_w at x, the nulls' delta-tracking product (null-scattering strategies only; directional
+/// MIS leaves it out, as it does for lights) and the NEE volume pdf p_V(y). The nulls' mu_bar Tbar
+/// are shared and cancel. The collision estimator weighs with h.weight(1 / r), NEE with
+/// h.weight(r): for one path they sum to 1.
+template <PathStrategy St>
+float emission_collision_over_nee(float survival, float phase_pdf, float null_pdf_product, float mu_bar, float dist2,
+                                  float volume_pdf) noexcept {
+    return unidirectional_pdf<St>(survival, phase_pdf, null_pdf_product) * mu_bar / (dist2 * volume_pdf);
+}
+
 /// A path estimator: strategy St, MIS heuristic H (mis::None exactly for single-strategy
 /// estimators) and absorption policy A for the delta-tracked segments.
 template <PathStrategy St, mis::Heuristic H = mis::None, AbsorptionPolicy A = absorption::Weight>
@@ -83,17 +147,45 @@ public:
                       "nsp::PathEstimator drives every channel with one pdf and needs a grey majorant "
                       "(GlobalMajorant or GridMajorant); per-channel majorants go with nsp::SpectralPathEstimator");
         using Spectrum = typename Sc::Spectrum;
+        constexpr bool kEmissive = EmissiveMedium<typename Sc::MediumType>;
         Spectrum L = Spectrum::Zero(), beta = Spectrum::Ones();
         Status status = Status::Ok;
         Ray ray = camera_ray;
         // The real vertex the current ray left from, for the MIS weight of a light it hits.
         Vec3 prev_x(0.f);
         float prev_phase_pdf = 0.f, prev_survival = 1.f;
+        float prev_eq_ratio = 0.f;  // p_equiangular / p_tracking of that vertex (equiangular strategies)
         bool from_camera = true;
+        std::optional<Vec3> target;
+        if constexpr (St::equiangular) target = scene.lights.equiangular_target();
 
         for (int depth = 0;;) {
             const LightHit hit = scene.lights.intersect(ray);
-            const auto seg = track_delta<A>(scene.medium, scene.majorant, ray, hit.t, lambda, rng, counter);
+            // Equiangular: a real vertex on this segment aimed at the light, and NEE from it.
+            EquiangularSampler eq;
+            if constexpr (St::equiangular) {
+                if (target) {
+                    const Interval in = scene.medium.bounds().clip(ray, 0.f, hit.t);
+                    eq = EquiangularSampler(ray, *target, in.t0, in.t1);
+                    if (depth < opts_.max_depth) {
+                        const Status es = equiangular_vertex(scene, ray, eq, depth + 1, beta, lambda, rng, counter, L);
+                        if (es != Status::Ok) status = es;
+                    }
+                }
+            }
+            DeltaTrack<typename Sc::Spectral> seg;
+            if constexpr (kEmissive) {
+                if (from_camera || St::hits_lights) {
+                    // The NEE alternative of emission exists from real vertices only (THEORY 5.7).
+                    seg = track_delta_visiting<A>(scene.medium, scene.majorant, ray, hit.t, lambda, rng, counter,
+                                                  EmissionCollector<Sc>{scene, ray, lambda, beta, L, heuristic_,
+                                                                        !from_camera, prev_survival, prev_phase_pdf});
+                } else {
+                    seg = track_delta<A>(scene.medium, scene.majorant, ray, hit.t, lambda, rng, counter);
+                }
+            } else {
+                seg = track_delta<A>(scene.medium, scene.majorant, ray, hit.t, lambda, rng, counter);
+            }
             if (const Status fs = flight_status(seg.end); fs != Status::Ok) {
                 status = fs;
                 break;
@@ -103,10 +195,19 @@ public:
                 if (from_camera || St::hits_lights) {
                     float w = 1.f;
                     if constexpr (St::combines) {
-                        if (!from_camera)  // the shared prefix of the two pdfs cancels
-                            w = unidirectional_weight<St>(heuristic_, prev_survival, prev_phase_pdf,
-                                                          seg.null_pdf_product,
-                                                          scene.lights.pdf(prev_x, hit));
+                        if (!from_camera) {  // the shared prefix of the pdfs cancels
+                            if constexpr (St::equiangular) {
+                                // Relative to tracking + NEE: hitting is p_uni / p_light, equiangular
+                                // + NEE is the vertex's p_eq / p_track (same light factor).
+                                const float s = unidirectional_pdf<St>(prev_survival, prev_phase_pdf,
+                                                                       seg.null_pdf_product) /
+                                                scene.lights.pdf(prev_x, hit);
+                                w = equiangular_mis_weight(heuristic_, VertexTechnique::TrackHit, 1.f, s, prev_eq_ratio);
+                            } else {
+                                w = unidirectional_weight<St>(heuristic_, prev_survival, prev_phase_pdf,
+                                                              seg.null_pdf_product, scene.lights.pdf(prev_x, hit));
+                            }
+                        }
                     }
                     L += w * beta * scene.lights.emitted(hit, lambda);
                 }
@@ -116,13 +217,25 @@ public:
             if (++depth > opts_.max_depth) break;
 
             const Vec3 x = ray.at(seg.t);
+            // p_eq / p_track of this vertex: the nulls' P_n and mu_bar P_s against the equiangular
+            // density (THEORY 5.4); inf if the tracking pdf underflowed.
+            float eq_ratio = 0.f;
+            if constexpr (St::equiangular)
+                if (target) eq_ratio = equiangular_over_tracking(eq.pdf(seg.t), seg.null_pdf_product, seg.event_density);
             // Roulette survival is fixed before NEE: the continuing unidirectional path carries it.
             float q = 1.f;
             if (opts_.russian_roulette && depth >= opts_.rr_start_depth)
                 q = std::min(opts_.rr_max_survival, beta.abs().maxCoeff());
             if constexpr (St::samples_lights) {
-                const Status ns = next_event(scene, x, ray.d, q, lambda, rng, counter, beta, L);
-                if (ns != Status::Ok) status = ns;
+                // Equiangular + NEE alone leaves the lights to its own vertices when it has a target.
+                if (St::combines || !St::equiangular || !target) {
+                    const Status ns = next_event(scene, x, ray.d, q, lambda, rng, counter, beta, L, 1.f, eq_ratio, false);
+                    if (ns != Status::Ok) status = ns;
+                }
+                if constexpr (kEmissive) {
+                    const Status es = emission_event(scene, x, ray.d, q, lambda, rng, counter, beta, L);
+                    if (es != Status::Ok) status = es;
+                }
             }
             if (q < 1.f) {
                 if (!(rng.uniform() < q)) break;
@@ -135,6 +248,7 @@ public:
             prev_x = x;
             prev_phase_pdf = ps.pdf;
             prev_survival = q;
+            prev_eq_ratio = eq_ratio;
             from_camera = false;
             ray = Ray{x, ps.wi};
         }
@@ -143,12 +257,15 @@ public:
     }
 
 private:
-    /// Adds NEE's weighted contribution at real vertex x (arrived along wo) to L; returns true if
-    /// its shadow flight was aborted.
+    /// Adds NEE's weighted contribution at real vertex x (arrived along wo, throughput beta) to L;
+    /// returns Aborted or Rejected if its shadow flight was, else Ok. For the equiangular
+    /// strategies, `track_ratio_` and `eq_ratio` are the tracking and equiangular pdfs of x over
+    /// the pdf of the technique that drew x (`equiangular_drawn` says which one it was).
     template <class Sc, UniformRng R, LookupCounter C>
     Status next_event(const Sc& scene, const Vec3& x, const Vec3& wo, float survival,
-                    const typename Sc::Spectral::Wavelengths& lambda, R& rng, C& counter,
-                    const typename Sc::Spectrum& beta, typename Sc::Spectrum& L) const {
+                      const typename Sc::Spectral::Wavelengths& lambda, R& rng, C& counter,
+                      const typename Sc::Spectrum& beta, typename Sc::Spectrum& L, float track_ratio_,
+                      float eq_ratio, bool equiangular_drawn) const {
         const float u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
         const LightSample<typename Sc::Spectral> ls = scene.lights.sample(x, u0, u1, u2, lambda);
         if (!(ls.pdf > 0.f)) return Status::Ok;
@@ -160,11 +277,131 @@ private:
         if (tr.end == SegmentEnd::Terminated) return Status::Ok;
         float w = 1.f;
         if constexpr (St::combines) {
-            if (!ls.delta)  // a point light cannot be hit: NEE keeps weight 1
+            if constexpr (St::equiangular) {
+                // Three techniques, relative to the one that drew x followed by NEE: tracking + NEE,
+                // tracking + hit (not for a point light) and equiangular + NEE.
+                const float s = ls.delta ? 0.f
+                                         : unidirectional_pdf<St>(survival, scene.phase.pdf(wo, ls.wi),
+                                                                  tr.null_pdf_product) / ls.pdf;
+                w = equiangular_mis_weight(heuristic_,
+                                           equiangular_drawn ? VertexTechnique::EquiangularNee : VertexTechnique::TrackNee,
+                                           track_ratio_, track_ratio_ * s, eq_ratio);
+            } else if (!ls.delta) {  // a point light cannot be hit: NEE keeps weight 1
                 w = next_event_weight<St>(heuristic_, survival, scene.phase.pdf(wo, ls.wi),
                                           tr.null_pdf_product, ls.pdf);
+            }
         }
         L += beta * tr.transmittance * ls.radiance * (w * scene.phase.eval(wo, ls.wi) / ls.pdf);
+        return Status::Ok;
+    }
+
+    /// Equiangular + NEE on the segment `ray` (THEORY 5.4): draws t with `eq`, ratio-tracks the
+    /// nulls on [0, t), makes t a real scattering vertex at path depth `depth` and does NEE from
+    /// it. `beta` is the throughput of the prefix (up to the ray's origin).
+    template <class Sc, UniformRng R, LookupCounter C>
+    Status equiangular_vertex(const Sc& scene, const Ray& ray, const EquiangularSampler& eq, int depth,
+                              const typename Sc::Spectrum& beta, const typename Sc::Spectral::Wavelengths& lambda,
+                              R& rng, C& counter, typename Sc::Spectrum& L) const {
+        using M = typename Sc::MediumType;
+        using B = bound_policy_t<typename Sc::MajorantType>;
+        const DistanceSample ds = eq.sample(rng.uniform());
+        if (!(ds.pdf > 0.f)) return Status::Ok;
+        const auto tr = track_ratio<A, St::combines>(scene.medium, scene.majorant, ray, ds.t, lambda, rng, counter);
+        if (tr.end == SegmentEnd::Aborted || tr.end == SegmentEnd::Rejected) return flight_status(tr.end);
+        if (tr.end == SegmentEnd::Terminated) return Status::Ok;
+        const Vec3 x = ray.at(ds.t);
+        const float mu_bar = majorant_value_at_point<M>(scene.majorant, ray, ds.t, lambda);
+        counter.lookup();
+        auto c = scene.medium.coefficients(x, lambda);
+        if constexpr (std::is_same_v<B, bound::Clamp>) {
+            detail::clamp_to_majorant(c, mu_bar);
+        } else if constexpr (std::is_same_v<B, bound::Reject>) {
+            if (detail::exceeds_majorant(c, mu_bar)) return Status::Rejected;
+        }
+        const typename Sc::Spectrum beta_eq = beta * tr.transmittance * c.sigma_s / ds.pdf;
+        if (!(beta_eq != 0.f).any()) return Status::Ok;
+        float track = 0.f, q = 1.f;  // p_track / p_eq of x; the roulette survival tracking would use at x
+        if constexpr (St::combines) {
+            track = tracking_over_equiangular<A>(ds.pdf, tr.null_pdf_product, c, mu_bar);
+            if (track > 0.f && opts_.russian_roulette && depth >= opts_.rr_start_depth) {
+                // Roulette survival is a function of the path: the throughput tracking would carry
+                // at x (null weights mu_n / (mu_bar P_n), real weight mu_s / (mu_bar P_s)), that is
+                // beta_eq p_eq / p_track.
+                q = std::min(opts_.rr_max_survival, (beta_eq / track).abs().maxCoeff());
+            }
+        }
+        return next_event(scene, x, ray.d, q, lambda, rng, counter, beta_eq, L, track, 1.f, true);
+    }
+
+    /// The collision estimator of volume emission (THEORY 5.7): at every tentative collision y of
+    /// a delta-tracked segment, beta mu_a(y) L_e(y) / mu_bar(y), weighted against NEE toward the
+    /// emission where the segment left a real vertex.
+    template <class Sc>
+    struct EmissionCollector {
+        static constexpr bool enabled = true;
+        using S = typename Sc::Spectral;
+        const Sc& scene;
+        const Ray& ray;
+        const typename S::Wavelengths& lambda;
+        const typename S::Spectrum& beta;
+        typename S::Spectrum& L;
+        const H& heuristic;
+        bool from_vertex;  ///< the segment left a real vertex (else the camera: no NEE alternative)
+        float survival, phase_pdf;
+
+        void operator()(float t, const Coefficients<S>& c, float mu_bar, const typename S::Spectrum& w,
+                        float null_pdf_product) const {
+            if (!(c.sigma_a > 0.f).any()) return;
+            const Vec3 y = ray.at(t);
+            const typename S::Spectrum le = scene.medium.emission(y, lambda);
+            if (!(le > 0.f).any()) return;
+            float wt = 1.f;
+            if constexpr (St::combines) {
+                if (from_vertex) {
+                    const float r = emission_collision_over_nee<St>(survival, phase_pdf, null_pdf_product, mu_bar, t * t,
+                                                                    scene.medium.emission_pdf(y));
+                    wt = heuristic.weight(1.f / r);
+                }
+            }
+            L += beta * w * c.sigma_a * le * (wt / mu_bar);
+        }
+    };
+
+    /// NEE toward the emitting volume at real vertex x (THEORY 5.7): a point y drawn by the
+    /// medium's emitted-power grid, the nulls to it ratio-tracked, weighted against the collision
+    /// estimator.
+    template <class Sc, UniformRng R, LookupCounter C>
+    Status emission_event(const Sc& scene, const Vec3& x, const Vec3& wo, float survival,
+                          const typename Sc::Spectral::Wavelengths& lambda, R& rng, C& counter,
+                          const typename Sc::Spectrum& beta, typename Sc::Spectrum& L) const {
+        using M = typename Sc::MediumType;
+        using B = bound_policy_t<typename Sc::MajorantType>;
+        const float u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform(), u3 = rng.uniform();
+        const VolumeSample vs = scene.medium.sample_emission(u0, u1, u2, u3);
+        if (!(vs.pdf > 0.f)) return Status::Ok;
+        const Vec3 dv = vs.p - x;
+        const float d2 = glm::dot(dv, dv);
+        if (!(d2 > 0.f)) return Status::Ok;
+        const float d = std::sqrt(d2);
+        const Ray shadow{x, dv / d};
+        if (scene.lights.sphere_blocks(shadow, d)) return Status::Ok;
+        const auto tr = track_ratio<A, St::null_pdfs>(scene.medium, scene.majorant, shadow, d, lambda, rng, counter);
+        if (tr.end == SegmentEnd::Aborted || tr.end == SegmentEnd::Rejected) return flight_status(tr.end);
+        if (tr.end == SegmentEnd::Terminated) return Status::Ok;
+        counter.lookup();
+        auto c = scene.medium.coefficients(vs.p, lambda);
+        const float mu_bar = majorant_value_at_point<M>(scene.majorant, shadow, d, lambda);
+        if constexpr (std::is_same_v<B, bound::Clamp>) {
+            detail::clamp_to_majorant(c, mu_bar);
+        } else if constexpr (std::is_same_v<B, bound::Reject>) {
+            if (detail::exceeds_majorant(c, mu_bar)) return Status::Rejected;
+        }
+        const typename Sc::Spectrum le = scene.medium.emission(vs.p, lambda);
+        float w = 1.f;
+        if constexpr (St::combines)
+            w = heuristic_.weight(emission_collision_over_nee<St>(survival, scene.phase.pdf(wo, shadow.d),
+                                                                  tr.null_pdf_product, mu_bar, d2, vs.pdf));
+        L += beta * tr.transmittance * c.sigma_a * le * (w * scene.phase.eval(wo, shadow.d) / (d2 * vs.pdf));
         return Status::Ok;
     }
 

@@ -18,6 +18,7 @@
 #include "../channel_tracking.hpp"
 #include "../core/counter.hpp"
 #include "../core/rng.hpp"
+#include "../media/emissive.hpp"
 #include "../mis.hpp"
 #include "../path_pdf.hpp"
 #include "../scene.hpp"
@@ -72,6 +73,12 @@ public:
         static_assert(CP::own_pdfs || !is_per_channel_majorant_v<Maj, M>,
                       "nsp::SpectralPathEstimator: spectral tracking shares one pdf over channels and needs a "
                       "grey majorant bounding every channel (GlobalMajorant)");
+        static_assert(!St::equiangular,
+                      "nsp::SpectralPathEstimator does not draw equiangular vertices yet; equiangular "
+                      "strategies go with nsp::PathEstimator (a grey majorant, every spectral mode)");
+        static_assert(!EmissiveMedium<M>,
+                      "nsp::SpectralPathEstimator does not collect volume emission yet; emissive media go "
+                      "with nsp::PathEstimator (a grey majorant, every spectral mode)");
         using Spectrum = typename Sc::Spectrum;
         const Spectrum& q = selection.probabilities();
         const int c = selection.sample(rng.uniform());

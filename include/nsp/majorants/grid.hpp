@@ -157,6 +157,15 @@ public:
         return {box_, res_, cell_, r, box_.clip(r, tmin, tmax)};
     }
 
+    /// The value of the cell holding point p (faces rounded to the cell above, clamped to the
+    /// grid), 0 outside the box.
+    float at_point(const Vec3& p) const noexcept {
+        if (!box_.contains(p)) return 0.f;
+        int c[3];
+        for (int a = 0; a < 3; ++a) c[a] = std::clamp(int((p[a] - box_.lo[a]) / cell_[a]), 0, res_[a] - 1);
+        return at(c[0], c[1], c[2]);
+    }
+
     /// The value of cell (x, y, z).
     float at(int x, int y, int z) const noexcept {
         return values_[std::size_t(x) + std::size_t(res_[0]) * (std::size_t(y) + std::size_t(res_[1]) * std::size_t(z))];
@@ -228,6 +237,10 @@ public:
 
     /// The majorant of cell (x, y, z).
     float cell(int x, int y, int z) const noexcept { return grid_.at(x, y, z) * unit_; }
+    /// The majorant at point p (its cell's; 0 outside the medium's box): one lookup, no walk.
+    float value_at(const Vec3& p, const typename M::Spectral::Wavelengths&) const noexcept {
+        return grid_.at_point(p) * unit_;
+    }
     std::array<int, 3> resolution() const noexcept { return grid_.resolution(); }
     Vec3 cell_size() const noexcept { return grid_.cell_size(); }
     /// Bytes of cell storage (one float per cell).
@@ -264,6 +277,10 @@ public:
     /// Every channel's majorant in cell (x, y, z) at wavelengths l.
     Spectrum cell(int x, int y, int z, const typename Spectral::Wavelengths& l) const noexcept {
         return Spectral::sample(unit_, l) * grid_.at(x, y, z);
+    }
+    /// Every channel's majorant at point p (its cell's; 0 outside the medium's box).
+    Spectrum value_at(const Vec3& p, const typename Spectral::Wavelengths& l) const noexcept {
+        return Spectral::sample(unit_, l) * grid_.at_point(p);
     }
     std::array<int, 3> resolution() const noexcept { return grid_.resolution(); }
     Vec3 cell_size() const noexcept { return grid_.cell_size(); }
