@@ -1,0 +1,194 @@
+// tests/test_emission_estimators.cpp: volume emission in the path estimators (THEORY 5.7). The
+// collision estimator, NEE toward the emitting volume and their MIS are unbiased: an emissive
+// furnace (L_e equal to the environment: radiance L_e everywhere, for any density and albedo), an
+// emitting absorber with analytic optical depth against quadrature, and NEE + MIS against the
+// collision estimator on a scattering medium with a spatially varying emission grid. The MIS
+// weights of the two techniques sum to 1 for one path.
+#include <cmath>
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include "majorants.hpp"
+
+namespace {
+
+using namespace nsp_test;
+
+// k = 5 standard errors of the mean (estimated from the samples; combined sqrt(se1^2 + se2^2)
+// for the difference of two independent runs). Fixed seeds: deterministic.
+constexpr double kSigmas = 5.0;
+
+template <AbsorptionPolicy A>
+using EmissionEstimatorsWith = std::tuple<PathEstimator<strategy::Unidirectional, mis::None, A>,
+                                          PathEstimator<strategy::NextEvent, mis::None, A>,
+                                          PathEstimator<strategy::DirectionalMis, mis::Balance, A>,
+                                          PathEstimator<strategy::NullScatteringMis, mis::Balance, A>,
+                                          PathEstimator<strategy::NullScatteringMis, mis::Power, A>,
+                                          PathEstimator<strategy::EquiangularMis, mis::Balance, A>>;
+
+/// The media with a closed-form optical depth: {Mono, Rgb} x {homogeneous, exponential} x absorption.
+using AnalyticCombosForEmission = decltype(std::tuple_cat(CombosOf<Mono, HomogeneousMedium>{}, CombosOf<Mono, ExponentialMedium>{},
+                                                          CombosOf<Rgb, HomogeneousMedium>{}, CombosOf<Rgb, ExponentialMedium>{}));
+
+/// An emission grid over `b` (voxel values uniform in [0, 2 mean) from `seed`, or all `mean`
+/// when seed is 0).
+EmissionGrid make_emission(const Box& b, std::array<int, 3> res, float mean, std::uint64_t seed) {
+    std::vector<float> v(std::size_t(res[0] * res[1] * res[2]), mean);
+    if (seed != 0) {
+        Pcg32 rng(seed, 3);
+        for (float& x : v) x = 2.f * mean * rng.uniform();
+    }
+    return EmissionGrid(b, res, std::move(v));
+}
+
+/// Runs every estimator of EmissionEstimatorsWith<A> on `scene` along `ray` and checks each
+/// channel's mean against `expected(c)`.
+template <class C, class Sc, class F>
+void check_all(const Sc& scene, const Ray& ray, const EstimatorOptions& opts, int n, int seed0,
+               const std::string& what, F expected) {
+    using S = typename C::Spectral;
+    std::apply(
+        [&](auto... est) {
+            int seed = seed0;
+            ((void)[&] {
+                using E = decltype(est);
+                const auto res = estimate_radiance(E(opts), scene, ray, n, std::uint64_t(++seed));
+                CHECK(res.not_ok == 0);
+                for (int c = 0; c < S::channels; ++c) {
+                    const Stat& s = res.stat.ch[c];
+                    CAPTURE(c);
+                    MESSAGE(combo_name<C>() << " " << what << " " << estimator_name<E>() << ": " << s.mean << " (SE "
+                                            << s.se() << "), expected " << expected(c));
+                    CHECK(std::abs(s.mean - expected(c)) <= kSigmas * s.se() + kRoundingFloor);
+                }
+            }(), ...);
+        },
+        EmissionEstimatorsWith<typename C::Absorption>{});
+}
+
+TEST_CASE_TEMPLATE_DEFINE("emissive furnace: L_e equal to the environment gives L_e", C, emissive_furnace) {
+    using S = typename C::Spectral;
+    using M = typename C::Medium;
+    const Box box{Vec3(-1.f), Vec3(1.f)};
+    // Constant L_e inside a box lit by an environment of the same radiance: L = L_e solves the
+    // transport equation for any mu_a, mu_s and phase function (emission balances absorption).
+    const auto le = spec<S>(0.7f, 0.4f, 1.1f);
+    const M base = make_medium<M>(box, 1.0f, spec<S>(0.5f, 0.3f, 0.8f), spec<S>(0.6f, 0.9f, 0.3f));
+    const Emissive<M> medium(base, make_emission(box, {3, 2, 4}, 1.f, 0), le, {4, 4, 4});
+    Lights<S> lights;
+    lights.set(EnvironmentLight<S>{le});
+    const Ray ray{Vec3(-3.f, 0.15f, -0.1f), glm::normalize(Vec3(1.f, 0.02f, 0.03f))};
+    auto run = [&](const auto& maj, const std::string& maj_name) {
+        const auto scene = Scene(medium, maj, HenyeyGreensteinPhase(0.3f), lights);
+        check_all<C>(scene, ray, EstimatorOptions{}, 6000, 40, maj_name, [&](int c) { return double(le[c]); });
+        // Roulette from the first real vertex, survival at most 0.6: both MIS sides must carry it.
+        EstimatorOptions rr;
+        rr.rr_start_depth = 1;
+        rr.rr_max_survival = 0.6f;
+        check_all<C>(scene, ray, rr, 6000, 50, maj_name + " roulette", [&](int c) { return double(le[c]); });
+    };
+    run(GlobalMajorant<Emissive<M>>(medium), "global");
+    for_each_kind<std::tuple<GridKind, SignedGridKind>, Emissive<M>>(
+        [&](auto kind) { run(decltype(kind)::make(medium), decltype(kind)::name); });
+}
+TEST_CASE_TEMPLATE_APPLY(emissive_furnace, AllCombos);
+
+TEST_CASE_TEMPLATE_DEFINE("emitting absorber with analytic optical depth = quadrature", C, emissive_absorber) {
+    using S = typename C::Spectral;
+    using M = typename C::Medium;
+    const Box box{Vec3(-1.f), Vec3(1.f)};
+    // No scattering: L_c = int T_c(0, t) mu_a,c(t) L_e,c(t) dt along the ray, L_e varying over a
+    // 5 x 3 x 4 grid (trilinear), by composite Simpson in double with 20000 intervals.
+    const M base = make_medium<M>(box, 0.9f, spec<S>(0.8f, 0.4f, 1.5f), grey<S>(0.f));
+    const auto le = spec<S>(2.f, 1.f, 0.5f);
+    const Emissive<M> medium(base, make_emission(Box{Vec3(-1.f, -0.8f, -1.2f), Vec3(0.9f, 1.f, 1.f)}, {5, 3, 4}, 1.f, 77),
+                             le, {6, 5, 4});
+    const Ray ray{Vec3(-3.f, 0.25f, -0.3f), glm::normalize(Vec3(1.f, -0.05f, 0.12f))};
+    const Interval in = box.clip(ray, 0.f, kInf);
+    std::array<double, 3> ref{};
+    const int n = 20000;
+    for (int i = 0; i <= n; ++i) {
+        const float t = in.t0 + (in.t1 - in.t0) * float(i) / float(n);
+        const auto tau = base.optical_depth(ray, 0.f, t);
+        const auto k = base.coefficients(ray.at(t), {});
+        const auto e = medium.emission(ray.at(t), {});
+        const double w = (i == 0 || i == n) ? 1.0 : (i % 2 ? 4.0 : 2.0);
+        for (int c = 0; c < S::channels; ++c) ref[c] += w * std::exp(-double(tau[c])) * double(k.sigma_a[c]) * double(e[c]);
+    }
+    for (double& r : ref) r *= double(in.t1 - in.t0) / (3.0 * n);
+    auto run = [&](const auto& maj, const std::string& maj_name) {
+        const auto scene = Scene(medium, maj, IsotropicPhase{}, Lights<S>{});
+        check_all<C>(scene, ray, EstimatorOptions{}, 20000, 60, maj_name, [&](int c) { return ref[c]; });
+    };
+    run(GlobalMajorant<Emissive<M>>(medium), "global");
+    for_each_kind<std::tuple<SignedGlobalKind, GridKind, SignedGridKind>, Emissive<M>>(
+        [&](auto kind) { run(decltype(kind)::make(medium), decltype(kind)::name); });
+}
+TEST_CASE_TEMPLATE_APPLY(emissive_absorber, AnalyticCombosForEmission);
+
+TEST_CASE_TEMPLATE_DEFINE("emission NEE and MIS agree with the collision estimator on a scattering medium", C,
+                          emissive_scattering) {
+    using S = typename C::Spectral;
+    using M = typename C::Medium;
+    using A = typename C::Absorption;
+    const Box box{Vec3(-1.f), Vec3(1.f)};
+    // Albedo about 0.6, optical thickness about 1.5, emission in a 4 x 4 x 4 grid over part of the
+    // box; no other light. Reference: the collision estimator alone (unidirectional), 3x the samples.
+    const M base = make_medium<M>(box, 0.75f, spec<S>(0.4f, 0.6f, 0.3f), spec<S>(0.6f, 0.5f, 0.8f));
+    const Emissive<M> medium(base, make_emission(Box{Vec3(-0.6f, -0.5f, -0.4f), Vec3(0.5f, 0.7f, 0.6f)}, {4, 4, 4}, 1.f, 91),
+                             spec<S>(1.f, 0.6f, 0.3f), {8, 8, 8});
+    const auto scene = Scene(medium, GlobalMajorant<Emissive<M>>(medium), HenyeyGreensteinPhase(-0.2f), Lights<S>{});
+    const Ray ray{Vec3(-3.f, 0.3f, 0.2f), glm::normalize(Vec3(1.f, -0.02f, 0.04f))};
+    const auto ref = estimate_radiance(PathEstimator<strategy::Unidirectional, mis::None, A>{}, scene, ray, 60000, 70);
+    CHECK(ref.not_ok == 0);
+    std::apply(
+        [&](auto... est) {
+            int seed = 70;
+            ((void)[&] {
+                using E = decltype(est);
+                const auto res = estimate_radiance(est, scene, ray, 20000, std::uint64_t(++seed));
+                CHECK(res.not_ok == 0);
+                for (int c = 0; c < S::channels; ++c) {
+                    const Stat &s = res.stat.ch[c], &r = ref.stat.ch[c];
+                    const double se = std::sqrt(s.se() * s.se() + r.se() * r.se());
+                    CAPTURE(c);
+                    MESSAGE(combo_name<C>() << " " << estimator_name<E>() << ": " << s.mean << " (SE " << s.se()
+                                            << "), collision only " << r.mean << " (SE " << r.se() << ")");
+                    CHECK(r.mean > 0.02);  // a non-trivial answer
+                    CHECK(std::abs(s.mean - r.mean) <= kSigmas * se);
+                }
+            }(), ...);
+        },
+        std::tuple<PathEstimator<strategy::NextEvent, mis::None, A>, PathEstimator<strategy::NullScatteringMis, mis::Balance, A>,
+                   PathEstimator<strategy::NullScatteringMis, mis::Power, A>>{});
+}
+TEST_CASE_TEMPLATE_APPLY(emissive_scattering, AllCombos);
+
+TEST_CASE("emission MIS: the collision and NEE weights of one path sum to 1 and follow the pdfs") {
+    // A real vertex x, a direction and a point y with nulls between them: the collision side and
+    // the NEE side each form the ratio from their own quantities (tracking's null product vs ratio
+    // tracking's for the same nulls; both equal here by construction), and the weights must sum
+    // to 1 and equal the heuristic of the absolute pdfs
+    // p_uni = q p_w / d^2 prod P_n mu_bar(y) (volume measure) and p_nee = p_V(y).
+    Pcg32 rng(4, 4);
+    for (int i = 0; i < 1000; ++i) {
+        const float q = 0.3f + 0.7f * rng.uniform(), p_w = 0.05f + 2.f * rng.uniform();
+        const float pn = std::pow(rng.uniform(), 3.f), mu = 0.1f + 20.f * rng.uniform();
+        const float d = 0.01f + 3.f * rng.uniform(), p_v = 0.01f + 5.f * rng.uniform();
+        CAPTURE(i);
+        for (const double beta : {1.0, 2.0}) {
+            const mis::Power h{float(beta)};
+            const float r = emission_collision_over_nee<strategy::NullScatteringMis>(q, p_w, pn, mu, d * d, p_v);
+            const double w_col = h.weight(1.f / r), w_nee = h.weight(r);
+            CHECK(w_col + w_nee == doctest::Approx(1.0).epsilon(1e-5));
+            const double p_uni = double(q) * p_w / (double(d) * d) * pn * mu, p_nee = p_v;
+            CHECK(w_nee == doctest::Approx(std::pow(p_nee, beta) / (std::pow(p_nee, beta) + std::pow(p_uni, beta))).epsilon(1e-4));
+            // Directional MIS leaves the null product out, as it does for lights.
+            const float rd = emission_collision_over_nee<strategy::DirectionalMis>(q, p_w, pn, mu, d * d, p_v);
+            CHECK(double(rd) == doctest::Approx(double(q) * p_w * mu / (double(d) * d * p_v)).epsilon(1e-5));
+        }
+    }
+}
+
+}  // namespace
