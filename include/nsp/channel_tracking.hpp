@@ -103,13 +103,15 @@ struct ChannelTrack {
 
 /// Delta tracking with channel c's sampling and every channel's pdf (THEORY 5.3): updates the
 /// state's f and uni at every vertex and, with `nee_alternative`, nee by ratio tracking's pdf
-/// mu_bar_c Tbar_c of each null (the NEE pdf of the same nulls, THEORY 5.1).
-template <ChannelPolicy CP, AbsorptionPolicy A, SpectralMode S, UniformRng R, class Rec>
+/// mu_bar_c Tbar_c of each null (the NEE pdf of the same nulls, THEORY 5.1). A state with an
+/// equiangular slot gets the same null factors there, and at the real vertex its Tbar_c since the
+/// last null (the equiangular technique's pdf of the segment, without its density; THEORY 5.4).
+template <ChannelPolicy CP, AbsorptionPolicy A, SpectralMode S, UniformRng R, class Rec, bool kEq = false>
 struct ChannelDeltaCollision {
     using Spec = typename S::Spectrum;
     R& rng;
     Rec& rec;
-    ChannelPathState<S>& st;
+    ChannelPathState<S, kEq>& st;
     int c;
     bool nee_alternative;
     ChannelTrack out{};
@@ -159,8 +161,12 @@ struct ChannelDeltaCollision {
             f_factor *= tb;
             p_factor *= tb;
             nee_factor *= tb;
+            if constexpr (kEq)  // Tbar_c alone at the real vertex: it is not a null
+                if (event == SegmentEnd::Scattered) st.eq *= tb;
         }
         if (event == SegmentEnd::Passed && nee_alternative) st.nee *= nee_factor;
+        if constexpr (kEq)
+            if (event == SegmentEnd::Passed) st.eq *= nee_factor;
         st.f *= f_factor;
         st.uni *= p_factor;
         if (!st.template renormalize<CP>(c)) {
@@ -178,14 +184,14 @@ struct ChannelDeltaCollision {
 /// Delta-tracks `ray` over [0, tmax] with sampling channel c, updating `st` (see
 /// ChannelDeltaCollision). On `Passed` the state includes every channel's Tbar to tmax.
 template <ChannelPolicy CP, AbsorptionPolicy A, Medium M, MajorantPolicy<M> Maj, UniformRng R, LookupCounter C,
-          class Rec = NoRecord>
+          bool kEq, class Rec = NoRecord>
 ChannelTrack track_channels_delta(const M& medium, const Maj& majorant, const Ray& ray, float tmax,
                                   const typename M::Spectral::Wavelengths& lambda, int c,
-                                  ChannelPathState<typename M::Spectral>& st, bool nee_alternative, R& rng,
+                                  ChannelPathState<typename M::Spectral, kEq>& st, bool nee_alternative, R& rng,
                                   C& counter, Rec&& rec = Rec{}) {
     using S = typename M::Spectral;
     using RecT = std::remove_reference_t<Rec>;
-    ChannelDeltaCollision<CP, A, S, R, RecT> cb{rng, rec, st, c, nee_alternative};
+    ChannelDeltaCollision<CP, A, S, R, RecT, kEq> cb{rng, rec, st, c, nee_alternative};
     const auto f = free_flight(medium, majorant, ray, 0.f, tmax, lambda, rng, counter, cb, kDefaultMaxCollisions, c);
     if (f.aborted) return {aborted_end(f), f.t};
     if (f.stopped) return cb.out;
@@ -194,6 +200,7 @@ ChannelTrack track_channels_delta(const M& medium, const Maj& majorant, const Ra
         st.f *= tb;
         st.uni *= tb;
         st.nee *= tb;
+        if constexpr (kEq) st.eq *= tb;
         if (!st.template renormalize<CP>(c)) return {SegmentEnd::Terminated, tmax};
     }
     if constexpr (RecT::enabled) rec.log_pdf -= double(channel_of(f.tau_tail, c));

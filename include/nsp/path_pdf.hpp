@@ -16,6 +16,7 @@
 #include <algorithm>
 #include <cmath>
 #include <concepts>
+#include <type_traits>
 
 #include "core/error.hpp"
 #include "spectrum.hpp"
@@ -127,29 +128,51 @@ private:
 // ---------------------------------------------------------------------------------------------
 // The state
 
+namespace detail {
+/// The equiangular pdf slot of a state whose strategy draws no equiangular vertices: nothing.
+struct NoEquiangularPdf {};
+}  // namespace detail
+
 /// What a path carries per channel, all relative to one normaliser K (see the file comment):
 /// `f` = f_c / K, `uni` = p_c / K of the path as sampled so far by unidirectional tracking with
 /// channel c, and `nee` = the pdf / K with which next-event estimation from the last real vertex
 /// would have produced the current segment's nulls (ratio tracking with channel c's majorant),
-/// without the light pdf, which is only known where the segment ends (THEORY 5.1).
-template <SpectralMode S>
+/// without the light pdf, which is only known where the segment ends (THEORY 5.1). With
+/// `kEquiangular`, `eq` = the pdf / K with which equiangular sampling on the current segment
+/// would have produced its nulls (ratio tracking) and the segment's last vertex, without the
+/// equiangular density, which the estimator multiplies in (THEORY 5.4); other states carry an
+/// empty slot there.
+template <SpectralMode S, bool kEquiangular = false>
 struct ChannelPathState {
     using Spectrum = typename S::Spectrum;
+    using EquiangularPdf = std::conditional_t<kEquiangular, Spectrum, detail::NoEquiangularPdf>;
+    static constexpr bool equiangular = kEquiangular;
+
     Spectrum f = Spectrum::Ones();
     Spectrum uni = Spectrum::Ones();
     Spectrum nee = Spectrum::Zero();
+    [[no_unique_address]] EquiangularPdf eq = zero_equiangular();
 
-    /// Rescales f, uni and nee by one factor: by the sampling channel's pdf `uni[c]` when only
-    /// that channel is ever estimated (independent tracking), else so that the largest pdf is 1.
-    /// Returns false if there is no positive finite pdf left to scale by (the path is dead).
+    /// Rescales f, uni, nee (and eq) by one factor: by the sampling channel's pdf `uni[c]` when
+    /// only that channel is ever estimated (independent tracking), else so that the largest pdf is
+    /// 1. Returns false if there is no positive finite pdf left to scale by (the path is dead).
     template <ChannelPolicy CP>
     bool renormalize(int c) noexcept {
-        const float k = CP::mis_over_channels ? std::max(uni.maxCoeff(), nee.maxCoeff()) : uni[c];
+        float k = CP::mis_over_channels ? std::max(uni.maxCoeff(), nee.maxCoeff()) : uni[c];
+        if constexpr (kEquiangular)
+            if (CP::mis_over_channels) k = std::max(k, eq.maxCoeff());
         if (!(k > 0.f) || !std::isfinite(k)) return false;
         f /= k;
         uni /= k;
         nee /= k;
+        if constexpr (kEquiangular) eq /= k;
         return true;
+    }
+
+private:
+    static EquiangularPdf zero_equiangular() noexcept {
+        if constexpr (kEquiangular) return Spectrum::Zero();
+        else return {};
     }
 };
 

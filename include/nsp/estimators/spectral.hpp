@@ -8,28 +8,35 @@
 // majorant and keeps every channel's contribution and pdf in a ChannelPathState, so one formula
 // weighs the 2 x C techniques of spectral MIS + NEE:
 //
-//     estimate_lambda = f_lambda / sum_c q_c (p_uni,c + p_nee,c).
+//     estimate_lambda = f_lambda / sum_c q_c (p_uni,c + p_nee,c),
+//
+// and the 3 x C of spectral MIS + NEE + equiangular sampling (strategy::EquiangularMis, THEORY
+// 5.4): a real vertex drawn toward the point light, its nulls ratio-tracked with c*'s majorant,
+// every channel's tracking and equiangular pdf of it in the same sum.
 #pragma once
 
 #include <algorithm>
 #include <cstdint>
+#include <optional>
 #include <type_traits>
 
 #include "../channel_tracking.hpp"
 #include "../core/counter.hpp"
 #include "../core/rng.hpp"
+#include "../equiangular.hpp"
 #include "../media/emissive.hpp"
 #include "../mis.hpp"
 #include "../path_pdf.hpp"
+#include "../pdf.hpp"
 #include "../scene.hpp"
 #include "common.hpp"
 
 namespace nsp {
 
-/// A path estimator over channels: channel policy CP, strategy St (Unidirectional, NextEvent or
-/// NullScatteringMis), heuristic H (mis::None for a single strategy, mis::Balance for
-/// NullScatteringMis: the weights are the one-sample balance heuristic over channels and
-/// techniques) and absorption policy A.
+/// A path estimator over channels: channel policy CP, strategy St (Unidirectional, NextEvent,
+/// NullScatteringMis, EquiangularNextEvent or EquiangularMis), heuristic H (mis::None for a single
+/// strategy, mis::Balance for the combining ones: the weights are the one-sample balance heuristic
+/// over channels and techniques) and absorption policy A. Emissive media go with PathEstimator.
 template <ChannelPolicy CP, PathStrategy St, mis::Heuristic H = mis::None, AbsorptionPolicy A = absorption::Weight>
 class SpectralPathEstimator {
     static_assert(St::null_pdfs || !St::combines,
@@ -73,25 +80,38 @@ public:
         static_assert(CP::own_pdfs || !is_per_channel_majorant_v<Maj, M>,
                       "nsp::SpectralPathEstimator: spectral tracking shares one pdf over channels and needs a "
                       "grey majorant bounding every channel (GlobalMajorant)");
-        static_assert(!St::equiangular,
-                      "nsp::SpectralPathEstimator does not draw equiangular vertices yet; equiangular "
-                      "strategies go with nsp::PathEstimator (a grey majorant, every spectral mode)");
         static_assert(!EmissiveMedium<M>,
                       "nsp::SpectralPathEstimator does not collect volume emission yet; emissive media go "
                       "with nsp::PathEstimator (a grey majorant, every spectral mode)");
         using Spectrum = typename Sc::Spectrum;
         const Spectrum& q = selection.probabilities();
         const int c = selection.sample(rng.uniform());
-        ChannelPathState<typename Sc::Spectral> st;
+        ChannelPathState<typename Sc::Spectral, St::equiangular> st;
         Spectrum L = Spectrum::Zero();
         Status status = Status::Ok;
         Ray ray = camera_ray;
         Vec3 prev_x(0.f);  // the real vertex the current ray left from
         bool from_camera = true;
+        std::optional<Vec3> target;
+        if constexpr (St::equiangular) target = scene.lights.equiangular_target();
 
         for (int depth = 0;;) {
             const LightHit hit = scene.lights.intersect(ray);
             const bool nee_alternative = St::combines && !from_camera;
+            // Equiangular: a real vertex on this segment aimed at the light, NEE from it; and the
+            // equiangular pdf of the vertex tracking is about to draw starts from the same prefix.
+            EquiangularSampler eq;
+            if constexpr (St::equiangular) {
+                st.eq = st.uni;
+                if (target) {
+                    const Interval in = scene.medium.bounds().clip(ray, 0.f, hit.t);
+                    eq = EquiangularSampler(ray, *target, in.t0, in.t1);
+                    if (depth < opts_.max_depth) {
+                        const Status es = equiangular_vertex(scene, ray, eq, depth + 1, lambda, q, c, st, rng, counter, L);
+                        if (es != Status::Ok) status = es;
+                    }
+                }
+            }
             const ChannelTrack seg = track_channels_delta<CP, A>(scene.medium, scene.majorant, ray, hit.t, lambda, c,
                                                                  st, nee_alternative, rng, counter);
             if (const Status fs = flight_status(seg.end); fs != Status::Ok) {
@@ -110,6 +130,10 @@ public:
             if (++depth > opts_.max_depth) break;
 
             const Vec3 x = ray.at(seg.t);
+            // Every channel's equiangular pdf of x (same prefix and normaliser as st.uni).
+            Spectrum eq_pdf = Spectrum::Zero();
+            if constexpr (St::equiangular)
+                if (target) eq_pdf = st.eq * eq.pdf(seg.t);
             // Roulette survival is fixed before NEE: the continuing unidirectional path carries it.
             // It follows what the path would contribute per unit of incident light, the largest
             // channel estimate, as PathEstimator's max |beta| does.
@@ -117,15 +141,22 @@ public:
             if (opts_.russian_roulette && depth >= opts_.rr_start_depth)
                 rr = std::min(opts_.rr_max_survival, channel_estimate<CP>(st.f, st.uni, q, c).abs().maxCoeff());
             if constexpr (St::samples_lights) {
-                const Status ns = next_event(scene, x, ray.d, rr, lambda, q, c, st, rng, counter, L);
-                if (ns != Status::Ok) status = ns;
+                // Equiangular + NEE alone leaves the lights to its own vertices when it has a target.
+                if (St::combines || !St::equiangular || !target) {
+                    const Status ns = next_event(scene, x, ray.d, rr, lambda, q, c, st.f, st.uni, eq_pdf, rng, counter, L);
+                    if (ns != Status::Ok) status = ns;
+                }
             }
             if (rr < 1.f && !(rng.uniform() < rr)) break;
             const float u1 = rng.uniform(), u2 = rng.uniform();
             const PhaseSample ps = scene.phase.sample(ray.d, u1, u2);
             if (!(ps.pdf > 0.f)) break;
-            // The NEE alternative of the next segment starts from the prefix, without roulette.
-            if constexpr (St::combines) st.nee = st.uni;
+            // The NEE alternative of the next segment starts from the prefix, without roulette
+            // (and, with equiangular sampling, from either technique's pdf of x).
+            if constexpr (St::combines) {
+                if constexpr (St::equiangular) st.nee = st.uni + eq_pdf;
+                else st.nee = st.uni;
+            }
             st.f *= ps.value;
             st.uni *= rr * ps.pdf;
             if (!st.template renormalize<CP>(c)) break;
@@ -138,13 +169,15 @@ public:
     }
 
 private:
-    /// Adds NEE's contribution at real vertex x (arrived along wo, roulette survival rr) to L;
-    /// returns Aborted or Rejected if its shadow flight was, else Ok.
+    /// Adds NEE's contribution at real vertex x (arrived along wo, roulette survival rr) to L:
+    /// `f` is every channel's contribution of the path up to x, `p_track` its tracking pdf and
+    /// `p_eq` its equiangular pdf (0 without equiangular sampling), all relative to one
+    /// normaliser. Returns Aborted or Rejected if the shadow flight was, else Ok.
     template <class Sc, UniformRng R, LookupCounter C>
     Status next_event(const Sc& scene, const Vec3& x, const Vec3& wo, float rr,
-                    const typename Sc::Spectral::Wavelengths& lambda, const typename Sc::Spectrum& q, int c,
-                    const ChannelPathState<typename Sc::Spectral>& st, R& rng, C& counter,
-                    typename Sc::Spectrum& L) const {
+                      const typename Sc::Spectral::Wavelengths& lambda, const typename Sc::Spectrum& q, int c,
+                      const typename Sc::Spectrum& f_x, const typename Sc::Spectrum& p_track,
+                      const typename Sc::Spectrum& p_eq, R& rng, C& counter, typename Sc::Spectrum& L) const {
         const float u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
         const LightSample<typename Sc::Spectral> ls = scene.lights.sample(x, u0, u1, u2, lambda);
         if (!(ls.pdf > 0.f)) return Status::Ok;
@@ -152,15 +185,75 @@ private:
         if (ls.occludable_by_sphere && scene.lights.sphere_blocks(shadow, ls.distance)) return Status::Ok;
         const bool uni_alternative = St::combines && !ls.delta;  // a point light cannot be hit
         const auto sh = track_channels_ratio<CP, A>(scene.medium, scene.majorant, shadow, ls.distance, lambda, c,
-                                                    st.f, uni_alternative, rng, counter);
+                                                    f_x, uni_alternative, rng, counter);
         if (sh.end == SegmentEnd::Aborted || sh.end == SegmentEnd::Rejected) return flight_status(sh.end);
         if (sh.end == SegmentEnd::Terminated) return Status::Ok;
         using Spectrum = typename Sc::Spectrum;
-        Spectrum pdf = ls.pdf * sh.nee;
-        if (uni_alternative) pdf += (rr * scene.phase.pdf(wo, ls.wi)) * sh.uni;
-        const Spectrum f = st.f * sh.f * scene.phase.eval(wo, ls.wi);
-        L += channel_estimate<CP, Spectrum>(f, st.uni * pdf, q, c) * ls.radiance;
+        const Spectrum f = f_x * sh.f * scene.phase.eval(wo, ls.wi);
+        Spectrum pdf;
+        if constexpr (St::equiangular) {
+            // Tracking + NEE, equiangular + NEE, tracking + hit (THEORY 5.4 with 5.1, 5.3).
+            pdf = (p_track + p_eq) * (ls.pdf * sh.nee);
+            if (uni_alternative) pdf += p_track * ((rr * scene.phase.pdf(wo, ls.wi)) * sh.uni);
+        } else {
+            Spectrum seg_pdf = ls.pdf * sh.nee;
+            if (uni_alternative) seg_pdf += (rr * scene.phase.pdf(wo, ls.wi)) * sh.uni;
+            pdf = p_track * seg_pdf;
+        }
+        L += channel_estimate<CP, Spectrum>(f, pdf, q, c) * ls.radiance;
         return Status::Ok;
+    }
+
+    /// Equiangular + NEE on the segment `ray` (THEORY 5.4 per channel): draws t with `eq`,
+    /// ratio-tracks the nulls on [0, t) with channel c's majorant and every channel's pdfs, makes t
+    /// a real scattering vertex at path depth `depth` and does NEE from it. `st` is the prefix up
+    /// to the ray's origin, its direction included.
+    template <class Sc, UniformRng R, LookupCounter C, class State>
+    Status equiangular_vertex(const Sc& scene, const Ray& ray, const EquiangularSampler& eq, int depth,
+                              const typename Sc::Spectral::Wavelengths& lambda, const typename Sc::Spectrum& q, int c,
+                              const State& st, R& rng, C& counter, typename Sc::Spectrum& L) const {
+        using M = typename Sc::MediumType;
+        using S = typename Sc::Spectral;
+        using Spectrum = typename Sc::Spectrum;
+        using B = bound_policy_t<typename Sc::MajorantType>;
+        const DistanceSample ds = eq.sample(rng.uniform());
+        if (!(ds.pdf > 0.f)) return Status::Ok;
+        const auto sh = track_channels_ratio<CP, A>(scene.medium, scene.majorant, ray, ds.t, lambda, c, st.f,
+                                                    St::combines, rng, counter);
+        if (sh.end == SegmentEnd::Aborted || sh.end == SegmentEnd::Rejected) return flight_status(sh.end);
+        if (sh.end == SegmentEnd::Terminated) return Status::Ok;
+        const Vec3 x = ray.at(ds.t);
+        const auto mu_v = majorant_value_at_point<M>(scene.majorant, ray, ds.t, lambda);
+        const Spectrum mu = detail::broadcast_majorant<Spectrum>(mu_v);
+        counter.lookup();
+        auto k = scene.medium.coefficients(x, lambda);
+        if constexpr (std::is_same_v<B, bound::Clamp>) {
+            detail::clamp_to_majorant(k, mu_v);
+        } else if constexpr (std::is_same_v<B, bound::Reject>) {
+            if (detail::exceeds_majorant(k, mu_v)) return Status::Rejected;
+        }
+        const Spectrum f_x = st.f * sh.f * k.sigma_s;
+        if (!(f_x != 0.f).any()) return Status::Ok;
+        const Spectrum p_eq = st.uni * sh.nee * ds.pdf;
+        Spectrum p_track = Spectrum::Zero();
+        float rr = 1.f;
+        if constexpr (St::combines) {
+            // Every channel's tracking pdf of the same nulls and of a real scattering vertex at x.
+            Spectrum scatter;
+            if constexpr (CP::own_pdfs) {
+                scatter = channel_event_densities<A, S>(k, mu).scatter;
+            } else {
+                const float m = channel_of(mu_v, 0);
+                scatter = m > 0.f ? Spectrum(Spectrum::Constant(
+                                        m * shared_event_probabilities<A, CP::throughput_weighted, S>(k, m, st.f * sh.f).scatter))
+                                  : Spectrum(Spectrum::Zero());
+            }
+            p_track = st.uni * sh.uni * scatter;
+            // The survival tracking would give x: a function of the path (its f and tracking pdfs).
+            if (opts_.russian_roulette && depth >= opts_.rr_start_depth)
+                rr = std::min(opts_.rr_max_survival, channel_estimate<CP>(f_x, p_track, q, c).abs().maxCoeff());
+        }
+        return next_event(scene, x, ray.d, rr, lambda, q, c, f_x, p_track, p_eq, rng, counter, L);
     }
 
     EstimatorOptions opts_;

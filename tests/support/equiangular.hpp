@@ -1,0 +1,44 @@
+// tests/support/equiangular.hpp: the closed-form reference of the equiangular suites.
+#pragma once
+
+#include <array>
+#include <cmath>
+
+#include "common.hpp"
+
+namespace nsp_test {
+
+/// Single scattering from an isotropic point light of intensity I along `ray`, isotropic phase:
+/// L_c = I_c / (4 pi) int T_c(0, t) mu_s,c(t) T_c(x_t, light) / |x_t - light|^2 dt over the part of
+/// the ray inside the medium, integrated in the equiangular angle (where the integrand is smooth)
+/// by composite Simpson in double with 20000 intervals.
+template <class M>
+inline std::array<double, 3> single_scatter_reference(const M& medium, const Ray& ray, const Vec3& light, float intensity) {
+    using S = typename M::Spectral;
+    const Interval in = medium.bounds().clip(ray, 0.f, kInf);
+    const Vec3 oc = light - ray.o;
+    const double delta = glm::dot(oc, ray.d);
+    const double d = glm::length(oc - float(delta) * ray.d);
+    const double th0 = std::atan2(double(in.t0) - delta, d), th1 = std::atan2(double(in.t1) - delta, d);
+    const int n = 20000;
+    std::array<double, 3> sum{};
+    for (int i = 0; i <= n; ++i) {
+        const double th = th0 + (th1 - th0) * double(i) / n;
+        const double t = delta + d * std::tan(th);
+        const double dt_dth = d / (std::cos(th) * std::cos(th));
+        const Vec3 x = ray.at(float(t));
+        const Vec3 to = light - x;
+        const float r = glm::length(to);
+        const auto tau_cam = medium.optical_depth(ray, 0.f, float(t));
+        const auto tau_light = medium.optical_depth(Ray{x, to / r}, 0.f, r);
+        const auto k = medium.coefficients(x, typename S::Wavelengths{});
+        const double wgt = (i == 0 || i == n) ? 1.0 : (i % 2 ? 4.0 : 2.0);
+        for (int c = 0; c < S::channels; ++c)
+            sum[c] += wgt * std::exp(-double(tau_cam[c]) - double(tau_light[c])) * double(k.sigma_s[c]) /
+                      (double(r) * double(r)) * dt_dth;
+    }
+    for (int c = 0; c < 3; ++c) sum[c] *= (th1 - th0) / (3.0 * n) * intensity / (4.0 * kPi);
+    return sum;
+}
+
+}  // namespace nsp_test
