@@ -16,6 +16,7 @@
 #include <cmath>
 #include <limits>
 #include <type_traits>
+#include <utility>
 
 #include "core/counter.hpp"
 #include "core/rng.hpp"
@@ -103,10 +104,17 @@ struct ChannelTrack {
 
 /// Delta tracking with channel c's sampling and every channel's pdf (THEORY 5.3): updates the
 /// state's f and uni at every vertex and, with `nee_alternative`, nee by ratio tracking's pdf
-/// mu_bar_c Tbar_c of each null (the NEE pdf of the same nulls, THEORY 5.1). A state with an
-/// equiangular slot gets the same null factors there, and at the real vertex its Tbar_c since the
-/// last null (the equiangular technique's pdf of the segment, without its density; THEORY 5.4).
-template <ChannelPolicy CP, AbsorptionPolicy A, SpectralMode S, UniformRng R, class Rec, bool kEq = false>
+/// mu_bar_c Tbar_c of each null (the NEE pdf of the same nulls, THEORY 5.1). A state with
+/// equiangular slots gets the same null factors there (eq.nee with nee, eq.vertex always), and
+/// eq.vertex at the real vertex its Tbar_c since the last null (the equiangular technique's pdf
+/// of the segment, without its density; THEORY 5.4).
+///
+/// A visitor with `enabled` is called at every tentative collision before its event is chosen, as
+/// `visit(t, coefficients, mu, tbar, st)` with every channel's majorant, its Tbar since the last
+/// tentative collision (relative, as the state's; ones for a grey majorant) and the state before
+/// this collision (the collision estimator of emission, THEORY 5.7 with 5.3, uses it).
+template <ChannelPolicy CP, AbsorptionPolicy A, SpectralMode S, UniformRng R, class Rec, bool kEq = false,
+          class Visit = NoVisit>
 struct ChannelDeltaCollision {
     using Spec = typename S::Spectrum;
     R& rng;
@@ -114,12 +122,19 @@ struct ChannelDeltaCollision {
     ChannelPathState<S, kEq>& st;
     int c;
     bool nee_alternative;
+    Visit visit{};
     ChannelTrack out{};
 
     template <class V>
     bool operator()(float t, const Coefficients<S>& k, const V& mu_v, const V& tau_v) {
         constexpr bool grey = std::is_same_v<V, float>;
         const Spec mu = detail::broadcast_majorant<Spec>(mu_v);
+        Spec tb;  // every channel's Tbar since the last tentative collision (a grey one cancels)
+        if constexpr (!grey) tb = detail::relative_transmittance(tau_v, c);
+        if constexpr (Visit::enabled) {
+            if constexpr (grey) visit(t, k, mu, Spec(Spec::Ones()), st);
+            else visit(t, k, mu, tb, st);
+        }
         // Every channel's density mu_bar_c P_x,c of each event: its own (own pdfs) or the one
         // shared by all channels (spectral tracking). The sampling channel's picks the event.
         ChannelEventDensities<Spec> d;
@@ -157,16 +172,18 @@ struct ChannelDeltaCollision {
         }
         Spec nee_factor = mu;  // ratio tracking's pdf of a null, for the NEE alternative (THEORY 5.1)
         if constexpr (!grey) {  // a grey majorant's Tbar is common to every channel and cancels
-            const Spec tb = detail::relative_transmittance(tau_v, c);
             f_factor *= tb;
             p_factor *= tb;
             nee_factor *= tb;
             if constexpr (kEq)  // Tbar_c alone at the real vertex: it is not a null
-                if (event == SegmentEnd::Scattered) st.eq *= tb;
+                if (event == SegmentEnd::Scattered) st.eq.vertex *= tb;
         }
-        if (event == SegmentEnd::Passed && nee_alternative) st.nee *= nee_factor;
+        if (event == SegmentEnd::Passed && nee_alternative) {
+            st.nee *= nee_factor;
+            if constexpr (kEq) st.eq.nee *= nee_factor;
+        }
         if constexpr (kEq)
-            if (event == SegmentEnd::Passed) st.eq *= nee_factor;
+            if (event == SegmentEnd::Passed) st.eq.vertex *= nee_factor;
         st.f *= f_factor;
         st.uni *= p_factor;
         if (!st.template renormalize<CP>(c)) {
@@ -181,17 +198,16 @@ struct ChannelDeltaCollision {
     }
 };
 
-/// Delta-tracks `ray` over [0, tmax] with sampling channel c, updating `st` (see
-/// ChannelDeltaCollision). On `Passed` the state includes every channel's Tbar to tmax.
+/// As track_channels_delta, calling `visit` at every tentative collision (see ChannelDeltaCollision).
 template <ChannelPolicy CP, AbsorptionPolicy A, Medium M, MajorantPolicy<M> Maj, UniformRng R, LookupCounter C,
-          bool kEq, class Rec = NoRecord>
-ChannelTrack track_channels_delta(const M& medium, const Maj& majorant, const Ray& ray, float tmax,
-                                  const typename M::Spectral::Wavelengths& lambda, int c,
-                                  ChannelPathState<typename M::Spectral, kEq>& st, bool nee_alternative, R& rng,
-                                  C& counter, Rec&& rec = Rec{}) {
+          bool kEq, class Visit, class Rec = NoRecord>
+ChannelTrack track_channels_delta_visiting(const M& medium, const Maj& majorant, const Ray& ray, float tmax,
+                                           const typename M::Spectral::Wavelengths& lambda, int c,
+                                           ChannelPathState<typename M::Spectral, kEq>& st, bool nee_alternative,
+                                           R& rng, C& counter, Visit visit, Rec&& rec = Rec{}) {
     using S = typename M::Spectral;
     using RecT = std::remove_reference_t<Rec>;
-    ChannelDeltaCollision<CP, A, S, R, RecT, kEq> cb{rng, rec, st, c, nee_alternative};
+    ChannelDeltaCollision<CP, A, S, R, RecT, kEq, Visit> cb{rng, rec, st, c, nee_alternative, std::move(visit)};
     const auto f = free_flight(medium, majorant, ray, 0.f, tmax, lambda, rng, counter, cb, kDefaultMaxCollisions, c);
     if (f.aborted) return {aborted_end(f), f.t};
     if (f.stopped) return cb.out;
@@ -200,11 +216,26 @@ ChannelTrack track_channels_delta(const M& medium, const Maj& majorant, const Ra
         st.f *= tb;
         st.uni *= tb;
         st.nee *= tb;
-        if constexpr (kEq) st.eq *= tb;
+        if constexpr (kEq) {
+            st.eq.vertex *= tb;
+            st.eq.nee *= tb;
+        }
         if (!st.template renormalize<CP>(c)) return {SegmentEnd::Terminated, tmax};
     }
     if constexpr (RecT::enabled) rec.log_pdf -= double(channel_of(f.tau_tail, c));
     return {SegmentEnd::Passed, tmax};
+}
+
+/// Delta-tracks `ray` over [0, tmax] with sampling channel c, updating `st` (see
+/// ChannelDeltaCollision). On `Passed` the state includes every channel's Tbar to tmax.
+template <ChannelPolicy CP, AbsorptionPolicy A, Medium M, MajorantPolicy<M> Maj, UniformRng R, LookupCounter C,
+          bool kEq, class Rec = NoRecord>
+ChannelTrack track_channels_delta(const M& medium, const Maj& majorant, const Ray& ray, float tmax,
+                                  const typename M::Spectral::Wavelengths& lambda, int c,
+                                  ChannelPathState<typename M::Spectral, kEq>& st, bool nee_alternative, R& rng,
+                                  C& counter, Rec&& rec = Rec{}) {
+    return track_channels_delta_visiting<CP, A>(medium, majorant, ray, tmax, lambda, c, st, nee_alternative, rng,
+                                                counter, NoVisit{}, rec);
 }
 
 /// What ratio tracking a shadow segment with per-channel pdfs found, relative to one normaliser:

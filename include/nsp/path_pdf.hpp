@@ -137,42 +137,46 @@ struct NoEquiangularPdf {};
 /// `f` = f_c / K, `uni` = p_c / K of the path as sampled so far by unidirectional tracking with
 /// channel c, and `nee` = the pdf / K with which next-event estimation from the last real vertex
 /// would have produced the current segment's nulls (ratio tracking with channel c's majorant),
-/// without the light pdf, which is only known where the segment ends (THEORY 5.1). With
-/// `kEquiangular`, `eq` = the pdf / K with which equiangular sampling on the current segment
-/// would have produced its nulls (ratio tracking) and the segment's last vertex, without the
-/// equiangular density, which the estimator multiplies in (THEORY 5.4); other states carry an
-/// empty slot there.
+/// without the light pdf, which is only known where the segment ends (THEORY 5.1).
+///
+/// With `kEquiangular` (THEORY 5.4) the state also carries `eq.vertex` = the pdf / K with which
+/// equiangular sampling on the current segment would have produced its nulls (ratio tracking)
+/// and its last vertex, without the equiangular density, which the estimator multiplies in; and
+/// `eq.nee` = the pdf / K of the path so far with the last real vertex drawn by equiangular
+/// sampling and the current segment's nulls by NEE's ratio tracking (the equiangular + NEE
+/// alternative of a light the segment hits). Other states carry an empty slot there.
 template <SpectralMode S, bool kEquiangular = false>
 struct ChannelPathState {
     using Spectrum = typename S::Spectrum;
-    using EquiangularPdf = std::conditional_t<kEquiangular, Spectrum, detail::NoEquiangularPdf>;
+    struct EquiangularPdfs {
+        Spectrum vertex = Spectrum::Zero();
+        Spectrum nee = Spectrum::Zero();
+    };
+    using EquiangularPdf = std::conditional_t<kEquiangular, EquiangularPdfs, detail::NoEquiangularPdf>;
     static constexpr bool equiangular = kEquiangular;
 
     Spectrum f = Spectrum::Ones();
     Spectrum uni = Spectrum::Ones();
     Spectrum nee = Spectrum::Zero();
-    [[no_unique_address]] EquiangularPdf eq = zero_equiangular();
+    [[no_unique_address]] EquiangularPdf eq{};
 
-    /// Rescales f, uni, nee (and eq) by one factor: by the sampling channel's pdf `uni[c]` when
-    /// only that channel is ever estimated (independent tracking), else so that the largest pdf is
-    /// 1. Returns false if there is no positive finite pdf left to scale by (the path is dead).
+    /// Rescales every pdf and f by one factor: by the sampling channel's pdf `uni[c]` when only
+    /// that channel is ever estimated (independent tracking), else so that the largest pdf is 1.
+    /// Returns false if there is no positive finite pdf left to scale by (the path is dead).
     template <ChannelPolicy CP>
     bool renormalize(int c) noexcept {
         float k = CP::mis_over_channels ? std::max(uni.maxCoeff(), nee.maxCoeff()) : uni[c];
         if constexpr (kEquiangular)
-            if (CP::mis_over_channels) k = std::max(k, eq.maxCoeff());
+            if (CP::mis_over_channels) k = std::max(k, std::max(eq.vertex.maxCoeff(), eq.nee.maxCoeff()));
         if (!(k > 0.f) || !std::isfinite(k)) return false;
         f /= k;
         uni /= k;
         nee /= k;
-        if constexpr (kEquiangular) eq /= k;
+        if constexpr (kEquiangular) {
+            eq.vertex /= k;
+            eq.nee /= k;
+        }
         return true;
-    }
-
-private:
-    static EquiangularPdf zero_equiangular() noexcept {
-        if constexpr (kEquiangular) return Spectrum::Zero();
-        else return {};
     }
 };
 

@@ -16,6 +16,7 @@
 #pragma once
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <optional>
 #include <type_traits>
@@ -36,7 +37,9 @@ namespace nsp {
 /// A path estimator over channels: channel policy CP, strategy St (Unidirectional, NextEvent,
 /// NullScatteringMis, EquiangularNextEvent or EquiangularMis), heuristic H (mis::None for a single
 /// strategy, mis::Balance for the combining ones: the weights are the one-sample balance heuristic
-/// over channels and techniques) and absorption policy A. Emissive media go with PathEstimator.
+/// over channels and techniques) and absorption policy A. An emissive medium adds emission as
+/// PathEstimator does (collisions where the strategy counts hits, NEE toward the volume where it
+/// samples lights), every channel's pdfs of both in the same sum.
 template <ChannelPolicy CP, PathStrategy St, mis::Heuristic H = mis::None, AbsorptionPolicy A = absorption::Weight>
 class SpectralPathEstimator {
     static_assert(St::null_pdfs || !St::combines,
@@ -80,9 +83,6 @@ public:
         static_assert(CP::own_pdfs || !is_per_channel_majorant_v<Maj, M>,
                       "nsp::SpectralPathEstimator: spectral tracking shares one pdf over channels and needs a "
                       "grey majorant bounding every channel (GlobalMajorant)");
-        static_assert(!EmissiveMedium<M>,
-                      "nsp::SpectralPathEstimator does not collect volume emission yet; emissive media go "
-                      "with nsp::PathEstimator (a grey majorant, every spectral mode)");
         using Spectrum = typename Sc::Spectrum;
         const Spectrum& q = selection.probabilities();
         const int c = selection.sample(rng.uniform());
@@ -102,7 +102,7 @@ public:
             // equiangular pdf of the vertex tracking is about to draw starts from the same prefix.
             EquiangularSampler eq;
             if constexpr (St::equiangular) {
-                st.eq = st.uni;
+                st.eq.vertex = st.uni;
                 if (target) {
                     const Interval in = scene.medium.bounds().clip(ray, 0.f, hit.t);
                     eq = EquiangularSampler(ray, *target, in.t0, in.t1);
@@ -112,8 +112,19 @@ public:
                     }
                 }
             }
-            const ChannelTrack seg = track_channels_delta<CP, A>(scene.medium, scene.majorant, ray, hit.t, lambda, c,
-                                                                 st, nee_alternative, rng, counter);
+            ChannelTrack seg;
+            if constexpr (EmissiveMedium<M>) {
+                if (from_camera || St::hits_lights)
+                    seg = track_channels_delta_visiting<CP, A>(
+                        scene.medium, scene.majorant, ray, hit.t, lambda, c, st, nee_alternative, rng, counter,
+                        EmissionCollector<Sc>{scene, ray, lambda, q, c, L, nee_alternative});
+                else
+                    seg = track_channels_delta<CP, A>(scene.medium, scene.majorant, ray, hit.t, lambda, c, st,
+                                                      nee_alternative, rng, counter);
+            } else {
+                seg = track_channels_delta<CP, A>(scene.medium, scene.majorant, ray, hit.t, lambda, c, st,
+                                                  nee_alternative, rng, counter);
+            }
             if (const Status fs = flight_status(seg.end); fs != Status::Ok) {
                 status = fs;
                 break;
@@ -121,7 +132,10 @@ public:
             if (seg.end == SegmentEnd::Passed) {
                 if (from_camera || St::hits_lights) {
                     Spectrum pdf = st.uni;
-                    if (nee_alternative) pdf += scene.lights.pdf(prev_x, hit) * st.nee;
+                    if (nee_alternative) {
+                        if constexpr (St::equiangular) pdf += scene.lights.pdf(prev_x, hit) * (st.nee + st.eq.nee);
+                        else pdf += scene.lights.pdf(prev_x, hit) * st.nee;
+                    }
                     L += channel_estimate<CP>(st.f, pdf, q, c) * scene.lights.emitted(hit, lambda);
                 }
                 break;
@@ -133,7 +147,7 @@ public:
             // Every channel's equiangular pdf of x (same prefix and normaliser as st.uni).
             Spectrum eq_pdf = Spectrum::Zero();
             if constexpr (St::equiangular)
-                if (target) eq_pdf = st.eq * eq.pdf(seg.t);
+                if (target) eq_pdf = st.eq.vertex * eq.pdf(seg.t);
             // Roulette survival is fixed before NEE: the continuing unidirectional path carries it.
             // It follows what the path would contribute per unit of incident light, the largest
             // channel estimate, as PathEstimator's max |beta| does.
@@ -146,16 +160,21 @@ public:
                     const Status ns = next_event(scene, x, ray.d, rr, lambda, q, c, st.f, st.uni, eq_pdf, rng, counter, L);
                     if (ns != Status::Ok) status = ns;
                 }
+                if constexpr (EmissiveMedium<M>) {
+                    const Status es = emission_event(scene, x, ray.d, rr, lambda, q, c, st, rng, counter, L);
+                    if (es != Status::Ok) status = es;
+                }
             }
             if (rr < 1.f && !(rng.uniform() < rr)) break;
             const float u1 = rng.uniform(), u2 = rng.uniform();
             const PhaseSample ps = scene.phase.sample(ray.d, u1, u2);
             if (!(ps.pdf > 0.f)) break;
             // The NEE alternative of the next segment starts from the prefix, without roulette
-            // (and, with equiangular sampling, from either technique's pdf of x).
+            // (with equiangular sampling also from the equiangular pdf of x, kept apart because
+            // NEE toward emission is done from tracked vertices only).
             if constexpr (St::combines) {
-                if constexpr (St::equiangular) st.nee = st.uni + eq_pdf;
-                else st.nee = st.uni;
+                st.nee = st.uni;
+                if constexpr (St::equiangular) st.eq.nee = eq_pdf;
             }
             st.f *= ps.value;
             st.uni *= rr * ps.pdf;
@@ -201,6 +220,75 @@ private:
             pdf = p_track * seg_pdf;
         }
         L += channel_estimate<CP, Spectrum>(f, pdf, q, c) * ls.radiance;
+        return Status::Ok;
+    }
+
+    /// The collision estimator of volume emission over channels (THEORY 5.7 with 5.3): at every
+    /// tentative collision y, f_c = f_c(prefix) Tbar_c mu_a,c L_e,c and the collision pdf
+    /// mu_bar_c Tbar_c of every channel; with `nee_alternative` also NEE's pdf of y toward the
+    /// volume (ratio-tracked nulls from the last real vertex, p_V(y) t^2 in the same measure).
+    template <class Sc>
+    struct EmissionCollector {
+        static constexpr bool enabled = true;
+        using S = typename Sc::Spectral;
+        using Spec = typename S::Spectrum;
+        const Sc& scene;
+        const Ray& ray;
+        const typename S::Wavelengths& lambda;
+        const Spec& q;
+        int c;
+        Spec& L;
+        bool nee_alternative;
+
+        template <class State>
+        void operator()(float t, const Coefficients<S>& k, const Spec& mu, const Spec& tbar, const State& st) const {
+            if (!(k.sigma_a > 0.f).any()) return;
+            const Vec3 y = ray.at(t);
+            const Spec le = scene.medium.emission(y, lambda);
+            if (!(le > 0.f).any()) return;
+            Spec pdf = st.uni * tbar * mu;
+            if (nee_alternative) pdf += st.nee * tbar * (scene.medium.emission_pdf(y) * t * t);
+            L += channel_estimate<CP, Spec>(Spec(st.f * tbar * k.sigma_a * le), pdf, q, c);
+        }
+    };
+
+    /// NEE toward the emitting volume over channels at real vertex x (THEORY 5.7 with 5.3): y drawn
+    /// by the power grid, the nulls ratio-tracked with c's majorant; weighed against the collision
+    /// estimator of every channel. `st` is the state at x (before roulette and the next direction).
+    template <class Sc, UniformRng R, LookupCounter C, class State>
+    Status emission_event(const Sc& scene, const Vec3& x, const Vec3& wo, float rr,
+                          const typename Sc::Spectral::Wavelengths& lambda, const typename Sc::Spectrum& q, int c,
+                          const State& st, R& rng, C& counter, typename Sc::Spectrum& L) const {
+        using M = typename Sc::MediumType;
+        using Spectrum = typename Sc::Spectrum;
+        using B = bound_policy_t<typename Sc::MajorantType>;
+        const float u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform(), u3 = rng.uniform();
+        const VolumeSample vs = scene.medium.sample_emission(u0, u1, u2, u3);
+        if (!(vs.pdf > 0.f)) return Status::Ok;
+        const Vec3 dv = vs.p - x;
+        const float d2 = glm::dot(dv, dv);
+        if (!(d2 > 0.f)) return Status::Ok;
+        const float d = std::sqrt(d2);
+        const Ray shadow{x, dv / d};
+        if (scene.lights.sphere_blocks(shadow, d)) return Status::Ok;
+        const auto sh = track_channels_ratio<CP, A>(scene.medium, scene.majorant, shadow, d, lambda, c, st.f,
+                                                    St::combines, rng, counter);
+        if (sh.end == SegmentEnd::Aborted || sh.end == SegmentEnd::Rejected) return flight_status(sh.end);
+        if (sh.end == SegmentEnd::Terminated) return Status::Ok;
+        counter.lookup();
+        auto k = scene.medium.coefficients(vs.p, lambda);
+        const auto mu_v = majorant_value_at_point<M>(scene.majorant, shadow, d, lambda);
+        if constexpr (std::is_same_v<B, bound::Clamp>) {
+            detail::clamp_to_majorant(k, mu_v);
+        } else if constexpr (std::is_same_v<B, bound::Reject>) {
+            if (detail::exceeds_majorant(k, mu_v)) return Status::Rejected;
+        }
+        const Spectrum le = scene.medium.emission(vs.p, lambda);
+        const Spectrum f = st.f * sh.f * k.sigma_a * le * scene.phase.eval(wo, shadow.d);
+        Spectrum pdf = sh.nee * (vs.pdf * d2);
+        if constexpr (St::combines)
+            pdf += sh.uni * detail::broadcast_majorant<Spectrum>(mu_v) * (rr * scene.phase.pdf(wo, shadow.d));
+        L += channel_estimate<CP, Spectrum>(f, Spectrum(st.uni * pdf), q, c);
         return Status::Ok;
     }
 
