@@ -6,7 +6,8 @@
 // static_assert are filtered out before any of them is named as an estimator, so adding a policy
 // to a list is all it takes to render it. The channel policy `Grey` stands for nsp::PathEstimator
 // (one pdf for every channel, the grey-majorant baseline); the others select
-// nsp::SpectralPathEstimator with that channel policy.
+// nsp::SpectralPathEstimator with that channel policy. The medium is an axis too: the dense grid
+// of most scenes, or the same grid with an emission grid (the plume scene).
 #pragma once
 
 #include <array>
@@ -20,12 +21,40 @@
 
 namespace nsp_examples {
 
-/// Which of the three scenes of default_scene.hpp a render uses.
+/// Which of the scenes of default_scene.hpp a render uses.
 enum class SceneKind {
     Cloud,      ///< the grey cloud (set-ups A, B)
     Chromatic,  ///< the chromatic cloud, extinction 1 : 4 : 16 (set-ups C1, C2)
     Sparse,     ///< the sparse grey medium, a plume and five puffs (set-ups SA, SB: A's and B's lights)
+    Fog,        ///< a fog bank lit by a lamp (set-ups F1, F2, F3)
+    Plume,      ///< a flame inside the cloud, an emissive medium (set-up P1)
 };
+
+/// One light set-up of one scene: A or B of the grey cloud, C1 or C2 of the chromatic cloud, SA or
+/// SB of the sparse medium (set-up A's or B's lights), F1, F2 or F3 of the fog, P1 of the plume.
+struct SceneChoice {
+    SceneKind kind = SceneKind::Cloud;
+    LightSetup cloud = LightSetup::A;                ///< with SceneKind::Cloud and SceneKind::Sparse
+    ChromaticSetup chromatic = ChromaticSetup::Env;  ///< with SceneKind::Chromatic
+    FogSetup fog = FogSetup::F1;                     ///< with SceneKind::Fog
+
+    /// "A", "B", "C1", "C2", "SA", "SB", "F1", "F2", "F3" or "P1".
+    const char* name() const {
+        switch (kind) {
+            case SceneKind::Chromatic: return nsp_examples::name(chromatic);
+            case SceneKind::Sparse: return cloud == LightSetup::A ? "SA" : "SB";
+            case SceneKind::Fog: return nsp_examples::name(fog);
+            case SceneKind::Plume: return "P1";
+            default: return nsp_examples::name(cloud);
+        }
+    }
+};
+
+/// The Henyey-Greenstein asymmetry of a scene: the clouds' kPhaseG, the fog's kFogPhaseG, the
+/// plume's smoke kPlumePhaseG.
+inline float phase_g(SceneKind kind) {
+    return kind == SceneKind::Fog ? kFogPhaseG : kind == SceneKind::Plume ? kPlumePhaseG : kPhaseG;
+}
 
 /// The run-time values of the majorant policies (flags --grid-res and --majorant-scale).
 struct MajorantSettings {
@@ -33,20 +62,35 @@ struct MajorantSettings {
     float scale = 0.5f;  ///< of the non-bounding majorants: the fraction of the bound they use
 };
 
-/// The medium of all three scenes: a density on a dense grid (the cloud with grey or chromatic
-/// coefficients, or the sparse plume and puffs; the type is the same, so the scene is a run-time
-/// choice).
+/// The medium of every scene but the plume: a density on a dense grid (the cloud with grey or
+/// chromatic coefficients, the sparse plume and puffs, or the fog; the type is the same, so the
+/// scene is a run-time choice).
 struct DenseGridCloud {
     static constexpr const char* name = "dense-grid";
+    static constexpr bool emissive = false;
     template <nsp::SpectralMode S>
     using type = nsp::DenseGridMedium<S>;
     template <nsp::SpectralMode S>
-    static type<S> make(SceneKind scene) {
-        switch (scene) {
+    static type<S> make(const SceneChoice& scene) {
+        switch (scene.kind) {
             case SceneKind::Chromatic: return make_chromatic_medium<S>();
             case SceneKind::Sparse: return make_sparse_medium<S>();
+            case SceneKind::Fog: return make_fog_medium<S>(scene.fog);
             default: return make_default_medium<S>();
         }
+    }
+};
+
+/// The plume scene's medium: the smoke of make_plume_medium with its flame, nsp::Emissive over a
+/// dense grid (a different type: PathEstimator compiles its emission code for it alone).
+struct EmissivePlume {
+    static constexpr const char* name = "emissive";
+    static constexpr bool emissive = true;
+    template <nsp::SpectralMode S>
+    using type = nsp::Emissive<nsp::DenseGridMedium<S>>;
+    template <nsp::SpectralMode S>
+    static type<S> make(const SceneChoice&) {
+        return make_plume_medium<S>();
     }
 };
 
@@ -133,10 +177,11 @@ using Majorants = tl::list<GlobalMajorantPolicy<>, ChannelMajorantPolicy, GridMa
                            GlobalMajorantPolicy<nsp::bound::Signed>, GlobalMajorantPolicy<nsp::bound::Clamp>,
                            GridMajorantPolicy<nsp::bound::Signed>, GridMajorantPolicy<nsp::bound::Clamp>>;
 using Strategies = tl::list<nsp::strategy::Unidirectional, nsp::strategy::NextEvent,
-                            nsp::strategy::DirectionalMis, nsp::strategy::NullScatteringMis>;
+                            nsp::strategy::DirectionalMis, nsp::strategy::NullScatteringMis,
+                            nsp::strategy::EquiangularNextEvent, nsp::strategy::EquiangularMis>;
 using Heuristics = tl::list<nsp::mis::None, nsp::mis::Balance, nsp::mis::Power>;
 using Absorptions = tl::list<nsp::absorption::Event, nsp::absorption::Weight>;
-using MediumKinds = tl::list<DenseGridCloud>;
+using MediumKinds = tl::list<DenseGridCloud, EmissivePlume>;
 
 /// The library's static_asserts as a predicate on a point of the product, evaluated on the policy
 /// tags alone (nothing is instantiated for an invalid point):
@@ -144,7 +189,8 @@ using MediumKinds = tl::list<DenseGridCloud>;
 ///   heuristic, single strategies mis::None;
 /// - SpectralPathEstimator: a multi-channel mode; spectral tracking (one shared pdf) with a grey
 ///   majorant only (the library's static_assert); no DirectionalMis; mis::None for single
-///   strategies, mis::Balance for NullScatteringMis.
+///   strategies, mis::Balance for NullScatteringMis and EquiangularMis; no emissive medium
+///   (emission is PathEstimator's alone so far).
 /// and choices of the examples, not the library's:
 /// - independent tracking only with a per-channel majorant (per-channel or channel-grid; with a
 ///   grey one it is spectral tracking's sampling without its shared weights: every channel's free
@@ -160,24 +206,42 @@ using MediumKinds = tl::list<DenseGridCloud>;
 ///   (the absorb-event rows answer nothing about majorants that the absorb-weight ones do not),
 ///   and the non-bounding ones (bound::Signed, Clamp) with PathEstimator in Mono only (what a low
 ///   majorant costs in variance or bias is a question the grey medium answers).
+/// - the equiangular strategies (EquiangularNextEvent, EquiangularMis) with PathEstimator in Mono
+///   only: the fog that shows them is grey, PathEstimator's cost per mode is the benchmarks'
+///   business, and SpectralPathEstimator's equiangular rows (15 channel-policy x majorant pairs x
+///   2 strategies per mode) would add some 60 points for no table; the tests cover them. In Mono
+///   they take both absorption policies with the grid majorant as well as the global one (every
+///   strategy x heuristic x {global, grid} x absorption compiles), and the non-bounding majorants
+///   with absorb-weight, as every grey strategy does.
+/// - the emissive medium (the plume) in Rgb only (a flame-coloured emission), with the bounding
+///   grey majorants (global, grid), absorb-weight, and the four strategies without equiangular
+///   sampling (the plume has no point or sphere light for it to aim at).
 template <class Tuple>
 struct is_valid;
 template <class S, class CP, class Maj, class St, class H, class A, class Med>
 struct is_valid<tl::list<S, CP, Maj, St, H, A, Med>> {
     static constexpr bool grey = std::is_same_v<CP, Grey>;
+    static constexpr bool weight = std::is_same_v<A, nsp::absorption::Weight>;
     static constexpr bool heuristic_fits =
         St::combines ? (grey ? H::combines : std::is_same_v<H, nsp::mis::Balance>) : !H::combines;
     static constexpr bool majorant_fits = [] {
         constexpr bool first = std::is_same_v<Maj, GlobalMajorantPolicy<>> || std::is_same_v<Maj, ChannelMajorantPolicy>;
-        if constexpr (!first && !std::is_same_v<A, nsp::absorption::Weight>) return false;
+        constexpr bool both_absorptions = first || (St::equiangular && std::is_same_v<Maj, GridMajorantPolicy<>>);
+        if constexpr (!both_absorptions && !weight) return false;
         else if constexpr (grey) return !Maj::per_channel && (Maj::bounding || S::channels == 1);
         else if constexpr (!Maj::bounding) return false;
         else if constexpr (!CP::own_pdfs) return !Maj::per_channel;
         else if constexpr (!CP::mis_over_channels) return Maj::per_channel;
         else return true;
     }();
-    static constexpr bool value = heuristic_fits && majorant_fits &&
-                                  (grey || (S::channels > 1 && (St::null_pdfs || !St::combines)));
+    static constexpr bool estimator_fits =
+        grey || (S::channels > 1 && (St::null_pdfs || !St::combines) && !Med::emissive);
+    static constexpr bool build_fits = [] {
+        if constexpr (Med::emissive) return std::is_same_v<S, nsp::Rgb> && Maj::bounding && weight && !St::equiangular;
+        else if constexpr (St::equiangular) return grey && std::is_same_v<S, nsp::Mono>;
+        else return true;
+    }();
+    static constexpr bool value = heuristic_fits && majorant_fits && estimator_fits && build_fits;
 };
 
 /// The estimator type of a combination (lazily, so that Grey is never passed to SpectralPathEstimator).
@@ -236,19 +300,22 @@ struct Combination<tl::list<S, CP, Maj, St, H, A, Med>> {
 /// Every valid combination of spectral mode S, in the order of the policy lists.
 template <class S>
 using CombinationsOf = tl::transform<
-    Combination, tl::filter<is_valid, tl::product<tl::list<S>, ChannelPolicies, Majorants, Strategies, Heuristics,
-                                                  Absorptions, MediumKinds>>>;
+    Combination, tl::filtered_product<is_valid, tl::list<S>, ChannelPolicies, Majorants, Strategies, Heuristics,
+                                      Absorptions, MediumKinds>>;
 
 // Grey: Unidirectional, NextEvent with None; two MIS strategies with Balance and Power: 6 per
 // absorption policy; with the global majorant both policies, with grid in every mode and the four
-// non-bounding ones (global and grid, signed and clamp) in Mono absorb-weight only. Spectral, in
-// Rgb and Hero: (Unidirectional, NextEvent, NullScatteringMis with Balance) with 5 (channel
-// policy, majorant) pairs of the first two majorants x 2 absorption policies (independent
-// per-channel, spectral tracking max and average global, spectral MIS per-channel and global),
-// and 5 pairs with the grid majorants x absorb-weight (independent channel-grid, spectral
-// tracking max and average grid, spectral MIS grid and channel-grid).
-static_assert(tl::size<CombinationsOf<nsp::Mono>> == 6 * 2 + 6 * (1 + 4));
-static_assert(tl::size<CombinationsOf<nsp::Rgb>> == 6 * 2 + 6 + 5 * 3 * 2 + 5 * 3);
+// non-bounding ones (global and grid, signed and clamp) in Mono absorb-weight only. In Mono the
+// equiangular strategies add 3 (EquiangularNextEvent; EquiangularMis with Balance and Power) to
+// each of these, and 3 more with grid and absorb-event. Spectral, in Rgb and Hero:
+// (Unidirectional, NextEvent, NullScatteringMis with Balance) with 5 (channel policy, majorant)
+// pairs of the first two majorants x 2 absorption policies (independent per-channel, spectral
+// tracking max and average global, spectral MIS per-channel and global), and 5 pairs with the grid
+// majorants x absorb-weight (independent channel-grid, spectral tracking max and average grid,
+// spectral MIS grid and channel-grid). The emissive medium, in Rgb: the 6 grey rows with global and
+// grid, absorb-weight.
+static_assert(tl::size<CombinationsOf<nsp::Mono>> == 9 * 2 + (9 + 3) + 9 * 4);
+static_assert(tl::size<CombinationsOf<nsp::Rgb>> == 6 * 2 + 6 + 5 * 3 * 2 + 5 * 3 + 6 * 2);
 static_assert(tl::size<CombinationsOf<Hero4>> == 6 * 2 + 6 + 5 * 3 * 2 + 5 * 3);
 
 /// What the driver knows of one combination at run time: its names and traits as plain data, so
@@ -267,6 +334,7 @@ struct CombinationInfo {
     bool uses_selection;        ///< see Combination::uses_selection
     bool bounding;              ///< the majorant bounds the extinction (bound::Guaranteed)
     bool per_channel_majorant;  ///< per-channel or channel-grid
+    bool emissive;              ///< the medium emits (the plume's): only the plume scene renders it
     std::string (*name)();      ///< Combination::name
 };
 
@@ -278,7 +346,7 @@ struct infos_of<tl::list<Cs...>> {
     static constexpr std::array<CombinationInfo, sizeof...(Cs)> value{CombinationInfo{
         Cs::Spectral::name, Cs::ChannelPolicy::name, Cs::MajorantKind::name, Cs::Strategy::name, Cs::Heuristic::name,
         Cs::Absorption::name, Cs::MediumKind::name, Cs::spectral, Cs::plain_global, Cs::uses_selection,
-        Cs::MajorantKind::bounding, Cs::MajorantKind::per_channel, &Cs::name}...};
+        Cs::MajorantKind::bounding, Cs::MajorantKind::per_channel, Cs::MediumKind::emissive, &Cs::name}...};
 };
 }  // namespace detail
 

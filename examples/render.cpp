@@ -1,20 +1,25 @@
 // examples/render.cpp: nsp_render, the example host renderer and the project's main job.
 //
-// Renders the three scenes of examples/default_scene.hpp with the path estimators nsp offers,
-// writes one EXR per render and prints an efficiency table per light set-up and spectral mode
-// (THEORY 7: LTUV = density lookups per sample x variance of one sample):
+// Renders the scenes of examples/default_scene.hpp with the path estimators nsp offers, writes
+// one EXR per render and prints an efficiency table per light set-up and spectral mode (THEORY 7:
+// LTUV = density lookups per sample x variance of one sample):
 // - the grey cloud in set-ups A and B (mono), with every nsp::PathEstimator;
 // - the chromatic cloud (extinction 1 : 4 : 16) in set-ups C1 and C2 (rgb and hero), with the
 //   spectral estimators (independent tracking, spectral tracking, spectral MIS) beside the
 //   grey-majorant baseline (THEORY 5.3);
 // - the sparse medium in set-up SA (mono, set-up A's light), the global majorant against the grid
-//   majorant (THEORY 4) for each grey strategy.
+//   majorant (THEORY 4) for each grey strategy;
+// - the fog bank lit by a lamp in set-ups F1, F2, F3 (mono): tracking + NEE against equiangular
+//   sampling and their three-way MIS (THEORY 5.4), global and grid majorant;
+// - the flame inside the cloud, set-up P1 (rgb, an emissive medium): the collision estimator of
+//   emission against NEE toward the emitting volume and their MIS (THEORY 5.7).
 // The majorant is an axis of its own (--majorant): every table can compare majorants, the
 // non-bounding ones (bound::Signed, Clamp with a deliberately low majorant) included.
 // This file plans renders by name and prints the tables; the command-line choices become types
 // once, in render_combination<S> (render_job.hpp), whose render loops are monomorphic.
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <charconv>
 #include <chrono>
 #include <cmath>
@@ -65,8 +70,19 @@ constexpr int kChromaticWidth = 32, kChromaticHeight = 32, kChromaticSpp = 128;
 /// middle, not tuned to this medium).
 constexpr int kSparseWidth = 64, kSparseHeight = 64, kSparseSpp = 256;
 
-/// The estimators of the grey cloud by default: every PathEstimator (the existing table).
-const std::vector<std::string> kCloudEstimators{"grey"};
+/// The fog: thin (F1, F2) or dense (F3) fog lit by a lamp. A thin-fog sample is cheap (most camera
+/// rays cross the fog without a real collision: 0.1-1.5 us), a dense-fog one costs 30-70 lookups
+/// (2-8 us), so F3 gets half the samples; the 30 renders take about 15 s on 2 cores. The size of
+/// run-main.sh's F1 comparison, so that a default table's row is its run 1 (seed 1).
+constexpr int kFogWidth = 64, kFogHeight = 64, kFogSpp = 128, kDenseFogSpp = 64;
+/// The plume: 8 renders (4 estimators, 2 majorants) in about 4 s on 2 cores; the size of
+/// run-main.sh's P1 comparison.
+constexpr int kPlumeWidth = 64, kPlumeHeight = 64, kPlumeSpp = 256;
+
+/// The estimators of the grey cloud by default: every PathEstimator but the equiangular ones (the
+/// existing table; its sphere lights are the fog's business), both absorption policies.
+const std::vector<std::string> kCloudEstimators{"unidirectional_grey", "ratio-nee_grey", "directional-mis_grey",
+                                                "uni-nee-mis_grey"};
 /// The estimators of the sparse medium by default: each grey strategy once (absorb-weight, the
 /// balance heuristic for the MIS strategies); each with every majorant of --majorant.
 const std::vector<std::string> kSparseEstimators{
@@ -76,10 +92,30 @@ const std::vector<std::string> kSparseEstimators{
     "uni-nee-mis_grey_balance_absorb-weight",
 };
 
+/// The estimators of the fog by default (absorb-weight): tracking + NEE (ratio-nee; with a point
+/// light, uni-nee-mis is the same estimator: a point light cannot be hit), equiangular + NEE, and
+/// the three-way MIS with the balance and the power heuristic.
+const std::vector<std::string> kFogEstimators{
+    "ratio-nee_grey_absorb-weight",
+    "uni-nee-mis_grey_balance_absorb-weight",
+    "equiangular-nee_grey_absorb-weight",
+    "uni-nee-eq-mis_grey_absorb-weight",
+};
+/// The estimators of the plume by default (absorb-weight): the collision estimator alone
+/// (unidirectional), NEE toward the emitting volume (ratio-nee; collisions on camera rays only),
+/// and their MIS with the balance and the power heuristic.
+const std::vector<std::string> kPlumeEstimators{
+    "unidirectional_grey_absorb-weight",
+    "ratio-nee_grey_absorb-weight",
+    "uni-nee-mis_grey_absorb-weight",
+};
+
 /// The majorants of each scene by default (--majorant overrides them for every scene).
 const std::vector<std::string> kCloudMajorants{"global"};
 const std::vector<std::string> kChromaticMajorants{"global", "per-channel"};
 const std::vector<std::string> kSparseMajorants{"global", "grid"};
+const std::vector<std::string> kFogMajorants{"global", "grid"};
+const std::vector<std::string> kPlumeMajorants{"global", "grid"};
 /// The estimators of the chromatic cloud by default (absorb-weight rows): the grey-majorant
 /// baseline with NEE MIS; each spectral channel policy unidirectional and with NEE MIS; spectral
 /// MIS also with NEE alone; with --selection both, spectral MIS + NEE and independent + NEE also
@@ -99,9 +135,18 @@ const std::vector<std::string> kChromaticEstimators{
     "uni-nee-mis_spectral-mis_global_absorb-weight",
 };
 
-/// The estimator of --reference-spp: unbiased, finite variance on the chromatic cloud (one shared
-/// pdf under the grey majorant, weights mu_c / (mu_bar P) bounded), and none of the compared ones.
+/// The estimator of --reference-spp on the chromatic cloud: unbiased, finite variance there (one
+/// shared pdf under the grey majorant, weights mu_c / (mu_bar P) bounded), and none of the compared
+/// ones.
 constexpr const char* kReferenceEstimator = "uni-nee-mis_spectral-tracking-avg_global_balance_absorb-weight";
+/// The estimator of --reference-spp on the fog: the three-way MIS with absorb-event (none of the
+/// default rows). Its NEE from tracked vertices near the lamp is weighted down by the equiangular
+/// pdf there, so unlike tracking + NEE it has no 1/r^2 tail around a lamp inside the fog.
+constexpr const char* kFogReferenceEstimator = "uni-nee-eq-mis_balance_absorb-event";
+/// The estimator of --reference-spp on the plume: emission NEE and collisions combined by the
+/// directional MIS weights under the grid majorant (none of the default rows; its weights sum to
+/// 1 and tame NEE's 1/d^2 near the flame as the null-scattering ones do).
+constexpr const char* kPlumeReferenceEstimator = "directional-mis_grid_balance_absorb-weight";
 /// The reference's seeds: seed + this (the rows use seed .. seed + runs - 1, runs <= 1000).
 constexpr std::uint64_t kReferenceSeedOffset = 1000000;
 
@@ -118,8 +163,9 @@ struct Options {
     std::string out = "out";
     bool write_exr = true;
     bool list = false;
-    std::vector<SceneKind> scenes{SceneKind::Cloud, SceneKind::Chromatic, SceneKind::Sparse};
-    std::vector<std::string> setups{"A", "B", "C1", "C2", "SA"};
+    std::vector<SceneKind> scenes{SceneKind::Cloud, SceneKind::Chromatic, SceneKind::Sparse, SceneKind::Fog,
+                                  SceneKind::Plume};
+    std::vector<std::string> setups{"A", "B", "C1", "C2", "SA", "F1", "F2", "F3", "P1"};
     std::vector<std::string> majorants;  ///< majorant names (empty: the scene's defaults)
     bool all_majorants = false;          ///< --majorant all: names without a row in a mode are no error
     MajorantSettings majorant;           ///< --grid-res, --majorant-scale
@@ -129,47 +175,65 @@ struct Options {
     LightOverrides lights;
 };
 
-constexpr const char* kHelp = R"(nsp_render: render the default cloud scenes with nsp's path estimators and print an
-efficiency table per light set-up and spectral mode (LTUV = density lookups per sample x
-variance per sample; lower is better).
+constexpr const char* kHelp = R"(nsp_render: render the example scenes with nsp's path estimators and print an efficiency
+table per light set-up and spectral mode (LTUV = density lookups per sample x variance per
+sample; cpu-s*var = CPU seconds per sample x variance per sample; lower is better).
 
 Default run (no flags): the grey cloud, set-ups A and B, mono, 128x128, 256 spp, every
-PathEstimator (24 renders); then the chromatic cloud, set-ups C1 and C2, rgb and hero, 32x32,
-128 spp, the grey-majorant baseline uni-nee-mis_balance_absorb-weight and the spectral
-estimators listed under --estimators, uniform and luminance selection (absorb-weight; 15
-renders per set-up and mode, 60 in all), one run each; then the sparse medium, set-up SA, mono,
-64x64, 256 spp, each grey strategy (absorb-weight) with the global and the grid majorant (8
-renders). scripts/run-main.sh then adds the heavy-tail comparison: baseline against spectral
-MIS + NEE with each majorant, --runs 3 at 32x32 with a 2048-spp reference image for the
-effective variance (the last example below, there with --runs 5).
+PathEstimator but the equiangular ones (24 renders); then the chromatic cloud, set-ups C1 and
+C2, rgb and hero, 32x32, 128 spp, the grey-majorant baseline uni-nee-mis_balance_absorb-weight
+and the spectral estimators listed under --estimators, uniform and luminance selection
+(absorb-weight; 15 renders per set-up and mode, 60 in all), one run each; then the sparse
+medium, set-up SA, mono, 64x64, 256 spp, each grey strategy (absorb-weight) with the global and
+the grid majorant (8 renders); then the fog, set-ups F1, F2 (64x64, 128 spp) and F3 (64x64, 64
+spp), mono: ratio-nee, uni-nee-mis balance, equiangular-nee and uni-nee-eq-mis balance and power
+(absorb-weight) with the global and the grid majorant (30 renders); then the plume, set-up P1,
+rgb, 64x64, 256 spp: unidirectional (the collision estimator of emission alone), ratio-nee (NEE
+toward the emitting volume), uni-nee-mis balance and power (absorb-weight), global and grid
+majorant (8 renders). scripts/run-main.sh then adds two comparisons with effective variances
+against reference images: the chromatic heavy-tail one (baseline against spectral MIS + NEE with
+each majorant, --runs 3 at 32x32 with a 2048-spp reference; the second-to-last example below,
+there with --runs 5), and F1 and P1 with --runs 3 and a 2048-spp reference (the last example).
 
 usage: nsp_render [flags]
 
-  --scene LIST       comma-separated scenes from cloud, chromatic, sparse; 'both' = cloud,chromatic;
-                     'all' = all three (default). cloud: the grey cloud (extinction 20, albedo
-                     0.9), set-ups A and B. chromatic: the same cloud with extinction 5 : 20 : 80
-                     in R : G : B (hero: a spectrum through those values), albedo 0.95, set-ups C1
-                     and C2. sparse: a thin plume and five small dense puffs filling ~2% of the
-                     box (grey, extinction 60, albedo 0.9), set-ups SA and SB
-  --setup LIST       comma-separated set-ups of the chosen scenes, from A, B, C1, C2, SA, SB, or
-                     'all' ('both' also means all; default: all but SB). A: a small bright
-                     sphere light above the grey cloud (NEE should win); B: a large dim sphere
-                     light behind it (unidirectional should win); C1: a constant white
+  --scene LIST       comma-separated scenes from cloud, chromatic, sparse, fog, plume; 'both' =
+                     cloud,chromatic; 'all' = all five (default). cloud: the grey cloud
+                     (extinction 20, albedo 0.9, HG g 0.9), set-ups A and B. chromatic: the same
+                     cloud with extinction 5 : 20 : 80 in R : G : B (hero: a spectrum through
+                     those values), albedo 0.95, set-ups C1 and C2. sparse: a thin plume and five
+                     small dense puffs filling ~2% of the box (grey, extinction 60, albedo 0.9),
+                     set-ups SA and SB. fog: a bank of ground fog over x in [-2.2, 0.8], thinning
+                     upward (grey, albedo 0.9, HG g 0.7), lit by a lamp (point light, intensity
+                     5), set-ups F1, F2, F3. plume: the cloud's density with extinction 5,
+                     isotropic smoke, and a small flickering flame inside, behind its dense
+                     core (nsp::Emissive: emission strength up to 80 x colour (6, 2, 0.5); no
+                     other light), set-up P1
+  --setup LIST       comma-separated set-ups of the chosen scenes, from A, B, C1, C2, SA, SB, F1,
+                     F2, F3, P1, or 'all' ('both' also means all; default: all but SB). A: a
+                     small bright sphere light above the grey cloud (NEE should win); B: a large
+                     dim sphere light behind it (unidirectional should win); C1: a constant white
                      environment around the chromatic cloud (unidirectional paths dominate); C2:
                      set-up A's small light above the chromatic cloud (NEE matters); SA, SB:
-                     set-up A's and B's lights around the sparse medium
+                     set-up A's and B's lights around the sparse medium; F1: the lamp inside the
+                     thin fog (extinction 0.12 per unit density: 0.03-0.28 optical depths along
+                     camera rays; equiangular sampling should win); F2: the lamp 0.4 beside the
+                     thin fog; F3: F2's lamp beside the fog 40x denser (~3 optical depths on the
+                     median camera ray, up to 11; tracking should win); P1: the flame in the
+                     plume scene (emission NEE + MIS should beat the collision estimator)
   --majorant LIST    comma-separated majorants, or 'all' (default: global for the cloud; global
                      and per-channel for the chromatic cloud; global and grid for the sparse
-                     medium; a list given here applies to every scene). Bounding: global (one
-                     grey value, the medium's extinction bound), per-channel (each channel's own
-                     bound; rgb and hero), grid (a grey voxel grid of density bounds walked by a
-                     DDA, --grid-res), channel-grid (the same grid times each channel's
-                     extinction per unit density; rgb and hero). Non-bounding, deliberately
-                     low (--majorant-scale), mono and nsp::PathEstimator only: global-signed,
-                     grid-signed (bound::Signed: signed null weights, unbiased), global-clamp,
-                     grid-clamp (bound::Clamp: density clamped to the majorant, biased). The
-                     majorants other than global and per-channel are compiled with absorb-weight
-                     only (build time). Grey rows with another majorant than global name it,
+                     medium, the fog and the plume; a list given here applies to every scene).
+                     Bounding: global (one grey value, the medium's extinction bound),
+                     per-channel (each channel's own bound; rgb and hero), grid (a grey voxel
+                     grid of density bounds walked by a DDA, --grid-res), channel-grid (the same
+                     grid times each channel's extinction per unit density; rgb and hero).
+                     Non-bounding, deliberately low (--majorant-scale), mono and
+                     nsp::PathEstimator only: global-signed, grid-signed (bound::Signed: signed
+                     null weights, unbiased), global-clamp, grid-clamp (bound::Clamp: density
+                     clamped to the majorant, biased). The majorants other than global and
+                     per-channel are compiled with absorb-weight only (build time; the
+                     equiangular strategies also with absorb-event under grid). Grey rows with another majorant than global name it,
                      e.g. uni-nee-mis_grid_balance_absorb-weight; each table has a majorant
                      column, and steps/spl (DDA steps per sample) where a grid is walked
   --grid-res N       cells per axis of the grid majorants (default 16)
@@ -177,21 +241,36 @@ usage: nsp_render [flags]
                      use S x the medium's largest extinction, grid-* S x each cell's bound
                      (default 0.5)
   --spectral LIST    comma-separated spectral modes from mono, rgb, hero; 'both' = mono,rgb;
-                     'all' = all three (default: mono for the cloud, rgb,hero for the chromatic
-                     cloud; a list given here applies to both scenes). hero: 4 wavelengths per
-                     path (stratified rotation), drawn from the pixel's random stream; every
-                     sample is converted to linear sRGB via CIE XYZ before any statistic
+                     'all' = all three (default: mono for the cloud, the sparse medium and the
+                     fog, rgb,hero for the chromatic cloud, rgb for the plume; a list given here
+                     applies to every scene). hero: 4 wavelengths per path (stratified
+                     rotation), drawn from the pixel's random stream; every sample is converted
+                     to linear sRGB via CIE XYZ before any statistic. Compiled for the build's
+                     sake: the equiangular strategies in mono only, the plume's emissive medium
+                     in rgb only (a scene's default row that a mode lacks is left out with a
+                     note)
   --estimators LIST  comma-separated filter. Each item selects the rows whose fields include all
                      of its '_'-separated fields, e.g. uni-nee-mis (every NEE-MIS row),
                      uni-nee-mis_power, spectral-mis_lum, absorb-event; 'all' selects every
                      valid combination. Fields of a row's name: strategy (unidirectional,
-                     ratio-nee, directional-mis, uni-nee-mis), channel policy (independent,
+                     ratio-nee, directional-mis, uni-nee-mis, equiangular-nee: a real vertex on
+                     every segment drawn toward the lamp with the equiangular pdf, nulls before
+                     it ratio-tracked, NEE from it; uni-nee-eq-mis: tracking + NEE, tracking +
+                     hit and equiangular + NEE weighed by their null-scattering pdfs; both aim
+                     at the point light, else the sphere light's centre), channel policy (independent,
                      spectral-tracking-max, spectral-tracking-avg, spectral-mis), majorant
                      (global, per-channel, grid, ...), heuristic (balance, power), absorption
                      (absorb-event, absorb-weight), lum (luminance selection). Rows of
                      nsp::PathEstimator keep their names without channel policy and majorant
                      and also match 'grey' and 'global'; uniform-selection rows also match
-                     'uniform'. Default for the cloud: grey (every PathEstimator). Default for
+                     'uniform'; the plume's rows also match 'emissive'. Default for the cloud:
+                     unidirectional_grey, ratio-nee_grey, directional-mis_grey,
+                     uni-nee-mis_grey (every PathEstimator but the equiangular ones; 'grey'
+                     adds those). Default for the fog:
+                     ratio-nee_grey_absorb-weight, uni-nee-mis_grey_balance_absorb-weight,
+                     equiangular-nee_grey_absorb-weight, uni-nee-eq-mis_grey_absorb-weight.
+                     Default for the plume: unidirectional_grey_absorb-weight,
+                     ratio-nee_grey_absorb-weight, uni-nee-mis_grey_absorb-weight. Default for
                      the sparse medium: unidirectional_grey_absorb-weight,
                      ratio-nee_grey_absorb-weight, directional-mis_grey_balance_absorb-weight,
                      uni-nee-mis_grey_balance_absorb-weight. Default for the chromatic cloud:
@@ -223,10 +302,14 @@ usage: nsp_render [flags]
                      and cpu-s*var (default 1); K > 1 adds the min..max of var/spl. For
                      heavy-tailed estimators, whose sample variance is itself unreliable (and
                      understates their error: see --reference-spp)
-  --reference-spp N  effective (error-based) variance: before the rows of each rgb or hero
-                     table, render a reference image of the same set-up, mode and resolution with
-                     uni-nee-mis_spectral-tracking-avg_global_balance_absorb-weight (unbiased,
-                     finite variance here), N spp, seed + 1000000; then for every row and run
+  --reference-spp N  effective (error-based) variance: before the rows of each table of the
+                     chromatic cloud (rgb, hero), the fog and the plume, render a reference image
+                     of the same set-up, mode and resolution with an estimator that is unbiased
+                     and of finite variance there and none of the default rows (chromatic:
+                     uni-nee-mis_spectral-tracking-avg_global_balance_absorb-weight; fog:
+                     uni-nee-eq-mis_balance_absorb-event; plume:
+                     directional-mis_grid_balance_absorb-weight), N spp, seed + 1000000; then for
+                     every row and run
                      report eff var/spl = spp x mean over pixels and channels of (pixel mean -
                      reference pixel mean)^2 - spp x mean(var_ref / N): an unbiased estimate of
                      spp x the image's MSE, which is the variance per sample of a finite-variance
@@ -234,13 +317,18 @@ usage: nsp_render [flags]
                      variance misses. Adds the columns eff var/spl, eff LTUV and img eff var
                      (the same from the error of the image mean: spp x pixels x (image mean -
                      reference's)^2 - the same reference term; 3 degrees of freedom per run, but
-                     a tail missed in every pixel adds up there) and the ratios baseline /
-                     spectral MIS + NEE of all three (not in mono tables; default: off)
+                     a tail missed in every pixel adds up there); on the chromatic cloud the
+                     ratios baseline / spectral MIS + NEE of all three, on the fog and the plume
+                     time x variance from eff var/spl in the summary lines (eff var/spl is per
+                     channel, as var/spl of the chromatic tables; in the plume's rgb table
+                     var/spl is the channel mean's, so compare eff with eff; default: off)
   --spp N            samples per pixel, N >= 2 (default 256 for the cloud, 128 for the
-                     chromatic cloud, 256 for the sparse medium); the variance per sample is
-                     estimated from the N samples of each pixel
+                     chromatic cloud, 256 for the sparse medium, 128 for the fog's F1 and F2 and
+                     64 for F3, 256 for the plume); the variance per sample is estimated from
+                     the N samples of each pixel
   --res WxH          image size in pixels (default 128x128 for the cloud, 32x32 for the
-                     chromatic cloud, 64x64 for the sparse medium); also --width W, --height H
+                     chromatic cloud, 64x64 for the sparse medium, the fog and the plume); also
+                     --width W, --height H
   --threads N        worker threads (default: hardware concurrency)
   --seed N           random seed, an unsigned 64-bit integer (default 1); images do not depend
                      on --threads
@@ -252,19 +340,23 @@ usage: nsp_render [flags]
   --no-exr           do not write images (timings and tables only)
   --list             list every compiled policy combination and exit
   --env L            add a constant environment light of radiance L >= 0
-  --point X,Y,Z,I    add an isotropic point light of intensity I >= 0 at (X, Y, Z); only next-
-                     event estimation reaches it, so unidirectional renders miss its light
+  --point X,Y,Z,I    add an isotropic point light of intensity I >= 0 at (X, Y, Z), or move the
+                     fog's lamp there; only next-event estimation reaches it, so unidirectional
+                     renders miss its light; the equiangular strategies aim at it
   --sphere X,Y,Z,R,L replace the set-up's sphere light (radius R > 0, radiance L >= 0); it must
-                     lie outside the medium box [-1, 1]^3
+                     lie outside the medium's box ([-1, 1]^3; the fog's [-2.2, 0.8] x
+                     [-1.6, 1.6] x [-1.5, 2.5])
   --help             this text
 
 Examples: nsp_render --scene cloud --setup A --spp 256 --estimators uni-nee-mis_balance
           nsp_render --scene sparse --majorant all --spp 32
           nsp_render --scene cloud --majorant global,grid,global-signed,grid-clamp --spp 64
           nsp_render --scene chromatic --estimators all --spp 16 --res 32x32
+          nsp_render --scene fog --setup F3 --point=-0.5,0,0.4,5   (F1's lamp, in the dense fog)
           nsp_render --scene chromatic --runs 5 --res 32x32 --spp 128 --no-exr \
                      --reference-spp 2048 --selection uniform \
                      --estimators uni-nee-mis_grey_balance_absorb-weight,uni-nee-mis_spectral-mis_absorb-weight
+          nsp_render --scene fog,plume --setup F1,P1 --runs 3 --reference-spp 2048 --no-exr
 )";
 
 [[noreturn]] void usage_error(const std::string& msg) {
@@ -385,21 +477,27 @@ Options parse(int argc, char** argv) {
                 if (t == "cloud") add(SceneKind::Cloud);
                 else if (t == "chromatic") add(SceneKind::Chromatic);
                 else if (t == "sparse") add(SceneKind::Sparse);
+                else if (t == "fog") add(SceneKind::Fog);
+                else if (t == "plume") add(SceneKind::Plume);
                 else if (t == "both") add(SceneKind::Cloud), add(SceneKind::Chromatic);
-                else if (t == "all") add(SceneKind::Cloud), add(SceneKind::Chromatic), add(SceneKind::Sparse);
-                else usage_error("--scene: '" + std::string(t) + "' is not one of cloud, chromatic, sparse, both, all");
+                else if (t == "all")
+                    for (const SceneKind k : {SceneKind::Cloud, SceneKind::Chromatic, SceneKind::Sparse, SceneKind::Fog,
+                                              SceneKind::Plume})
+                        add(k);
+                else
+                    usage_error("--scene: '" + std::string(t) +
+                                "' is not one of cloud, chromatic, sparse, fog, plume, both, all");
             }
         } else if (flag == "--setup") {
             o.setups.clear();
+            const std::vector<std::string> known{"A", "B", "C1", "C2", "SA", "SB", "F1", "F2", "F3", "P1"};
             for (const auto t : split(value(), ',')) {
-                if (t == "all" || t == "both") o.setups = {"A", "B", "C1", "C2", "SA", "SB"};
-                else if (t == "A" || t == "a") o.setups.emplace_back("A");
-                else if (t == "B" || t == "b") o.setups.emplace_back("B");
-                else if (t == "C1" || t == "c1") o.setups.emplace_back("C1");
-                else if (t == "C2" || t == "c2") o.setups.emplace_back("C2");
-                else if (t == "SA" || t == "sa") o.setups.emplace_back("SA");
-                else if (t == "SB" || t == "sb") o.setups.emplace_back("SB");
-                else usage_error("--setup: '" + std::string(t) + "' is not one of A, B, C1, C2, SA, SB, all");
+                std::string up(t);
+                for (char& ch : up) ch = char(std::toupper(static_cast<unsigned char>(ch)));
+                if (up == "ALL" || up == "BOTH") o.setups = known;
+                else if (std::find(known.begin(), known.end(), up) != known.end()) o.setups.push_back(up);
+                else
+                    usage_error("--setup: '" + std::string(t) + "' is not one of A, B, C1, C2, SA, SB, F1, F2, F3, P1, all");
             }
         } else if (flag == "--majorant") {
             const auto known = majorant_names();
@@ -472,6 +570,7 @@ struct Candidate {
     std::string strategy;
     std::string absorption;
     bool uses_selection = false;
+    bool emissive = false;  ///< the emissive medium (the plume scene's)
 };
 
 /// The run-time descriptions of every combination of spectral mode `mode`, in index order.
@@ -498,6 +597,7 @@ std::vector<Candidate> candidates(std::string_view mode, const std::vector<Selec
         c.strategy = info.strategy;
         c.absorption = info.absorption;
         c.uses_selection = info.uses_selection;
+        c.emissive = info.emissive;
         c.name = info.name();
         for (const auto f : split(c.name, '_')) {
             c.fields.emplace_back(f);
@@ -507,6 +607,7 @@ std::vector<Candidate> candidates(std::string_view mode, const std::vector<Selec
         }
         if (!info.spectral) c.fields.emplace_back("grey");
         if (info.plain_global) c.fields.emplace_back("global");
+        if (info.emissive) c.fields.emplace_back("emissive");
         if (!info.uses_selection) {
             out.push_back(c);
             continue;
@@ -543,51 +644,90 @@ struct TablePlan {
     std::vector<Candidate> rows;
 };
 
+/// What a scene renders when the flags do not say: its set-ups, spectral modes, image size,
+/// estimators and majorants.
+struct SceneDefaults {
+    struct Setup {
+        std::string name;  ///< as --setup names it
+        SceneChoice choice;
+        int spp = 0;  ///< 0: the scene's
+    };
+    std::vector<Setup> setups;
+    std::vector<std::string_view> modes;
+    int width = 0, height = 0, spp = 0;
+    const std::vector<std::string>* estimators = nullptr;
+    const std::vector<std::string>* majorants = nullptr;
+};
+
+SceneDefaults scene_defaults(SceneKind kind) {
+    using K = SceneKind;
+    const std::vector<std::string_view> mono{nsp::Mono::name};
+    switch (kind) {
+        case K::Chromatic:
+            return {{{"C1", {kind, LightSetup::A, ChromaticSetup::Env}}, {"C2", {kind, LightSetup::A, ChromaticSetup::Small}}},
+                    {nsp::Rgb::name, Hero4::name}, kChromaticWidth, kChromaticHeight, kChromaticSpp,
+                    &kChromaticEstimators, &kChromaticMajorants};
+        case K::Sparse:
+            return {{{"SA", {kind, LightSetup::A}}, {"SB", {kind, LightSetup::B}}}, mono, kSparseWidth,
+                    kSparseHeight, kSparseSpp, &kSparseEstimators, &kSparseMajorants};
+        case K::Fog: {
+            SceneDefaults d{{}, mono, kFogWidth, kFogHeight, kFogSpp, &kFogEstimators, &kFogMajorants};
+            for (const FogSetup f : {FogSetup::F1, FogSetup::F2, FogSetup::F3}) {
+                SceneChoice c{kind};
+                c.fog = f;
+                d.setups.push_back({name(f), c, f == FogSetup::F3 ? kDenseFogSpp : 0});
+            }
+            return d;
+        }
+        case K::Plume:
+            return {{{"P1", {kind}}}, {nsp::Rgb::name}, kPlumeWidth, kPlumeHeight, kPlumeSpp, &kPlumeEstimators,
+                    &kPlumeMajorants};
+        default:
+            return {{{"A", {kind, LightSetup::A}}, {"B", {kind, LightSetup::B}}}, mono, kCloudWidth, kCloudHeight,
+                    kCloudSpp, &kCloudEstimators, &kCloudMajorants};
+    }
+}
+
 std::vector<TablePlan> plan(const Options& o) {
     std::vector<TablePlan> tables;
     std::vector<std::string> all_tokens = o.estimators;
     std::vector<bool> used(all_tokens.size(), false);
     std::vector<bool> majorant_used(o.majorants.size(), false);
     for (const SceneKind kind : o.scenes) {
-        const bool chromatic = kind == SceneKind::Chromatic, sparse = kind == SceneKind::Sparse;
-        std::vector<SceneChoice> choices;
-        for (const auto& s : o.setups) {
-            if (kind == SceneKind::Cloud && (s == "A" || s == "B"))
-                choices.push_back({kind, s == "A" ? LightSetup::A : LightSetup::B});
-            if (chromatic && (s == "C1" || s == "C2"))
-                choices.push_back({kind, LightSetup::A, s == "C1" ? ChromaticSetup::Env : ChromaticSetup::Small});
-            if (sparse && (s == "SA" || s == "SB")) choices.push_back({kind, s == "SA" ? LightSetup::A : LightSetup::B});
-        }
-        std::vector<std::string_view> modes = o.modes;
-        if (modes.empty()) {
-            if (chromatic) modes = {nsp::Rgb::name, Hero4::name};
-            else modes = {nsp::Mono::name};
-        }
-        const std::vector<std::string>& tokens =
-            !o.estimators.empty() ? o.estimators
-                                  : (chromatic ? kChromaticEstimators : sparse ? kSparseEstimators : kCloudEstimators);
-        const std::vector<std::string>& majorants =
-            !o.majorants.empty() ? o.majorants
-                                 : (chromatic ? kChromaticMajorants : sparse ? kSparseMajorants : kCloudMajorants);
-        for (const SceneChoice& choice : choices) {
+        const SceneDefaults d = scene_defaults(kind);
+        std::vector<SceneDefaults::Setup> choices;
+        for (const auto& s : o.setups)
+            for (const SceneDefaults::Setup& setup : d.setups)
+                if (s == setup.name) choices.push_back(setup);
+        const std::vector<std::string_view> modes = o.modes.empty() ? d.modes : o.modes;
+        const std::vector<std::string>& tokens = !o.estimators.empty() ? o.estimators : *d.estimators;
+        const std::vector<std::string>& majorants = !o.majorants.empty() ? o.majorants : *d.majorants;
+        const bool emissive = kind == SceneKind::Plume;  // the plume renders the emissive medium, the others not
+        for (const auto& [setup_name, choice, setup_spp] : choices) {
             for (const auto mode : modes) {
-                TablePlan t{choice, mode,
-                            o.width.value_or(chromatic ? kChromaticWidth : sparse ? kSparseWidth : kCloudWidth),
-                            o.height.value_or(chromatic ? kChromaticHeight : sparse ? kSparseHeight : kCloudHeight),
-                            o.spp.value_or(chromatic ? kChromaticSpp : sparse ? kSparseSpp : kCloudSpp),
-                            {}};
+                TablePlan t{choice, mode, o.width.value_or(d.width), o.height.value_or(d.height),
+                            o.spp.value_or(setup_spp > 0 ? setup_spp : d.spp), {}};
+                std::vector<bool> token_used(tokens.size(), false);
                 for (const Candidate& c : candidates(mode, o.selections)) {
+                    if (c.emissive != emissive) continue;
                     const auto maj = std::find(majorants.begin(), majorants.end(), c.majorant);
                     if (maj == majorants.end()) continue;
                     if (!o.majorants.empty()) majorant_used[std::size_t(maj - majorants.begin())] = true;
                     bool any = false;
                     for (std::size_t k = 0; k < tokens.size(); ++k) {
                         if (!matches(c, tokens[k])) continue;
-                        any = true;
+                        any = token_used[k] = true;
                         if (!o.estimators.empty()) used[k] = true;
                     }
                     if (any) t.rows.push_back(c);
                 }
+                // A scene's default row that this mode does not compile (e.g. the equiangular
+                // strategies outside mono) is left out with a note rather than silently.
+                for (std::size_t k = 0; k < tokens.size() && o.estimators.empty(); ++k)
+                    if (!token_used[k] && !t.rows.empty())
+                        std::fprintf(stderr, "nsp_render: note: set-up %s, %.*s: no row '%s' (not compiled in this "
+                                     "mode, see --list)\n", choice.name(), int(mode.size()), mode.data(),
+                                     tokens[k].c_str());
                 if (!t.rows.empty()) tables.push_back(std::move(t));
             }
         }
@@ -600,7 +740,10 @@ std::vector<TablePlan> plan(const Options& o) {
         if (!majorant_used[k] && !o.all_majorants)
             usage_error("--majorant: '" + o.majorants[k] + "' has no row in the chosen spectral modes (see --list: "
                         "per-channel majorants need rgb or hero, the non-bounding ones mono)");
-    if (tables.empty()) usage_error("nothing to render: --scene and --setup choose no set-up in common");
+    if (tables.empty())
+        usage_error("nothing to render: the chosen scenes, set-ups, spectral modes and majorants have no row in "
+                    "common (--scene and --setup must share a set-up; see --list: the plume's emissive medium is "
+                    "compiled in rgb only, the equiangular strategies in mono only)");
     return tables;
 }
 
@@ -683,6 +826,7 @@ struct Metrics {
 
 /// The reference image of --reference-spp for one table, and what it cost.
 struct Reference {
+    std::string estimator;  ///< the row name of the estimator that rendered it
     int spp = 0;
     std::uint64_t seed = 0;
     RenderStats stats;  ///< with pixel_mean and pixel_variance
@@ -876,7 +1020,7 @@ void print_majorant_comparison(const std::vector<Row>& rows, const Metrics& m) {
 }
 
 /// Footer lines every table shares: medians, status counts, majorants, rarely nonzero rows.
-void print_common_footer(const Options& o, const std::vector<Row>& rows) {
+void print_common_footer(const TablePlan& t, const Options& o, const std::vector<Row>& rows) {
     if (o.runs > 1)
         std::printf("seconds, lookups/spl, var/spl, LTUV, cpu-s*var: MEDIAN over %d runs (seeds %llu..%llu), "
                     "LTUV/best from the median LTUV; min..max: var/spl over the runs; mean: over the runs.\n",
@@ -894,6 +1038,10 @@ void print_common_footer(const Options& o, const std::vector<Row>& rows) {
     if (o.lights.point)
         std::printf("note: the point light (--point) is reachable by next-event estimation only, so the "
                     "unidirectional rows leave out its light and their mean is lower\n");
+    else if (t.scene.kind == SceneKind::Fog &&
+             std::any_of(rows.begin(), rows.end(), [](const Row& r) { return r.c.strategy == "unidirectional"; }))
+        std::printf("note: the lamp is a point light, reachable by next-event estimation only: the "
+                    "unidirectional rows cannot see it\n");
     for (const Row& r : rows) {
         std::uint64_t samples = 0;
         for (const RenderStats& s : r.runs) samples += s.samples;
@@ -904,11 +1052,153 @@ void print_common_footer(const Options& o, const std::vector<Row>& rows) {
     }
 }
 
-void print_cloud_table(const TablePlan& t, const Options& o, const std::vector<Row>& rows) {
+/// The lowest-LTUV row among `rows` that `pred` accepts (nullptr if none measured a variance).
+template <class P>
+const Row* best_of(const std::vector<Row>& rows, const Metrics& m, P pred) {
+    const Row* best = nullptr;
+    for (const Row& r : rows)
+        if (pred(r) && m.ltuv(r) > 0.0 && (!best || m.ltuv(r) < m.ltuv(*best))) best = &r;
+    return best;
+}
+
+/// What the eff var/spl columns are (--reference-spp), and the reference they were measured against.
+void print_reference_footer(const TablePlan& t, const Options& o, const std::vector<Row>& rows,
+                            const Reference& reference) {
+    double smallest = std::numeric_limits<double>::infinity();
+    for (const Row& r : rows)
+        if (!r.effective.empty()) smallest = std::min(smallest, Metrics::eff(r));
+    const double contrib = reference.contribution(t.spp);
+    std::printf("eff var/spl: effective variance per sample against a reference image of this set-up, mode "
+                "and resolution: %s, %d spp, seed %llu (independent of every row), %.1f s, var/spl %s. Per "
+                "run: %d x mean over pixels and channels of (pixel mean - reference pixel mean)^2, minus the "
+                "reference's own noise, %d x mean(var_ref/%d) = %s (%.1f%% of the lowest eff var/spl). For an "
+                "unbiased estimator it is an unbiased estimate of %d x the image's MSE = its variance per "
+                "sample; for a heavy-tailed one it also holds the error its sample variance misses. eff LTUV "
+                "= lookups/spl x eff var/spl; img eff var: the same from the image mean's error, %d x %d "
+                "pixels x mean over channels of (image mean - reference's)^2 minus the same reference term "
+                "(3 degrees of freedom per run, noisy, but a tail missed in every pixel adds up there); all "
+                "%s. Reference image mean R G B: %s %s %s.\n",
+                reference.estimator.c_str(), reference.spp, (unsigned long long)reference.seed,
+                reference.stats.wall_seconds, num(reference.stats.variance_per_channel()).c_str(), t.spp, t.spp,
+                reference.spp, num(contrib).c_str(),
+                std::isfinite(smallest) && smallest > 0.0 ? 100.0 * contrib / smallest : 0.0, t.spp, t.spp,
+                t.width * t.height, o.runs > 1 ? ("median over " + std::to_string(o.runs) + " runs").c_str() : "one run",
+                num(reference.stats.mean[0]).c_str(), num(reference.stats.mean[1]).c_str(),
+                num(reference.stats.mean[2]).c_str());
+}
+
+/// Means that disagree: the per-pixel variances give each image mean a standard error, and a row
+/// far from the best row is heavy-tailed (its sample variance understates its variance, and its
+/// mean is low in most runs) or biased. `channels`: name the channel (not in mono tables).
+void print_mean_notes(const std::vector<Row>& rows, const Metrics& m, bool channels) {
+    const Row* ref = best_of(rows, m, [](const Row& r) { return r.nonzero() >= kFewNonzero; });
+    for (const Row& r : rows) {
+        if (!ref || &r == ref || r.nonzero() < kFewNonzero) continue;
+        const auto [z, c] = mean_gap(r, *ref);
+        if (z > kMeanGap)
+            std::printf("note: %s: image mean %s%s is %.1f standard errors from %s's %s: a heavy tail (its var/spl "
+                        "then understates the variance) or a bias\n", r.c.name.c_str(), num(r.mean(c)).c_str(),
+                        channels ? (std::string(" in ") + "RGB"[c]).c_str() : "", z, ref->c.name.c_str(),
+                        num(ref->mean(c)).c_str());
+    }
+}
+
+/// Time x variance of a row: the median over its runs of thread CPU seconds per sample x var/spl,
+/// or x eff var/spl of the same run when the table has a reference (--reference-spp).
+double time_variance(const Row& r, const Metrics& m) {
+    if (r.effective.empty()) return r.median([&](const RenderStats& s) { return m.time_variance(s); });
+    std::vector<double> v;
+    for (std::size_t i = 0; i < r.effective.size(); ++i)
+        v.push_back(r.runs[i].cpu_seconds_per_sample() * r.effective[i]);
+    return Metrics::median_of(v);
+}
+
+/// The row of estimator `key` (its name without the majorant) with majorant `majorant`.
+const Row* find_row(const std::vector<Row>& rows, std::string_view key, std::string_view majorant) {
+    for (const Row& r : rows)
+        if (r.c.key == key && r.c.majorant == majorant) return &r;
+    return nullptr;
+}
+
+/// The majorants of `rows`, in the order they first appear.
+std::vector<std::string> majorants_of(const std::vector<Row>& rows) {
+    std::vector<std::string> out;
+    for (const Row& r : rows)
+        if (std::find(out.begin(), out.end(), r.c.majorant) == out.end()) out.push_back(r.c.majorant);
+    return out;
+}
+
+std::string ratio_text(double a, double b) { return b > 0.0 && std::isfinite(a / b) ? num(a / b) : "n/a"; }
+
+/// A row's estimator without its absorption policy, e.g. uni-nee-eq-mis_balance.
+std::string without_absorption(const std::string& key) {
+    const auto p = key.rfind("_absorb-");
+    return p == std::string::npos ? key : key.substr(0, p);
+}
+
+/// The fog's question (THEORY 5.4), per majorant: which single vertex sampler wins in time x
+/// variance, tracking + NEE or equiangular + NEE, and how far the three-way MIS is from it.
+void print_fog_summary(const std::vector<Row>& rows, const Metrics& m) {
+    const bool eff = std::any_of(rows.begin(), rows.end(), [](const Row& r) { return !r.effective.empty(); });
+    for (const std::string& maj : majorants_of(rows)) {
+        const Row* nee = find_row(rows, "ratio-nee_absorb-weight", maj);
+        const Row* eq = find_row(rows, "equiangular-nee_absorb-weight", maj);
+        if (!nee || !eq) continue;
+        const double tn = time_variance(*nee, m), te = time_variance(*eq, m);
+        const bool eq_best = te < tn;
+        const double best = std::min(tn, te);
+        std::printf("%s majorant, time x variance (%s): ratio-nee %s, equiangular-nee %s -> best single strategy: "
+                    "%s (%sx lower)", maj.c_str(), eff ? "cpu-s/spl x eff var/spl" : "cpu-s*var", num(tn).c_str(),
+                    num(te).c_str(), eq_best ? "equiangular-nee" : "ratio-nee",
+                    ratio_text(std::max(tn, te), best).c_str());
+        for (const char* key : {"uni-nee-eq-mis_balance_absorb-weight", "uni-nee-eq-mis_power_absorb-weight",
+                                "uni-nee-mis_balance_absorb-weight"})
+            if (const Row* r = find_row(rows, key, maj))
+                std::printf("; %s / best single: %s", without_absorption(r->c.key).c_str(),
+                            ratio_text(time_variance(*r, m), best).c_str());
+        std::printf("\n");
+    }
+}
+
+/// The plume's question (THEORY 5.7), per majorant: the collision estimator alone against NEE
+/// toward the emitting volume combined with it by MIS, in time x variance and LTUV (effective
+/// ones with a reference).
+void print_plume_summary(const std::vector<Row>& rows, const Metrics& m) {
+    const bool eff = std::any_of(rows.begin(), rows.end(), [](const Row& r) { return !r.effective.empty(); });
+    const auto ltuv = [&](const Row& r) { return r.effective.empty() ? m.ltuv(r) : Metrics::eff_ltuv(r); };
+    for (const std::string& maj : majorants_of(rows)) {
+        const Row* uni = find_row(rows, "unidirectional_absorb-weight", maj);
+        if (!uni) continue;
+        std::string line;
+        for (const char* key : {"uni-nee-mis_balance_absorb-weight", "uni-nee-mis_power_absorb-weight",
+                                "ratio-nee_absorb-weight"})
+            if (const Row* r = find_row(rows, key, maj))
+                line += std::string(line.empty() ? "" : "; ") + without_absorption(r->c.key) + " " +
+                        ratio_text(time_variance(*uni, m), time_variance(*r, m)) + "x (LTUV " +
+                        ratio_text(ltuv(*uni), ltuv(*r)) + "x)";
+        if (!line.empty())
+            std::printf("%s majorant, collision estimator alone (unidirectional) / each row, time x variance (%s): "
+                        "%s\n", maj.c_str(), eff ? "cpu-s/spl x eff var/spl" : "cpu-s*var", line.c_str());
+    }
+}
+
+/// The scene words of a grey table's title.
+std::string scene_words(const SceneChoice& c) {
+    switch (c.kind) {
+        case SceneKind::Sparse: return "sparse medium, ";
+        case SceneKind::Fog:
+            return c.fog == FogSetup::F1 ? "thin fog, lamp inside, "
+                   : c.fog == FogSetup::F2 ? "thin fog, lamp beside, "
+                                           : "dense fog (40x F2's), lamp beside, ";
+        case SceneKind::Plume: return "flame in the smoke (emissive medium), ";
+        default: return "";
+    }
+}
+
+void print_cloud_table(const TablePlan& t, const Options& o, const std::vector<Row>& rows, const Reference* reference) {
     const Metrics m{false};
-    std::printf("\nSet-up %s (%s%.*s, %dx%d, %d spp, %d threads%s)\n", t.scene.name(),
-                t.scene.kind == SceneKind::Sparse ? "sparse medium, " : "", int(t.mode.size()),
-                t.mode.data(), t.width, t.height, t.spp, o.threads,
+    std::printf("\nSet-up %s (%s%.*s, %dx%d, %d spp, %d threads%s)\n", t.scene.name(), scene_words(t.scene).c_str(),
+                int(t.mode.size()), t.mode.data(), t.width, t.height, t.spp, o.threads,
                 o.runs > 1 ? (", " + std::to_string(o.runs) + " runs").c_str() : "");
     print_rows(t, o, rows, m);
     std::printf("var/spl: per-pixel sample variance of the %d samples of each pixel (Welford)%s, averaged over "
@@ -919,8 +1209,13 @@ void print_cloud_table(const TablePlan& t, const Options& o, const std::vector<R
                 t.width * t.height);
     std::printf("LTUV = lookups/spl x var/spl; cpu-s*var = thread CPU seconds per sample x var/spl; lower is "
                 "better. mean: image mean (should agree across rows).\n");
-    print_common_footer(o, rows);
+    print_common_footer(t, o, rows);
     print_majorant_comparison(rows, m);
+    if (reference) print_reference_footer(t, o, rows, *reference);
+    if (t.scene.kind == SceneKind::Fog || t.scene.kind == SceneKind::Plume)
+        print_mean_notes(rows, m, t.mode != nsp::Mono::name);
+    if (t.scene.kind == SceneKind::Fog) return print_fog_summary(rows, m);
+    if (t.scene.kind == SceneKind::Plume) return print_plume_summary(rows, m);
     // THEORY 7's claim, on the absorb-weight rows when present.
     const auto* uni = find_row(rows, "unidirectional_absorb-weight");
     const auto* nee = find_row(rows, "ratio-nee_absorb-weight");
@@ -931,15 +1226,6 @@ void print_cloud_table(const TablePlan& t, const Options& o, const std::vector<R
         std::printf("; uni-nee-mis_balance / best single strategy: %s",
                     num(m.ltuv(*mis) / std::min(m.ltuv(*uni), m.ltuv(*nee))).c_str());
     if (uni && nee) std::printf(" (absorb-weight rows)\n");
-}
-
-/// The lowest-LTUV row among `rows` that `pred` accepts (nullptr if none measured a variance).
-template <class P>
-const Row* best_of(const std::vector<Row>& rows, const Metrics& m, P pred) {
-    const Row* best = nullptr;
-    for (const Row& r : rows)
-        if (pred(r) && m.ltuv(r) > 0.0 && (!best || m.ltuv(r) < m.ltuv(*best))) best = &r;
-    return best;
 }
 
 void print_chromatic_table(const TablePlan& t, const Options& o, const std::vector<Row>& rows,
@@ -958,44 +1244,10 @@ void print_chromatic_table(const TablePlan& t, const Options& o, const std::vect
                 hero ? " (linear sRGB)" : "");
     std::printf("Rows without a channel policy are nsp::PathEstimator with the grey (global) majorant; _lum: "
                 "luminance channel selection, otherwise uniform.\n");
-    print_common_footer(o, rows);
+    print_common_footer(t, o, rows);
     print_majorant_comparison(rows, m);
-    if (reference) {
-        double smallest = std::numeric_limits<double>::infinity();
-        for (const Row& r : rows)
-            if (!r.effective.empty()) smallest = std::min(smallest, Metrics::eff(r));
-        const double contrib = reference->contribution(t.spp);
-        std::printf("eff var/spl: effective variance per sample against a reference image of this set-up, mode "
-                    "and resolution: %s, %d spp, seed %llu (independent of every row), %.1f s, var/spl %s. Per "
-                    "run: %d x mean over pixels and channels of (pixel mean - reference pixel mean)^2, minus the "
-                    "reference's own noise, %d x mean(var_ref/%d) = %s (%.1f%% of the lowest eff var/spl). For an "
-                    "unbiased estimator it is an unbiased estimate of %d x the image's MSE = its variance per "
-                    "sample; for a heavy-tailed one it also holds the error its sample variance misses. eff LTUV "
-                    "= lookups/spl x eff var/spl; img eff var: the same from the image mean's error, %d x %d "
-                    "pixels x mean over channels of (image mean - reference's)^2 minus the same reference term "
-                    "(3 degrees of freedom per run, noisy, but a tail missed in every pixel adds up there); all "
-                    "%s. Reference image mean R G B: %s %s %s.\n",
-                    kReferenceEstimator, reference->spp, (unsigned long long)reference->seed,
-                    reference->stats.wall_seconds, num(reference->stats.variance_per_channel()).c_str(), t.spp,
-                    t.spp, reference->spp, num(contrib).c_str(),
-                    std::isfinite(smallest) && smallest > 0.0 ? 100.0 * contrib / smallest : 0.0, t.spp, t.spp,
-                    t.width * t.height,
-                    o.runs > 1 ? ("median over " + std::to_string(o.runs) + " runs").c_str() : "one run",
-                    num(reference->stats.mean[0]).c_str(), num(reference->stats.mean[1]).c_str(),
-                    num(reference->stats.mean[2]).c_str());
-    }
-    // Means that disagree: the per-pixel variances give each image mean a standard error, and a
-    // row far from the best row is heavy-tailed (its sample variance understates its variance,
-    // and its mean is low in most runs) or biased.
-    const Row* ref = best_of(rows, m, [](const Row& r) { return r.nonzero() >= kFewNonzero; });
-    for (const Row& r : rows) {
-        if (!ref || &r == ref || r.nonzero() < kFewNonzero) continue;
-        const auto [z, c] = mean_gap(r, *ref);
-        if (z > kMeanGap)
-            std::printf("note: %s: image mean %s in %c is %.1f standard errors from %s's %s: a heavy tail (its "
-                        "var/spl then understates the variance) or a bias\n", r.c.name.c_str(),
-                        num(r.mean(c)).c_str(), "RGB"[c], z, ref->c.name.c_str(), num(ref->mean(c)).c_str());
-    }
+    if (reference) print_reference_footer(t, o, rows, *reference);
+    print_mean_notes(rows, m, true);
 
     const std::string runs_note = o.runs > 1 ? "median over " + std::to_string(o.runs) + " runs"
                                              : "one run; the baseline is heavy-tailed, see --runs, --reference-spp";
@@ -1106,9 +1358,13 @@ void list_combinations() {
                 "nsp::SpectralPathEstimator, only in multi-channel modes: independent tracking with a per-channel "
                 "majorant (per-channel, channel-grid), spectral tracking with a grey one (global, grid), "
                 "spectral-mis with any of the four; no directional-mis; mis::None for single strategies, balance "
-                "for uni-nee-mis. Majorants other than global and per-channel: absorb-weight only (build time). "
-                "Independent and spectral-mis rows are rendered once per --selection rule (luminance rows end in "
-                "_lum).\n", total);
+                "for uni-nee-mis. Majorants other than global and per-channel: absorb-weight only (build time), "
+                "except the equiangular strategies (equiangular-nee, uni-nee-eq-mis), which take both absorption "
+                "policies with grid too and are compiled for nsp::PathEstimator in mono only (build time; the "
+                "library also has them in nsp::SpectralPathEstimator). Medium 'emissive' (the plume scene's flame, "
+                "nsp::Emissive): nsp::PathEstimator in rgb with global or grid, absorb-weight, without the "
+                "equiangular strategies. Independent and spectral-mis rows are rendered once per --selection rule "
+                "(luminance rows end in _lum).\n", total);
 }
 
 RenderStats render_in_mode(std::string_view mode, std::size_t index, const RenderRequest& rq, std::vector<float>& rgb) {
@@ -1124,15 +1380,25 @@ int run(const Options& o) {
     }
     const std::vector<TablePlan> tables = plan(o);
     if (o.write_exr) std::filesystem::create_directories(o.out);
-    // --reference-spp: the multi-channel tables get a reference image (mono has no spectral tracking).
-    auto reference_index = [&](std::string_view mode) -> std::optional<std::size_t> {
-        if (!o.reference_spp) return std::nullopt;
-        for (const Candidate& c : candidates(mode, {SelectionRule::Uniform}))
-            if (c.name == kReferenceEstimator) return c.index;
+    // --reference-spp: the chromatic cloud's tables (rgb, hero: mono has no spectral tracking), the
+    // fog's and the plume's get a reference image.
+    auto reference_name = [](const TablePlan& t) -> const char* {
+        switch (t.scene.kind) {
+            case SceneKind::Chromatic: return kReferenceEstimator;
+            case SceneKind::Fog: return kFogReferenceEstimator;
+            case SceneKind::Plume: return kPlumeReferenceEstimator;
+            default: return nullptr;
+        }
+    };
+    auto reference_index = [&](const TablePlan& t) -> std::optional<std::size_t> {
+        const char* name = reference_name(t);
+        if (!o.reference_spp || !name) return std::nullopt;
+        for (const Candidate& c : candidates(t.mode, {SelectionRule::Uniform}))
+            if (c.emissive == (t.scene.kind == SceneKind::Plume) && c.name == name) return c.index;
         return std::nullopt;
     };
     std::size_t total = 0;
-    for (const TablePlan& t : tables) total += t.rows.size() * std::size_t(o.runs) + (reference_index(t.mode) ? 1 : 0);
+    for (const TablePlan& t : tables) total += t.rows.size() * std::size_t(o.runs) + (reference_index(t) ? 1 : 0);
     std::fprintf(stderr, "nsp_render: %zu renders in %zu tables on %d threads\n", total, tables.size(), o.threads);
     const auto t0 = std::chrono::steady_clock::now();
     std::size_t done = 0;
@@ -1152,8 +1418,9 @@ int run(const Options& o) {
     };
     for (const TablePlan& t : tables) {
         std::optional<Reference> reference;
-        if (const auto index = reference_index(t.mode)) {
+        if (const auto index = reference_index(t)) {
             reference.emplace();
+            reference->estimator = reference_name(t);
             reference->spp = *o.reference_spp;
             reference->seed = o.seed + kReferenceSeedOffset;
             RenderRequest rq = request(t, reference->seed, SelectionRule::Uniform);
@@ -1165,8 +1432,13 @@ int run(const Options& o) {
             std::vector<float> rgb;
             reference->stats = render_in_mode(t.mode, *index, rq, rgb);
         } else if (o.reference_spp) {
-            std::fprintf(stderr, "nsp_render: --reference-spp: no reference in %.*s mode (it needs %s)\n",
-                         int(t.mode.size()), t.mode.data(), kReferenceEstimator);
+            const char* name = reference_name(t);
+            if (name)
+                std::fprintf(stderr, "nsp_render: --reference-spp: no reference for set-up %s in %.*s mode (it needs "
+                             "%s)\n", t.scene.name(), int(t.mode.size()), t.mode.data(), name);
+            else
+                std::fprintf(stderr, "nsp_render: --reference-spp: set-up %s has no reference estimator (only the "
+                             "chromatic cloud's, the fog's and the plume's tables have one)\n", t.scene.name());
         }
         std::vector<Row> rows;
         for (const Candidate& c : t.rows) {
@@ -1193,7 +1465,7 @@ int run(const Options& o) {
             }
             rows.push_back(std::move(row));
         }
-        if (t.scene.kind != SceneKind::Chromatic) print_cloud_table(t, o, rows);
+        if (t.scene.kind != SceneKind::Chromatic) print_cloud_table(t, o, rows, reference ? &*reference : nullptr);
         else print_chromatic_table(t, o, rows, reference ? &*reference : nullptr);
         std::fflush(stdout);
     }

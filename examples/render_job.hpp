@@ -20,23 +20,6 @@
 
 namespace nsp_examples {
 
-/// One light set-up of one scene: A or B of the grey cloud, C1 or C2 of the chromatic cloud, SA or
-/// SB of the sparse medium (set-up A's or B's lights).
-struct SceneChoice {
-    SceneKind kind = SceneKind::Cloud;
-    LightSetup cloud = LightSetup::A;                ///< with SceneKind::Cloud and SceneKind::Sparse
-    ChromaticSetup chromatic = ChromaticSetup::Env;  ///< with SceneKind::Chromatic
-
-    /// "A", "B", "C1", "C2", "SA" or "SB".
-    const char* name() const {
-        switch (kind) {
-            case SceneKind::Chromatic: return nsp_examples::name(chromatic);
-            case SceneKind::Sparse: return cloud == LightSetup::A ? "SA" : "SB";
-            default: return nsp_examples::name(cloud);
-        }
-    }
-};
-
 /// Lights the command line adds to (or replaces in) a set-up.
 struct LightOverrides {
     std::optional<float> env;                    ///< constant environment radiance

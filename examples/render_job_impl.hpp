@@ -115,13 +115,23 @@ Eigen::Array3d to_linear_rgb(const typename S::Spectrum& L, const typename S::Wa
     else return Eigen::Array3d::Constant(double(L[0]));
 }
 
+/// The lights of set-up `choice` (the plume has none: the flame is its light).
+template <nsp::SpectralMode S>
+nsp::Lights<S> scene_lights(const SceneChoice& choice) {
+    switch (choice.kind) {
+        case SceneKind::Chromatic: return chromatic_lights<S>(choice.chromatic);
+        case SceneKind::Fog: return fog_lights<S>(choice.fog);
+        case SceneKind::Plume: return {};
+        default: return default_lights<S>(choice.cloud);
+    }
+}
+
 /// The scene of combination C in `choice`, with the lights the flags add or replace and the
 /// majorant built with `settings`.
 template <class C>
 typename C::Scene make_scene(const SceneChoice& choice, const LightOverrides& o, const MajorantSettings& settings) {
     using S = typename C::Spectral;
-    nsp::Lights<S> lights = choice.kind == SceneKind::Chromatic ? chromatic_lights<S>(choice.chromatic)
-                                                                : default_lights<S>(choice.cloud);
+    nsp::Lights<S> lights = scene_lights<S>(choice);
     if (o.sphere) {
         const auto& s = *o.sphere;
         lights.set(nsp::SphereLight<S>{nsp::Vec3(s[0], s[1], s[2]), s[3], nsp::constant_coefficient<S>(s[4])});
@@ -131,9 +141,9 @@ typename C::Scene make_scene(const SceneChoice& choice, const LightOverrides& o,
         lights.set(nsp::PointLight<S>{nsp::Vec3(p[0], p[1], p[2]), nsp::constant_coefficient<S>(p[3])});
     }
     if (o.env) lights.set(nsp::EnvironmentLight<S>{nsp::constant_coefficient<S>(*o.env)});
-    auto medium = C::MediumKind::template make<S>(choice.kind);
+    auto medium = C::MediumKind::template make<S>(choice);
     auto majorant = C::MajorantKind::make(medium, settings);
-    return typename C::Scene(std::move(medium), std::move(majorant), nsp::HenyeyGreensteinPhase(kPhaseG),
+    return typename C::Scene(std::move(medium), std::move(majorant), nsp::HenyeyGreensteinPhase(phase_g(choice.kind)),
                              std::move(lights));
 }
 
