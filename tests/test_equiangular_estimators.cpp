@@ -158,23 +158,26 @@ TEST_CASE_TEMPLATE_DEFINE("equiangular MIS: a large light and strong roulette ma
     using M = typename C::Medium;
     using A = typename C::Absorption;
     const Box box{Vec3(-1.f), Vec3(1.f)};
-    // A sphere light of radius 1 just beside a thin (thickness ~0.4), bright (albedo 0.9) box:
-    // hitting it from a tracked vertex (p_hit) is as likely as sampling it (p_nee), and the
-    // equiangular vertex is as likely as the tracked one, so the three weights are all near 1/3
-    // and a survival probability of 0.3 (roulette from the first vertex) that one side left out
-    // would move the weights by ~10 %. Reference: uni + NEE MIS, a separate run.
-    const M medium = make_medium<M>(box, 0.2f, spec<S>(0.1f, 0.15f, 0.05f), spec<S>(0.9f, 0.85f, 0.95f));
+    // Single scattering (max depth 1) toward a sphere light of radius 1.2 just off the camera
+    // ray's line, beyond a box of optical thickness 1 and albedo 0.9, forward scattering (HG 0.9):
+    // from a vertex on the ray, hitting the light (phase pdf ~1.4 toward it) is within a few times
+    // as likely as sampling its cone (~2.5), and the equiangular vertex about as likely as the
+    // tracked one (p_eq ~0.5, mu_bar 0.5), so all three weights matter: a survival probability of
+    // 0.3 (roulette from the first vertex) that one side left out moves the equiangular weight by
+    // ~15 %. Reference: uni + NEE MIS, a separate run.
+    const M medium = make_medium<M>(box, 0.5f, spec<S>(0.1f, 0.15f, 0.05f), spec<S>(0.9f, 0.85f, 0.95f));
     Lights<S> lights;
-    lights.set(SphereLight<S>{Vec3(0.f, 2.2f, 0.f), 1.f, grey<S>(1.f)});
-    const Ray ray{Vec3(-3.f, 0.6f, 0.1f), glm::normalize(Vec3(1.f, 0.01f, 0.02f))};
+    lights.set(SphereLight<S>{Vec3(3.2f, 1.6f, 0.1f), 1.2f, grey<S>(1.f)});
+    const Ray ray{Vec3(-3.f, 0.3f, 0.1f), Vec3(1.f, 0.f, 0.f)};
     EstimatorOptions opts;
+    opts.max_depth = 1;
     opts.rr_start_depth = 1;
     opts.rr_max_survival = 0.3f;
-    const auto scene = Scene(medium, GlobalMajorant<M>(medium), IsotropicPhase{}, lights);
+    const auto scene = Scene(medium, GlobalMajorant<M>(medium), HenyeyGreensteinPhase(0.9f), lights);
     const auto ref = estimate_radiance(PathEstimator<strategy::NullScatteringMis, mis::Balance, A>(opts), scene, ray,
-                                       100000, 40);
+                                       200000, 40);
     const auto res = estimate_radiance(PathEstimator<strategy::EquiangularMis, mis::Balance, A>(opts), scene, ray,
-                                       100000, 41);
+                                       200000, 41);
     CHECK(ref.not_ok == 0);
     CHECK(res.not_ok == 0);
     for (int c = 0; c < S::channels; ++c) {

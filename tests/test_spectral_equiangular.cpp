@@ -125,23 +125,25 @@ TEST_CASE_TEMPLATE_APPLY(spectral_eq_furnace, SpectralEquiangular);
 
 TEST_CASE_TEMPLATE_DEFINE("spectral equiangular MIS: strong roulette and a large light agree with spectral uni + NEE MIS",
                           CP, spectral_eq_roulette) {
-    // As the grey suite's case: a sphere light of radius 1 beside a thin, bright box, roulette from
-    // the first vertex with survival at most 0.3, so every one of the 3 x C techniques matters.
+    // As the grey suite's case: single scattering toward a large light just off the camera ray's
+    // line, forward scattering, roulette from the first vertex with survival at most 0.3, so every
+    // one of the 3 x C techniques matters.
     using A = absorption::Weight;
-    const auto medium = make_medium<DenseGridMedium<Rgb>>(kBox, 0.2f, spec<Rgb>(0.1f, 0.15f, 0.05f),
+    const auto medium = make_medium<DenseGridMedium<Rgb>>(kBox, 0.5f, spec<Rgb>(0.1f, 0.15f, 0.05f),
                                                           spec<Rgb>(0.9f, 2.f, 0.5f));
     Lights<Rgb> lights;
-    lights.set(SphereLight<Rgb>{Vec3(0.f, 2.2f, 0.f), 1.f, Rgb::Spectrum(1.f, 0.5f, 2.f)});
-    const Ray ray{Vec3(-3.f, 0.6f, 0.1f), glm::normalize(Vec3(1.f, 0.01f, 0.02f))};
+    lights.set(SphereLight<Rgb>{Vec3(3.2f, 1.6f, 0.1f), 1.2f, Rgb::Spectrum(1.f, 0.5f, 2.f)});
+    const Ray ray{Vec3(-3.f, 0.3f, 0.1f), Vec3(1.f, 0.f, 0.f)};
     EstimatorOptions opts;
+    opts.max_depth = 1;
     opts.rr_start_depth = 1;
     opts.rr_max_survival = 0.3f;
     for_each_majorant<CP>(medium, [&](const auto& maj, const char* maj_name) {
-        const auto scene = Scene(medium, maj, IsotropicPhase{}, lights);
+        const auto scene = Scene(medium, maj, HenyeyGreensteinPhase(0.9f), lights);
         const auto ref = estimate_radiance(SpectralPathEstimator<CP, strategy::NullScatteringMis, mis::Balance, A>(opts),
-                                           scene, ray, 60000, 300);
+                                           scene, ray, 200000, 300);
         const auto res = estimate_radiance(SpectralPathEstimator<CP, strategy::EquiangularMis, mis::Balance, A>(opts),
-                                           scene, ray, 60000, 301);
+                                           scene, ray, 200000, 301);
         CHECK(ref.not_ok == 0);
         CHECK(res.not_ok == 0);
         for (int c = 0; c < 3; ++c) {
