@@ -2,10 +2,16 @@
 // techniques run and how they combine), run-time options, and the result type.
 #pragma once
 
+#include <cmath>
 #include <concepts>
 #include <cstdint>
+#include <optional>
+#include <type_traits>
 
 #include "../core/error.hpp"
+#include "../light.hpp"
+#include "../media/emissive.hpp"
+#include "../pdf.hpp"
 #include "../spectrum.hpp"
 #include "../tracking.hpp"
 
@@ -95,6 +101,55 @@ struct RadianceSample {
     typename S::Spectrum value;
     Status status = Status::Ok;
 };
+
+/// What tracking would see at a vertex it did not draw itself (an equiangular or emission sample).
+template <Medium M, class Maj>
+struct UntrackedVertex {
+    Coefficients<typename M::Spectral> k;  ///< the lookup, clamped to the majorant under bound::Clamp
+    MajorantValue<Maj, M> mu;              ///< the majorant there (grey or per channel)
+};
+
+/// One density lookup (counted) at distance t on `ray` with the majorant there, treated as
+/// free_flight treats its lookups: clamped under bound::Clamp; std::nullopt under bound::Reject
+/// where mu_t exceeds mu_bar (the estimator reports Status::Rejected).
+template <Medium M, MajorantPolicy<M> Maj, LookupCounter C>
+std::optional<UntrackedVertex<M, Maj>> lookup_untracked(const M& medium, const Maj& majorant, const Ray& ray, float t,
+                                                        const typename M::Spectral::Wavelengths& lambda, C& counter) {
+    using B = bound_policy_t<Maj>;
+    counter.lookup();
+    UntrackedVertex<M, Maj> v{medium.coefficients(ray.at(t), lambda), majorant_value_at_point<M>(majorant, ray, t, lambda)};
+    if constexpr (std::is_same_v<B, bound::Clamp>) {
+        detail::clamp_to_majorant(v.k, v.mu);
+    } else if constexpr (std::is_same_v<B, bound::Reject>) {
+        if (detail::exceeds_majorant(v.k, v.mu)) return std::nullopt;
+    }
+    return v;
+}
+
+/// A point y of the emitting volume drawn for NEE from x (THEORY 5.7), with the shadow ray toward
+/// it and its squared distance.
+struct EmissionSample {
+    VolumeSample y;  ///< the point and its volume pdf p_V(y) > 0
+    Ray shadow;      ///< from x toward y (unit direction)
+    float dist = 0.f, dist2 = 0.f;
+};
+
+/// Draws y from the medium's power grid with four random numbers; std::nullopt when nothing
+/// emits, y = x, or the sphere light blocks the way.
+template <EmissiveMedium M, SpectralMode S, UniformRng R>
+std::optional<EmissionSample> sample_emission_from(const M& medium, const Lights<S>& lights, const Vec3& x, R& rng) {
+    const float u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform(), u3 = rng.uniform();
+    EmissionSample e;
+    e.y = medium.sample_emission(u0, u1, u2, u3);
+    if (!(e.y.pdf > 0.f)) return std::nullopt;
+    const Vec3 dv = e.y.p - x;
+    e.dist2 = glm::dot(dv, dv);
+    if (!(e.dist2 > 0.f)) return std::nullopt;
+    e.dist = std::sqrt(e.dist2);
+    e.shadow = Ray{x, dv / e.dist};
+    if (lights.sphere_blocks(e.shadow, e.dist)) return std::nullopt;
+    return e;
+}
 
 /// Throws InvalidArgument on max_depth < 0, rr_start_depth < 1 or rr_max_survival outside (0, 1].
 inline void validate(const EstimatorOptions& opts) {

@@ -302,22 +302,16 @@ private:
     Status equiangular_vertex(const Sc& scene, const Ray& ray, const EquiangularSampler& eq, int depth,
                               const typename Sc::Spectrum& beta, const typename Sc::Spectral::Wavelengths& lambda,
                               R& rng, C& counter, typename Sc::Spectrum& L) const {
-        using M = typename Sc::MediumType;
-        using B = bound_policy_t<typename Sc::MajorantType>;
         const DistanceSample ds = eq.sample(rng.uniform());
         if (!(ds.pdf > 0.f)) return Status::Ok;
         const auto tr = track_ratio<A, St::combines>(scene.medium, scene.majorant, ray, ds.t, lambda, rng, counter);
         if (tr.end == SegmentEnd::Aborted || tr.end == SegmentEnd::Rejected) return flight_status(tr.end);
         if (tr.end == SegmentEnd::Terminated) return Status::Ok;
         const Vec3 x = ray.at(ds.t);
-        const float mu_bar = majorant_value_at_point<M>(scene.majorant, ray, ds.t, lambda);
-        counter.lookup();
-        auto c = scene.medium.coefficients(x, lambda);
-        if constexpr (std::is_same_v<B, bound::Clamp>) {
-            detail::clamp_to_majorant(c, mu_bar);
-        } else if constexpr (std::is_same_v<B, bound::Reject>) {
-            if (detail::exceeds_majorant(c, mu_bar)) return Status::Rejected;
-        }
+        const auto v = lookup_untracked(scene.medium, scene.majorant, ray, ds.t, lambda, counter);
+        if (!v) return Status::Rejected;
+        const auto& c = v->k;
+        const float mu_bar = v->mu;
         const typename Sc::Spectrum beta_eq = beta * tr.transmittance * c.sigma_s / ds.pdf;
         if (!(beta_eq != 0.f).any()) return Status::Ok;
         float track = 0.f, q = 1.f;  // p_track / p_eq of x; the roulette survival tracking would use at x
@@ -374,34 +368,20 @@ private:
     Status emission_event(const Sc& scene, const Vec3& x, const Vec3& wo, float survival,
                           const typename Sc::Spectral::Wavelengths& lambda, R& rng, C& counter,
                           const typename Sc::Spectrum& beta, typename Sc::Spectrum& L) const {
-        using M = typename Sc::MediumType;
-        using B = bound_policy_t<typename Sc::MajorantType>;
-        const float u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform(), u3 = rng.uniform();
-        const VolumeSample vs = scene.medium.sample_emission(u0, u1, u2, u3);
-        if (!(vs.pdf > 0.f)) return Status::Ok;
-        const Vec3 dv = vs.p - x;
-        const float d2 = glm::dot(dv, dv);
-        if (!(d2 > 0.f)) return Status::Ok;
-        const float d = std::sqrt(d2);
-        const Ray shadow{x, dv / d};
-        if (scene.lights.sphere_blocks(shadow, d)) return Status::Ok;
-        const auto tr = track_ratio<A, St::null_pdfs>(scene.medium, scene.majorant, shadow, d, lambda, rng, counter);
+        const auto e = sample_emission_from(scene.medium, scene.lights, x, rng);
+        if (!e) return Status::Ok;
+        const auto tr = track_ratio<A, St::null_pdfs>(scene.medium, scene.majorant, e->shadow, e->dist, lambda, rng, counter);
         if (tr.end == SegmentEnd::Aborted || tr.end == SegmentEnd::Rejected) return flight_status(tr.end);
         if (tr.end == SegmentEnd::Terminated) return Status::Ok;
-        counter.lookup();
-        auto c = scene.medium.coefficients(vs.p, lambda);
-        const float mu_bar = majorant_value_at_point<M>(scene.majorant, shadow, d, lambda);
-        if constexpr (std::is_same_v<B, bound::Clamp>) {
-            detail::clamp_to_majorant(c, mu_bar);
-        } else if constexpr (std::is_same_v<B, bound::Reject>) {
-            if (detail::exceeds_majorant(c, mu_bar)) return Status::Rejected;
-        }
-        const typename Sc::Spectrum le = scene.medium.emission(vs.p, lambda);
+        const auto v = lookup_untracked(scene.medium, scene.majorant, e->shadow, e->dist, lambda, counter);
+        if (!v) return Status::Rejected;
+        const typename Sc::Spectrum le = scene.medium.emission(e->y.p, lambda);
+        const Vec3& wi = e->shadow.d;
         float w = 1.f;
         if constexpr (St::combines)
-            w = heuristic_.weight(emission_collision_over_nee<St>(survival, scene.phase.pdf(wo, shadow.d),
-                                                                  tr.null_pdf_product, mu_bar, d2, vs.pdf));
-        L += beta * tr.transmittance * c.sigma_a * le * (w * scene.phase.eval(wo, shadow.d) / (d2 * vs.pdf));
+            w = heuristic_.weight(emission_collision_over_nee<St>(survival, scene.phase.pdf(wo, wi), tr.null_pdf_product,
+                                                                  v->mu, e->dist2, e->y.pdf));
+        L += beta * tr.transmittance * v->k.sigma_a * le * (w * scene.phase.eval(wo, wi) / (e->dist2 * e->y.pdf));
         return Status::Ok;
     }
 

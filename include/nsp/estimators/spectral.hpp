@@ -259,35 +259,21 @@ private:
     Status emission_event(const Sc& scene, const Vec3& x, const Vec3& wo, float rr,
                           const typename Sc::Spectral::Wavelengths& lambda, const typename Sc::Spectrum& q, int c,
                           const State& st, R& rng, C& counter, typename Sc::Spectrum& L) const {
-        using M = typename Sc::MediumType;
         using Spectrum = typename Sc::Spectrum;
-        using B = bound_policy_t<typename Sc::MajorantType>;
-        const float u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform(), u3 = rng.uniform();
-        const VolumeSample vs = scene.medium.sample_emission(u0, u1, u2, u3);
-        if (!(vs.pdf > 0.f)) return Status::Ok;
-        const Vec3 dv = vs.p - x;
-        const float d2 = glm::dot(dv, dv);
-        if (!(d2 > 0.f)) return Status::Ok;
-        const float d = std::sqrt(d2);
-        const Ray shadow{x, dv / d};
-        if (scene.lights.sphere_blocks(shadow, d)) return Status::Ok;
-        const auto sh = track_channels_ratio<CP, A>(scene.medium, scene.majorant, shadow, d, lambda, c, st.f,
+        const auto e = sample_emission_from(scene.medium, scene.lights, x, rng);
+        if (!e) return Status::Ok;
+        const auto sh = track_channels_ratio<CP, A>(scene.medium, scene.majorant, e->shadow, e->dist, lambda, c, st.f,
                                                     St::combines, rng, counter);
         if (sh.end == SegmentEnd::Aborted || sh.end == SegmentEnd::Rejected) return flight_status(sh.end);
         if (sh.end == SegmentEnd::Terminated) return Status::Ok;
-        counter.lookup();
-        auto k = scene.medium.coefficients(vs.p, lambda);
-        const auto mu_v = majorant_value_at_point<M>(scene.majorant, shadow, d, lambda);
-        if constexpr (std::is_same_v<B, bound::Clamp>) {
-            detail::clamp_to_majorant(k, mu_v);
-        } else if constexpr (std::is_same_v<B, bound::Reject>) {
-            if (detail::exceeds_majorant(k, mu_v)) return Status::Rejected;
-        }
-        const Spectrum le = scene.medium.emission(vs.p, lambda);
-        const Spectrum f = st.f * sh.f * k.sigma_a * le * scene.phase.eval(wo, shadow.d);
-        Spectrum pdf = sh.nee * (vs.pdf * d2);
+        const auto v = lookup_untracked(scene.medium, scene.majorant, e->shadow, e->dist, lambda, counter);
+        if (!v) return Status::Rejected;
+        const Vec3& wi = e->shadow.d;
+        const Spectrum le = scene.medium.emission(e->y.p, lambda);
+        const Spectrum f = st.f * sh.f * v->k.sigma_a * le * scene.phase.eval(wo, wi);
+        Spectrum pdf = sh.nee * (e->y.pdf * e->dist2);
         if constexpr (St::combines)
-            pdf += sh.uni * detail::broadcast_majorant<Spectrum>(mu_v) * (rr * scene.phase.pdf(wo, shadow.d));
+            pdf += sh.uni * detail::broadcast_majorant<Spectrum>(v->mu) * (rr * scene.phase.pdf(wo, wi));
         L += channel_estimate<CP, Spectrum>(f, Spectrum(st.uni * pdf), q, c);
         return Status::Ok;
     }
@@ -300,10 +286,8 @@ private:
     Status equiangular_vertex(const Sc& scene, const Ray& ray, const EquiangularSampler& eq, int depth,
                               const typename Sc::Spectral::Wavelengths& lambda, const typename Sc::Spectrum& q, int c,
                               const State& st, R& rng, C& counter, typename Sc::Spectrum& L) const {
-        using M = typename Sc::MediumType;
         using S = typename Sc::Spectral;
         using Spectrum = typename Sc::Spectrum;
-        using B = bound_policy_t<typename Sc::MajorantType>;
         const DistanceSample ds = eq.sample(rng.uniform());
         if (!(ds.pdf > 0.f)) return Status::Ok;
         const auto sh = track_channels_ratio<CP, A>(scene.medium, scene.majorant, ray, ds.t, lambda, c, st.f,
@@ -311,15 +295,11 @@ private:
         if (sh.end == SegmentEnd::Aborted || sh.end == SegmentEnd::Rejected) return flight_status(sh.end);
         if (sh.end == SegmentEnd::Terminated) return Status::Ok;
         const Vec3 x = ray.at(ds.t);
-        const auto mu_v = majorant_value_at_point<M>(scene.majorant, ray, ds.t, lambda);
+        const auto v = lookup_untracked(scene.medium, scene.majorant, ray, ds.t, lambda, counter);
+        if (!v) return Status::Rejected;
+        const auto& k = v->k;
+        const auto& mu_v = v->mu;
         const Spectrum mu = detail::broadcast_majorant<Spectrum>(mu_v);
-        counter.lookup();
-        auto k = scene.medium.coefficients(x, lambda);
-        if constexpr (std::is_same_v<B, bound::Clamp>) {
-            detail::clamp_to_majorant(k, mu_v);
-        } else if constexpr (std::is_same_v<B, bound::Reject>) {
-            if (detail::exceeds_majorant(k, mu_v)) return Status::Rejected;
-        }
         const Spectrum f_x = st.f * sh.f * k.sigma_s;
         if (!(f_x != 0.f).any()) return Status::Ok;
         const Spectrum p_eq = st.uni * sh.nee * ds.pdf;
