@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "majorants.hpp"
+#include "references.hpp"
 
 namespace {
 
@@ -105,18 +106,7 @@ TEST_CASE_TEMPLATE_DEFINE("emitting absorber with analytic optical depth = quadr
     const Emissive<M> medium(base, make_emission(Box{Vec3(-1.f, -0.8f, -1.2f), Vec3(0.9f, 1.f, 1.f)}, {5, 3, 4}, 1.f, 77),
                              le, {6, 5, 4});
     const Ray ray{Vec3(-3.f, 0.25f, -0.3f), glm::normalize(Vec3(1.f, -0.05f, 0.12f))};
-    const Interval in = box.clip(ray, 0.f, kInf);
-    std::array<double, 3> ref{};
-    const int n = 20000;
-    for (int i = 0; i <= n; ++i) {
-        const float t = in.t0 + (in.t1 - in.t0) * float(i) / float(n);
-        const auto tau = base.optical_depth(ray, 0.f, t);
-        const auto k = base.coefficients(ray.at(t), {});
-        const auto e = medium.emission(ray.at(t), {});
-        const double w = (i == 0 || i == n) ? 1.0 : (i % 2 ? 4.0 : 2.0);
-        for (int c = 0; c < S::channels; ++c) ref[c] += w * std::exp(-double(tau[c])) * double(k.sigma_a[c]) * double(e[c]);
-    }
-    for (double& r : ref) r *= double(in.t1 - in.t0) / (3.0 * n);
+    const auto ref = emitting_absorber_reference(base, medium, ray);
     auto run = [&](const auto& maj, const std::string& maj_name) {
         const auto scene = Scene(medium, maj, IsotropicPhase{}, Lights<S>{});
         check_all<C>(scene, ray, EstimatorOptions{}, 20000, 60, maj_name, [&](int c) { return ref[c]; });

@@ -6,7 +6,7 @@
 #include <string>
 #include <tuple>
 
-#include "equiangular.hpp"
+#include "references.hpp"
 #include "majorants.hpp"
 
 namespace {

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "majorants.hpp"
+#include "references.hpp"
 #include "spectral.hpp"
 
 namespace {
@@ -104,18 +105,7 @@ TEST_CASE_TEMPLATE_DEFINE("spectral emitting absorber = quadrature per channel",
                                                                      {5, 3, 4}, e),
                                                   spec<Rgb>(2.f, 1.f, 0.5f), {6, 5, 4});
     const Ray ray{Vec3(-3.f, 0.25f, -0.3f), glm::normalize(Vec3(1.f, -0.05f, 0.12f))};
-    const Interval in = kBox.clip(ray, 0.f, kInf);
-    std::array<double, 3> ref{};
-    const int n = 20000;
-    for (int i = 0; i <= n; ++i) {
-        const float t = in.t0 + (in.t1 - in.t0) * float(i) / float(n);
-        const auto tau = base.optical_depth(ray, 0.f, t);
-        const auto k = base.coefficients(ray.at(t), {});
-        const auto le = medium.emission(ray.at(t), {});
-        const double w = (i == 0 || i == n) ? 1.0 : (i % 2 ? 4.0 : 2.0);
-        for (int c = 0; c < 3; ++c) ref[std::size_t(c)] += w * std::exp(-double(tau[c])) * double(k.sigma_a[c]) * double(le[c]);
-    }
-    for (double& r : ref) r *= double(in.t1 - in.t0) / (3.0 * n);
+    const auto ref = emitting_absorber_reference(base, medium, ray);
     int seed = 500;
     for_each_majorant<typename E::Channels>(medium, [&](const auto& maj, const char* maj_name) {
         const auto scene = Scene(medium, maj, IsotropicPhase{}, Lights<Rgb>{});

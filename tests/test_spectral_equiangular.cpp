@@ -12,7 +12,7 @@
 #include <string>
 #include <tuple>
 
-#include "equiangular.hpp"
+#include "references.hpp"
 #include "majorants.hpp"
 #include "spectral.hpp"
 

@@ -1,4 +1,5 @@
-// tests/support/equiangular.hpp: the closed-form reference of the equiangular suites.
+// tests/support/references.hpp: closed-form references (by quadrature in double) of the
+// equiangular and emission suites.
 #pragma once
 
 #include <array>
@@ -39,6 +40,28 @@ inline std::array<double, 3> single_scatter_reference(const M& medium, const Ray
     }
     for (int c = 0; c < 3; ++c) sum[c] *= (th1 - th0) / (3.0 * n) * intensity / (4.0 * kPi);
     return sum;
+}
+
+/// Emission of a non-scattering medium along `ray`: L_c = int T_c(0, t) mu_a,c(t) L_e,c(t) dt over
+/// the part of the ray inside `base`'s box, with T from base's closed-form optical depth, by
+/// composite Simpson in double with 20000 intervals.
+template <class Base, class Emitting>
+inline std::array<double, 3> emitting_absorber_reference(const Base& base, const Emitting& medium, const Ray& ray) {
+    using S = typename Base::Spectral;
+    const Interval in = base.bounds().clip(ray, 0.f, kInf);
+    std::array<double, 3> ref{};
+    const int n = 20000;
+    for (int i = 0; i <= n; ++i) {
+        const float t = in.t0 + (in.t1 - in.t0) * float(i) / float(n);
+        const auto tau = base.optical_depth(ray, 0.f, t);
+        const auto k = base.coefficients(ray.at(t), {});
+        const auto e = medium.emission(ray.at(t), {});
+        const double w = (i == 0 || i == n) ? 1.0 : (i % 2 ? 4.0 : 2.0);
+        for (int c = 0; c < S::channels; ++c)
+            ref[std::size_t(c)] += w * std::exp(-double(tau[c])) * double(k.sigma_a[c]) * double(e[c]);
+    }
+    for (double& r : ref) r *= double(in.t1 - in.t0) / (3.0 * n);
+    return ref;
 }
 
 }  // namespace nsp_test
