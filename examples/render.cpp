@@ -1363,7 +1363,7 @@ void list_combinations() {
                 "policies with grid too and are compiled for nsp::PathEstimator in mono only (build time; the "
                 "library also has them in nsp::SpectralPathEstimator). Medium 'emissive' (the plume scene's flame, "
                 "nsp::Emissive): nsp::PathEstimator in rgb with global or grid, absorb-weight, without the "
-                "equiangular strategies. Independent and spectral-mis rows are rendered once per --selection rule "
+                "equiangular strategies (build time; nsp::SpectralPathEstimator takes emissive media too). Independent and spectral-mis rows are rendered once per --selection rule "
                 "(luminance rows end in _lum).\n", total);
 }
 
