@@ -3,8 +3,8 @@
 // density lookups per sample. Camera rays are pre-generated (fixtures.hpp) and cycled; Hero<4>
 // draws each sample's wavelengths from the benchmark's generator.
 //
-// The 60 combinations are the Cartesian product of four type lists, registered by a fold at
-// start-up (the BENCHMARK_TEMPLATE idea without 60 hand-written lines); names come from the
+// The 84 combinations are the Cartesian product of four type lists, registered by a fold at
+// start-up (the BENCHMARK_TEMPLATE idea without 84 hand-written lines); names come from the
 // policies' own `name`s: BM_Radiance/<strategy[:heuristic]>/<absorption>/<mode>/<set-up>.
 // The timed loop counts with LookupCount (one integer increment per lookup); the BM_CountCost
 // pair shows that this costs nothing measurable.
@@ -34,7 +34,8 @@ struct List {};
 using Kinds = List<Kind<nsp::strategy::Unidirectional>, Kind<nsp::strategy::NextEvent>,
                    Kind<nsp::strategy::DirectionalMis, nsp::mis::Balance>,
                    Kind<nsp::strategy::NullScatteringMis, nsp::mis::Balance>,
-                   Kind<nsp::strategy::NullScatteringMis, nsp::mis::Power>>;
+                   Kind<nsp::strategy::NullScatteringMis, nsp::mis::Power>,
+                   Kind<nsp::strategy::EquiangularNextEvent>, Kind<nsp::strategy::EquiangularMis, nsp::mis::Balance>>;
 using Absorptions = List<nsp::absorption::Event, nsp::absorption::Weight>;
 using Modes = List<nsp::Mono, nsp::Rgb, Hero4>;
 
