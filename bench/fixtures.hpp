@@ -21,7 +21,8 @@ inline constexpr std::size_t kSetSize = std::size_t(1) << 14;
 inline constexpr std::size_t kSetMask = kSetSize - 1;
 
 /// Minimum time of one repetition of one benchmark, in seconds: with 5 repetitions the main run
-/// of bench/run.sh (148 benchmarks) takes about three and a half minutes on 2 cores.
+/// of bench/run.sh took about three and a half minutes on 2 cores with 148 benchmarks; issue 7's
+/// equiangular and emission rows make it 184 (about a minute more).
 inline constexpr double kMinTime = 0.2;
 
 /// Far end of every tracked segment: past the cloud's box from any ray origin used here.
