@@ -2,9 +2,12 @@
 # Fresh-machine command 1: set up, build nsp_render (only that target: the tests and benchmarks
 # are run-tests.sh's business), and run the main job. Without arguments:
 #  1. nsp_render's default run: the grey cloud (set-ups A, B) with every estimator, the
-#     chromatic cloud (set-ups C1, C2, rgb and hero, 32x32) with the spectral estimators, and the
+#     chromatic cloud (set-ups C1, C2, rgb and hero, 32x32) with the spectral estimators, the
 #     sparse medium (set-up SA, mono, 64x64, 256 spp) with each grey strategy under the global
-#     and the grid majorant; EXRs in ./out, one efficiency table per set-up and mode;
+#     and the grid majorant, the fog lit by a lamp (set-ups F1, F2, F3, mono, 64x64) with
+#     tracking + NEE, equiangular + NEE and their three-way MIS, and the flame in the plume
+#     (set-up P1, rgb, 64x64) with the collision estimator, emission NEE and their MIS, each under
+#     the global and the grid majorant; EXRs in ./out, one efficiency table per set-up and mode;
 #  2. the heavy-tail comparison: the grey-majorant baseline against spectral MIS + NEE (per-channel
 #     and global majorant, uniform selection) on the chromatic cloud, 3 runs each at 32x32. The
 #     baseline's variance is practically infinite: in a typical run it misses the rare huge
@@ -12,8 +15,12 @@
 #     var/spl cannot rank it. --reference-spp 2048 therefore first renders a reference image per
 #     set-up and mode with a third, finite-variance estimator (spectral tracking + NEE, other
 #     seeds) and reports each run's effective variance per sample: spp x the mean squared
-#     error against the reference, minus the reference's own noise.
-# Renders in about 200 s on 2 cores (measured 2026-11-30, build up to date).
+#     error against the reference, minus the reference's own noise;
+#  3. the same for the two new heavy-tailed set-ups, F1 (tracking + NEE near a lamp inside the
+#     fog: a 1/r^2 tail) and P1 (the collision estimator rarely reaches the flame): 3 runs each,
+#     2048-spp references (fog: uni-nee-eq-mis_balance_absorb-event; plume:
+#     directional-mis_grid_balance_absorb-weight), time x variance from the effective variance.
+# Renders in about 280 s on 2 cores (measured 2026-11-30 at ecb55af, build up to date).
 # With arguments, runs nsp_render once with them instead (see build/examples/nsp_render --help).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -31,5 +38,8 @@ echo "majorant), 3 runs, effective variance against a 2048-spp reference"
 build/examples/nsp_render --scene chromatic --runs 3 --res 32x32 --spp 128 --no-exr \
     --reference-spp 2048 --selection uniform \
     --estimators uni-nee-mis_grey_balance_absorb-weight,uni-nee-mis_spectral-mis_absorb-weight
+echo
+echo "Lamp in fog (F1) and flame in smoke (P1): 3 runs, effective variance against 2048-spp references"
+build/examples/nsp_render --scene fog,plume --setup F1,P1 --runs 3 --reference-spp 2048 --no-exr
 echo
 echo "main job: $((SECONDS - start)) s of rendering"
