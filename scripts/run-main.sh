@@ -20,7 +20,7 @@
 #     fog: a 1/r^2 tail) and P1 (the collision estimator rarely reaches the flame): 3 runs each,
 #     2048-spp references (fog: uni-nee-eq-mis_balance_absorb-event; plume:
 #     directional-mis_grid_balance_absorb-weight), time x variance from the effective variance.
-# Renders in about 280 s on 2 cores (measured 2026-11-30 at ecb55af, build up to date).
+# Renders in about 250 s on 2 cores (measured 2026-11-30 at ecb55af, build up to date).
 # With arguments, runs nsp_render once with them instead (see build/examples/nsp_render --help).
 set -euo pipefail
 cd "$(dirname "$0")/.."
