@@ -128,6 +128,9 @@ public:
     /// The largest value over the range (what a majorant must bound).
     float max_value() const noexcept { return max_; }
 
+    /// The value of table entry k (0 <= k < kSize), at wavelength kLambdaMin + k kStep.
+    float operator[](int k) const noexcept { return v_[std::size_t(k)]; }
+
     /// The sum of two spectra, wavelength by wavelength.
     friend TabulatedSpectrum operator+(const TabulatedSpectrum& a, const TabulatedSpectrum& b) noexcept {
         TabulatedSpectrum s;

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <concepts>
 #include <cstddef>
+#include <limits>
 #include <utility>
 #include <vector>
 
@@ -50,8 +51,9 @@ concept EmissiveMedium = Medium<M> &&
 /// at index x + nx * (y + ny * z). Read-only after construction.
 class EmissionGrid {
 public:
-    /// Throws InvalidArgument on an empty or non-finite box, a resolution below 1, an empty grid,
-    /// a size that does not match `resolution`, or a negative or non-finite value.
+    /// Throws InvalidArgument on an empty or non-finite box, a resolution below 1 (or with more
+    /// voxels than a vector holds), an empty grid, a size that does not match `resolution`, or a
+    /// negative or non-finite value.
     EmissionGrid(const Box& bounds, std::array<int, 3> resolution, std::vector<float> values)
         : bounds_(bounds), res_(resolution), values_(std::move(values)) {
         detail::require_box(bounds, "EmissionGrid bounds");
@@ -59,7 +61,7 @@ public:
             if (res_[a] < 1)
                 detail::fail("EmissionGrid resolution[", a, "] = ", res_[a],
                              " is not allowed: every axis needs at least 1 voxel");
-        const std::size_t n = std::size_t(res_[0]) * std::size_t(res_[1]) * std::size_t(res_[2]);
+        const std::size_t n = detail::voxel_count(res_, values_.max_size(), "EmissionGrid");
         if (values_.empty()) detail::fail("EmissionGrid: the value grid is empty");
         if (values_.size() != n)
             detail::fail("EmissionGrid: ", values_.size(), " values given, but resolution ", res_[0], "x",
@@ -136,14 +138,19 @@ public:
     using Wavelengths = typename Spectral::Wavelengths;
     using Coefficient = typename Spectral::Coefficient;
 
-    /// Throws InvalidArgument on a negative or non-finite radiance_scale channel, a
-    /// power_resolution outside [1, 256] on some axis, or a power grid whose cells are too thin to
-    /// be told apart in float.
+    /// Throws InvalidArgument on a negative or non-finite radiance_scale channel, a largest
+    /// emission (grid max x radiance_scale max) that overflows, a power_resolution outside
+    /// [1, 256] on some axis, or a power grid whose cells are too thin to be told apart in float.
     Emissive(M medium, EmissionGrid emission, const Coefficient& radiance_scale,
              std::array<int, 3> power_resolution = {16, 16, 16})
         : medium_(std::move(medium)), emission_(std::move(emission)), radiance_scale_(radiance_scale),
           res_(power_resolution) {
         detail::require_coefficient(radiance_scale_, "Emissive radiance_scale");
+        const float le_max = emission_.max_value() * max_value(radiance_scale_);
+        if (!std::isfinite(le_max))
+            detail::fail("Emissive: the largest emission L_e = emission grid max ", emission_.max_value(),
+                         " x radiance_scale max ", max_value(radiance_scale_), " = ", le_max,
+                         " is not allowed: it must be finite (at most ", std::numeric_limits<float>::max(), ")");
         for (int a = 0; a < 3; ++a)
             if (res_[a] < 1 || res_[a] > 256)
                 detail::fail("Emissive power_resolution[", a, "] = ", res_[a],

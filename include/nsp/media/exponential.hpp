@@ -22,8 +22,9 @@ public:
     using Spectrum = typename S::Spectrum;
     using Coefficient = typename S::Coefficient;  ///< how coefficients are given (a tabulated spectrum in Hero mode)
 
-    /// Throws InvalidArgument on non-finite or negative d0 or scales, non-finite k, a zero axis or
-    /// an empty box. `axis` is normalised.
+    /// Throws InvalidArgument on non-finite or negative d0 or scales, non-finite k, a zero or
+    /// non-finite axis, an empty or non-finite box, or a density or extinction bound that
+    /// overflows. `axis` is normalised.
     ExponentialMedium(const Box& bounds, const Vec3& axis, float d0, float k,
                       const Coefficient& sigma_a_scale, const Coefficient& sigma_s_scale)
         : bounds_(bounds), d0_(d0), k_(k), sigma_a_(sigma_a_scale), sigma_s_(sigma_s_scale) {
@@ -49,6 +50,8 @@ public:
         if (!std::isfinite(max_density_))
             detail::fail("ExponentialMedium: d0 * exp(k * s) overflows inside the box (k = ", k,
                          "); choose a smaller |k| or box");
+        detail::require_finite_extinction(max_extinction(),
+                                          "ExponentialMedium extinction bound max(sigma_a_scale + sigma_s_scale) x max density");
     }
 
     Box bounds() const noexcept { return bounds_; }

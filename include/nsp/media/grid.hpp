@@ -89,7 +89,8 @@ public:
     using Coefficient = typename S::Coefficient;  ///< how coefficients are given (a tabulated spectrum in Hero mode)
 
     /// Throws InvalidArgument on an empty grid, a size that does not match `resolution`, a
-    /// negative or non-finite density or scale, or an empty box.
+    /// negative or non-finite density or scale, an extinction bound that overflows, or an empty or
+    /// non-finite box.
     DenseGridMedium(const Box& bounds, std::array<int, 3> resolution, std::vector<float> density,
                     const Coefficient& sigma_a_scale, const Coefficient& sigma_s_scale)
         : bounds_(bounds), res_(resolution), density_(std::move(density)),
@@ -99,7 +100,7 @@ public:
             if (res_[a] < 1)
                 detail::fail("DenseGridMedium resolution[", a, "] = ", res_[a],
                              " is not allowed: every axis needs at least 1 voxel");
-        const std::size_t n = std::size_t(res_[0]) * std::size_t(res_[1]) * std::size_t(res_[2]);
+        const std::size_t n = detail::voxel_count(res_, density_.max_size(), "DenseGridMedium");
         if (density_.empty()) detail::fail("DenseGridMedium: the density grid is empty");
         if (density_.size() != n)
             detail::fail("DenseGridMedium: ", density_.size(), " densities given, but resolution ",
@@ -111,6 +112,8 @@ public:
         detail::require_coefficient(sigma_a_, "DenseGridMedium sigma_a_scale");
         detail::require_coefficient(sigma_s_, "DenseGridMedium sigma_s_scale");
         max_density_ = *std::max_element(density_.begin(), density_.end());
+        detail::require_finite_extinction(max_extinction(),
+                                          "DenseGridMedium extinction bound max(sigma_a_scale + sigma_s_scale) x max density");
         inv_extent_ = 1.f / (bounds_.hi - bounds_.lo);
     }
 

@@ -15,12 +15,14 @@ public:
     using Spectrum = typename S::Spectrum;
     using Coefficient = typename S::Coefficient;  ///< how coefficients are given (a tabulated spectrum in Hero mode)
 
-    /// Throws InvalidArgument if a coefficient is negative or non-finite or the box is empty.
+    /// Throws InvalidArgument if a coefficient is negative or non-finite, their sum overflows, or
+    /// the box is empty or not finite.
     HomogeneousMedium(const Box& bounds, const Coefficient& sigma_a, const Coefficient& sigma_s)
         : bounds_(bounds), sigma_a_(sigma_a), sigma_s_(sigma_s) {
         detail::require_box(bounds, "HomogeneousMedium bounds");
         detail::require_coefficient(sigma_a, "HomogeneousMedium sigma_a");
         detail::require_coefficient(sigma_s, "HomogeneousMedium sigma_s");
+        detail::require_finite_extinction(max_extinction(), "HomogeneousMedium extinction bound max(sigma_a + sigma_s)");
     }
 
     Box bounds() const noexcept { return bounds_; }
