@@ -134,7 +134,20 @@ public:
         if (n > (std::size_t(1) << 28))
             fail(what, " resolution ", res[0], "x", res[1], "x", res[2], " has ", n,
                  " cells; at most 2^28 are allowed");
-        for (int a = 0; a < 3; ++a) cell_[a] = (box_.hi[a] - box_.lo[a]) / float(res[a]);
+        // A host medium's bounds are not validated by nsp: the DDA divides by the cell size.
+        for (int a = 0; a < 3; ++a) {
+            if (!std::isfinite(box_.lo[a]) || !std::isfinite(box_.hi[a]) || !(box_.lo[a] < box_.hi[a]))
+                fail(what, ": the medium's bounds on axis ", a, " are [", box_.lo[a], ", ", box_.hi[a],
+                     "]; they must be finite with lo < hi");
+            cell_[a] = (box_.hi[a] - box_.lo[a]) / float(res[a]);
+            if (!std::isfinite(cell_[a]) || !(cell_[a] > 0.f))
+                fail(what, " cell size on axis ", a, " = ", cell_[a], " (bounds [", box_.lo[a], ", ", box_.hi[a],
+                     "] over resolution[", a, "] = ", res[a], ") is not allowed: it must be finite and > 0");
+        }
+        const float unit = max_value(medium.extinction_per_density());
+        if (!std::isfinite(unit) || unit < 0.f)
+            fail(what, ": the medium's largest extinction per unit density = ", unit,
+                 " is not allowed: it must be finite and >= 0");
         values_.resize(n);
         const float pad = kGridMajorantPad * scale;
         std::size_t i = 0;
@@ -150,6 +163,15 @@ public:
                     const float d = medium.density_bound(region);
                     require_finite_nonnegative(d, "the medium's density bound of a majorant cell");
                     values_[i] = d * pad;
+                    // The policy's majorant must stay finite, and > 0 wherever the density may be.
+                    if (!std::isfinite(values_[i] * unit))
+                        fail(what, " cell (", x, ", ", y, ", ", z, ") majorant = density bound ", d, " x scale ",
+                             scale, " x extinction per density ", unit, " = ", values_[i] * unit,
+                             " is not allowed: it must be finite");
+                    if (d > 0.f && unit > 0.f && !(values_[i] * unit > 0.f))
+                        fail(what, " cell (", x, ", ", y, ", ", z, ") majorant = density bound ", d, " x scale ",
+                             scale, " x extinction per density ", unit, " rounds to 0 where the density "
+                             "is not 0; it must be > 0 (no collision would be sampled there)");
                 }
     }
 
@@ -223,7 +245,8 @@ public:
     using Bound = B;
 
     /// Throws InvalidArgument on a resolution outside [1, 4096] per axis (2^28 cells in all), a
-    /// scale the policy does not allow, or a medium whose bounds are not finite.
+    /// scale the policy does not allow, a medium whose bounds are not finite, or a cell majorant
+    /// that overflows, or rounds to 0 where the density is not 0.
     GridMajorant(const M& medium, std::array<int, 3> resolution, float scale = 1.f)
         : grid_(medium, resolution, detail::require_majorant_scale<B>(scale, "GridMajorant scale"), "GridMajorant"),
           unit_(max_value(medium.extinction_per_density())) {}
