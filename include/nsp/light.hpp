@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cmath>
+#include <limits>
 #include <optional>
 
 #include "core/error.hpp"
@@ -64,11 +65,15 @@ public:
         point_ = l;
         return *this;
     }
-    /// Sets the sphere light; throws InvalidArgument on a bad centre, radius or radiance.
+    /// Sets the sphere light; throws InvalidArgument on a non-finite centre, a radius that is not
+    /// finite and > 0 (or whose square overflows), or a bad radiance.
     Lights& set(const SphereLight<S>& l) {
         for (int a = 0; a < 3; ++a) detail::require_finite(l.center[a], "SphereLight center");
         if (!std::isfinite(l.radius) || !(l.radius > 0.f))
             detail::fail("SphereLight radius = ", l.radius, " is not allowed: it must be finite and > 0");
+        if (!std::isfinite(l.radius * l.radius))
+            detail::fail("SphereLight radius = ", l.radius, " is not allowed: radius^2 must be finite (radius <= ",
+                         std::sqrt(std::numeric_limits<float>::max()), ")");
         detail::require_coefficient(l.radiance, "SphereLight radiance");
         sphere_ = l;
         return *this;

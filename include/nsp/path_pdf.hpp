@@ -93,14 +93,21 @@ public:
     ChannelSelection() : q_(Spectrum::Constant(1.f / float(S::channels))) { build_cdf(); }
 
     /// Selection proportional to `weights`. Throws InvalidArgument unless every weight is finite
-    /// and > 0: a channel that is never chosen would not be estimated at all by independent
+    /// and > 0, their sum is finite and no probability rounds to 0: a channel that is never chosen would not be estimated at all by independent
     /// tracking, and spectral MIS would estimate it from the other channels' pdfs alone.
     explicit ChannelSelection(const Spectrum& weights) {
         for (int c = 0; c < S::channels; ++c)
             if (!std::isfinite(weights[c]) || !(weights[c] > 0.f))
                 detail::fail("ChannelSelection weight[", c, "] = ", weights[c],
                              " is not allowed: every channel needs a finite weight > 0");
-        q_ = weights / weights.sum();
+        const float sum = weights.sum();
+        if (!std::isfinite(sum))
+            detail::fail("ChannelSelection weights sum to ", sum, ", which is not allowed: the sum must be finite");
+        q_ = weights / sum;
+        for (int c = 0; c < S::channels; ++c)
+            if (!(q_[c] > 0.f))
+                detail::fail("ChannelSelection weight[", c, "] = ", weights[c], " is not allowed: its probability ",
+                             weights[c], " / ", sum, " rounds to 0; every channel needs a probability > 0");
         build_cdf();
     }
 
