@@ -168,10 +168,10 @@ public:
                         fail(what, " cell (", x, ", ", y, ", ", z, ") majorant = density bound ", d, " x scale ",
                              scale, " x extinction per density ", unit, " = ", values_[i] * unit,
                              " is not allowed: it must be finite");
-                    if (d > 0.f && unit > 0.f && !(values_[i] * unit > 0.f))
+                    if (d * unit > 0.f && !(values_[i] * unit > 0.f))
                         fail(what, " cell (", x, ", ", y, ", ", z, ") majorant = density bound ", d, " x scale ",
-                             scale, " x extinction per density ", unit, " rounds to 0 where the density "
-                             "is not 0; it must be > 0 (no collision would be sampled there)");
+                             scale, " x extinction per density ", unit, " rounds to 0 where the extinction may be ",
+                             d * unit, "; it must be > 0 there (no collision would be sampled)");
                 }
     }
 

@@ -62,7 +62,9 @@ public:
                 detail::fail("EmissionGrid resolution[", a, "] = ", res_[a],
                              " is not allowed: every axis needs at least 1 voxel");
         const std::size_t n = detail::voxel_count(res_, values_.max_size(), "EmissionGrid");
-        if (values_.empty()) detail::fail("EmissionGrid: the value grid is empty");
+        if (values_.empty())
+            detail::fail("EmissionGrid: the value grid is empty; resolution ", res_[0], "x", res_[1], "x", res_[2],
+                         " needs ", n, " values");
         if (values_.size() != n)
             detail::fail("EmissionGrid: ", values_.size(), " values given, but resolution ", res_[0], "x",
                          res_[1], "x", res_[2], " needs ", n);
@@ -311,7 +313,8 @@ private:
         inv_cell_volume_ = 1.f / (cell_[0] * cell_[1] * cell_[2]);
         if (!std::isfinite(inv_cell_volume_))
             detail::fail("Emissive: the power grid's cells have volume ", cell_[0] * cell_[1] * cell_[2],
-                         ", too small for a float pdf; choose a lower power_resolution");
+                         ", too small for a float pdf: 1 / volume must be finite; choose a lower power_resolution "
+                         "or a larger box");
 
         // Step 1: per cell, the estimate (mean of the sub-point values) and whether it may emit.
         const std::size_t n = std::size_t(res_[0]) * std::size_t(res_[1]) * std::size_t(res_[2]);

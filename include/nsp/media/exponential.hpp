@@ -48,8 +48,8 @@ public:
         }
         max_density_ = d0_ * std::max(std::exp(k_ * smax), std::exp(k_ * smin));
         if (!std::isfinite(max_density_))
-            detail::fail("ExponentialMedium: d0 * exp(k * s) overflows inside the box (k = ", k,
-                         "); choose a smaller |k| or box");
+            detail::fail("ExponentialMedium: the largest density d0 * exp(k * s) in the box (d0 = ", d0, ", k = ", k,
+                         ") overflows float; it must be finite: choose a smaller d0, |k| or box");
         detail::require_finite_extinction(max_extinction(),
                                           "ExponentialMedium extinction bound max(sigma_a_scale + sigma_s_scale) x max density");
     }

@@ -101,7 +101,9 @@ public:
                 detail::fail("DenseGridMedium resolution[", a, "] = ", res_[a],
                              " is not allowed: every axis needs at least 1 voxel");
         const std::size_t n = detail::voxel_count(res_, density_.max_size(), "DenseGridMedium");
-        if (density_.empty()) detail::fail("DenseGridMedium: the density grid is empty");
+        if (density_.empty())
+            detail::fail("DenseGridMedium: the density grid is empty; resolution ", res_[0], "x", res_[1], "x",
+                         res_[2], " needs ", n, " densities");
         if (density_.size() != n)
             detail::fail("DenseGridMedium: ", density_.size(), " densities given, but resolution ",
                          res_[0], "x", res_[1], "x", res_[2], " needs ", n);

@@ -52,7 +52,8 @@ inline std::size_t voxel_count(const std::array<int, 3>& res, std::size_t max, c
 inline void require_box(const Box& b, const char* what) {
     for (int a = 0; a < 3; ++a) {
         if (!std::isfinite(b.lo[a]) || !std::isfinite(b.hi[a]))
-            fail(what, " has a non-finite corner on axis ", a, ": [", b.lo[a], ", ", b.hi[a], "]");
+            fail(what, " has a non-finite corner on axis ", a, ": [", b.lo[a], ", ", b.hi[a],
+                 "]; corners must be finite");
         if (!(b.lo[a] < b.hi[a]))
             fail(what, " is empty on axis ", a, ": lo = ", b.lo[a], " must be < hi = ", b.hi[a]);
         // Lookups divide by the extent: it and its reciprocal must be finite floats.
