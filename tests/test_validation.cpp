@@ -343,6 +343,30 @@ TEST_CASE("majorants reject a host medium's non-finite bounds, extinction or den
     CHECK_NOTHROW(GridMajorant<HostMedium>(HostMedium{}, 2));
 }
 
+TEST_CASE_TEMPLATE("Scene rejects a global majorant its bound policy forbids for the scene's medium", B,
+                   bound::Guaranteed, bound::Signed, bound::Clamp, bound::Reject) {
+    // A majorant built for a thinner medium (bound 1.5) paired with one of bound 3.
+    using H = HomogeneousMedium<Rgb>;
+    const H thin(kUnitBox, grey<Rgb>(0.5f), grey<Rgb>(1.f)), dense(kUnitBox, grey<Rgb>(1.f), grey<Rgb>(2.f));
+    const H empty(kUnitBox, grey<Rgb>(0.f), grey<Rgb>(0.f));
+    using Sc = Scene<H, GlobalMajorant<H, B>, IsotropicPhase>;
+    CAPTURE(B::name);
+    if constexpr (B::allows_below) {
+        CHECK_NOTHROW(Sc(dense, GlobalMajorant<H, B>(thin), IsotropicPhase{}, Lights<Rgb>{}));
+        CHECK_THROWS_WITH_AS(Sc(dense, GlobalMajorant<H, B>(empty, 0.f), IsotropicPhase{}, Lights<Rgb>{}),
+                             Contains("Scene: the majorant value = 0 is not allowed for a medium with extinction bound 3 "
+                                      "of the scene's medium: no collision would ever be sampled; it must be > 0"),
+                             InvalidArgument);
+    } else {
+        CHECK_THROWS_WITH_AS(Sc(dense, GlobalMajorant<H, B>(thin), IsotropicPhase{}, Lights<Rgb>{}),
+                             Contains("Scene: the majorant value = 1.5 is below the medium's extinction bound 3 of the "
+                                      "scene's medium; bound::Guaranteed requires mu_bar >= mu_t everywhere"),
+                             InvalidArgument);
+    }
+    CHECK_NOTHROW(Sc(dense, GlobalMajorant<H, B>(dense), IsotropicPhase{}, Lights<Rgb>{}));
+    CHECK_NOTHROW(Sc(thin, GlobalMajorant<H, B>(dense), IsotropicPhase{}, Lights<Rgb>{}));
+}
+
 // ---------------------------------------------------------------------------------------------
 // Lights and channel selection
 

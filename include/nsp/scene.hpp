@@ -2,6 +2,7 @@
 // and the lights, composed at compile time.
 #pragma once
 
+#include <concepts>
 #include <utility>
 
 #include "light.hpp"
@@ -25,9 +26,14 @@ struct Scene {
     P phase;
     Lights<Spectral> lights;
 
-    /// Throws InvalidArgument if the sphere light overlaps the medium's bounds.
+    /// Throws InvalidArgument if the sphere light overlaps the medium's bounds, or if a majorant
+    /// with one value (GlobalMajorant) has a value its bound policy forbids for this medium (e.g. one
+    /// built for another, less dense medium under bound::Guaranteed).
     Scene(M m, Maj maj, P p, Lights<Spectral> l)
         : medium(std::move(m)), majorant(std::move(maj)), phase(std::move(p)), lights(std::move(l)) {
+        if constexpr (requires(const Maj& j) { { j.value() } -> std::convertible_to<float>; })
+            detail::require_majorant_value<bound_policy_t<Maj>>(majorant.value(), medium.max_extinction(),
+                                                                "Scene: the majorant value", " of the scene's medium");
         if (const auto& s = lights.sphere()) {
             const Box b = medium.bounds();
             const Vec3 nearest = glm::clamp(s->center, b.lo, b.hi);
