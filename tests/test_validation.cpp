@@ -270,8 +270,8 @@ TEST_CASE("majorants reject a bound or cell value that overflows float") {
     // Extinction bound 2e38 is finite; twice it is not.
     const Grid dense(kUnitBox, {1, 1, 1}, {1e38f}, grey<Rgb>(1.f), grey<Rgb>(1.f));
     CHECK_THROWS_WITH_AS(ChannelMajorant<Grid>(dense, 2.f),
-                         Contains("ChannelMajorant: the medium's extinction bound x scale = inf is not allowed: it must be "
-                                  "finite and >= 0"),
+                         Contains("ChannelMajorant: the medium's extinction bound x scale[channel 0] = inf is not allowed: "
+                                  "coefficients must be finite and >= 0"),
                          InvalidArgument);
     CHECK_THROWS_WITH_AS(GridMajorant<Grid>(dense, 1, 2.f),
                          Contains("GridMajorant cell (0, 0, 0) majorant = density bound 1e+38 x scale 2 x extinction per "
@@ -337,8 +337,8 @@ TEST_CASE("majorants reject a host medium's non-finite bounds, extinction or den
     HostMedium nan_coefficient;
     nan_coefficient.per_density = kNaN;
     CHECK_THROWS_WITH_AS(GridMajorant<HostMedium>(nan_coefficient, 2),
-                         Contains("GridMajorant: the medium's largest extinction per unit density = nan is not allowed: "
-                                  "it must be finite and >= 0"),
+                         Contains("GridMajorant: the medium's extinction per unit density[channel 0] = nan is not allowed: "
+                                  "coefficients must be finite and >= 0"),
                          InvalidArgument);
     CHECK_NOTHROW(GridMajorant<HostMedium>(HostMedium{}, 2));
 }

@@ -15,6 +15,7 @@
 #include <type_traits>
 
 #include "core/error.hpp"
+#include "media/validate.hpp"
 #include "medium.hpp"
 
 namespace nsp {
@@ -266,7 +267,7 @@ public:
         : bounds_(medium.bounds()),
           bound_(nsp::scale(medium.extinction_bound_coefficient(),
                             detail::require_majorant_scale<B>(scale, "ChannelMajorant scale"))) {
-        detail::require_finite_nonnegative(max_value(bound_), "ChannelMajorant: the medium's extinction bound x scale");
+        detail::require_coefficient(bound_, "ChannelMajorant: the medium's extinction bound x scale");
     }
 
     /// The per-channel values at wavelengths l.

@@ -15,10 +15,12 @@
 #include <cstdint>
 #include <limits>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "../core/error.hpp"
 #include "../majorant.hpp"
+#include "../media/validate.hpp"
 #include "../medium.hpp"
 
 namespace nsp {
@@ -144,10 +146,9 @@ public:
                 fail(what, " cell size on axis ", a, " = ", cell_[a], " (bounds [", box_.lo[a], ", ", box_.hi[a],
                      "] over resolution[", a, "] = ", res[a], ") is not allowed: it must be finite and > 0");
         }
+        require_coefficient(medium.extinction_per_density(),
+                            (std::string(what) + ": the medium's extinction per unit density").c_str());
         const float unit = max_value(medium.extinction_per_density());
-        if (!std::isfinite(unit) || unit < 0.f)
-            fail(what, ": the medium's largest extinction per unit density = ", unit,
-                 " is not allowed: it must be finite and >= 0");
         values_.resize(n);
         const float pad = kGridMajorantPad * scale;
         std::size_t i = 0;
