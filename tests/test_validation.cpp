@@ -313,8 +313,8 @@ TEST_CASE("majorants reject a host medium's non-finite bounds, extinction or den
                                   "and >= 0"),
                          InvalidArgument);
     CHECK_THROWS_WITH_AS(GridMajorant<HostMedium>(inf_extinction, 2),
-                         Contains("the medium's density bound of a majorant cell = inf is not allowed: it must be finite "
-                                  "and >= 0"),
+                         Contains("GridMajorant cell (0, 0, 0): the medium's density bound = inf is not allowed: it must "
+                                  "be finite and >= 0"),
                          InvalidArgument);
 
     HostMedium open;

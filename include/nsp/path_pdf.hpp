@@ -93,8 +93,9 @@ public:
     ChannelSelection() : q_(Spectrum::Constant(1.f / float(S::channels))) { build_cdf(); }
 
     /// Selection proportional to `weights`. Throws InvalidArgument unless every weight is finite
-    /// and > 0, their sum is finite and no probability rounds to 0: a channel that is never chosen would not be estimated at all by independent
-    /// tracking, and spectral MIS would estimate it from the other channels' pdfs alone.
+    /// and > 0, their sum is finite and no probability rounds to 0: a channel that is never chosen
+    /// would not be estimated at all by independent tracking, and spectral MIS would estimate it
+    /// from the other channels' pdfs alone.
     explicit ChannelSelection(const Spectrum& weights) {
         for (int c = 0; c < S::channels; ++c)
             if (!std::isfinite(weights[c]) || !(weights[c] > 0.f))

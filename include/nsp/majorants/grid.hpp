@@ -162,7 +162,9 @@ public:
                         region.hi[a] = c[a] + 1 == res[a] ? box_.hi[a] : box_.lo[a] + float(c[a] + 1) * cell_[a];
                     }
                     const float d = medium.density_bound(region);
-                    require_finite_nonnegative(d, "the medium's density bound of a majorant cell");
+                    if (!std::isfinite(d) || d < 0.f)
+                        fail(what, " cell (", x, ", ", y, ", ", z, "): the medium's density bound = ", d,
+                             " is not allowed: it must be finite and >= 0");
                     values_[i] = d * pad;
                     // The policy's majorant must stay finite, and > 0 wherever the density may be.
                     if (!std::isfinite(values_[i] * unit))

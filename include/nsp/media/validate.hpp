@@ -1,4 +1,4 @@
-// nsp/media/validate.hpp: input checks shared by the media constructors.
+// nsp/media/validate.hpp: input checks shared by the constructors of media, lights and majorants.
 #pragma once
 
 #include <array>
