@@ -1,0 +1,76 @@
+#!/usr/bin/env bash
+# Builds the libFuzzer target nsp_fuzz_kernels (tests/fuzz, issue 8) with clang into ./build-fuzz
+# and runs it, one process, for NSP_FUZZ_SECONDS (default 120) over a scratch copy of
+# tests/fuzz/corpus, so a CI run leaves the checkout clean. Any crash (a broken invariant, a
+# sanitizer report, a timeout) fails the run; the input is left in the scratch directory's
+# artifacts/ and printed in base64. Installs clang and libclang-rt-dev if missing (root or sudo).
+# usage: scripts/run-fuzz.sh                  fuzz for NSP_FUZZ_SECONDS
+#        scripts/run-fuzz.sh --update-corpus  fuzz, then merge what it found into tests/fuzz/corpus
+#                                             (-merge=1 keeps only inputs that add coverage)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+repo="$(pwd)"
+
+update=0
+case "${1:-}" in
+    "") ;;
+    --update-corpus) update=1 ;;
+    *) echo "usage: $0 [--update-corpus]" >&2; exit 2 ;;
+esac
+seconds="${NSP_FUZZ_SECONDS:-120}"
+
+packages=(cmake ninja-build clang libclang-rt-dev libglm-dev libeigen3-dev)
+missing=()
+for p in "${packages[@]}"; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+    echo "run-fuzz: installing ${missing[*]}"
+    sudo_cmd=()
+    [ "$(id -u)" -eq 0 ] || sudo_cmd=(sudo)
+    export DEBIAN_FRONTEND=noninteractive
+    "${sudo_cmd[@]}" apt-get update -qq
+    "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
+
+generator=()
+command -v ninja >/dev/null && generator=(-G Ninja)
+CC=clang CXX=clang++ cmake -S . -B build-fuzz "${generator[@]}" -DCMAKE_BUILD_TYPE=Release \
+    -DNSP_BUILD_FUZZER=ON -DNSP_BUILD_TESTS=OFF -DNSP_BUILD_EXAMPLES=OFF -DNSP_BUILD_BENCHMARKS=OFF
+cmake --build build-fuzz --parallel "${NSP_FUZZ_BUILD_JOBS:-$(nproc)}" --target nsp_fuzz_kernels
+
+scratch="$(mktemp -d "${TMPDIR:-/tmp}/nsp-fuzz.XXXXXX")"
+mkdir -p "$scratch/corpus" "$scratch/artifacts"
+cp tests/fuzz/corpus/* "$scratch/corpus/"
+echo "run-fuzz: ${seconds} s over a copy of tests/fuzz/corpus in $scratch"
+# -max_len bounds the structure and the random numbers an input may carry; -timeout (s) catches an
+# input whose work the harness failed to bound; -rss_limit_mb a runaway allocation.
+status=0
+(cd "$scratch" && "$repo/build-fuzz/tests/fuzz/nsp_fuzz_kernels" -max_len=1024 -timeout=10 -rss_limit_mb=2048 \
+    -max_total_time="$seconds" -print_final_stats=1 -artifact_prefix="$scratch/artifacts/" corpus) || status=$?
+if [ "$status" -ne 0 ] || [ -n "$(ls -A "$scratch/artifacts")" ]; then
+    echo "run-fuzz: FAILED (exit $status); inputs in $scratch/artifacts:" >&2
+    for f in "$scratch"/artifacts/*; do
+        [ -e "$f" ] && echo "  $f  base64: $(base64 -w0 "$f")" >&2
+    done
+    exit 1
+fi
+
+if [ "$update" -eq 1 ]; then
+    # Re-minimise: merge the checked-in corpus and what this run found into an empty directory
+    # (-merge=1 keeps an input only if it adds coverage, smallest first), then replace the corpus
+    # with it. Inputs of findings (finding-*) are kept as they are, whatever their coverage.
+    mkdir -p "$scratch/merged"
+    (cd "$scratch" && "$repo/build-fuzz/tests/fuzz/nsp_fuzz_kernels" -merge=1 -max_len=1024 -timeout=10 \
+        merged "$repo/tests/fuzz/corpus" corpus)
+    find tests/fuzz/corpus -type f ! -name 'finding-*' -delete
+    cp "$scratch"/merged/* tests/fuzz/corpus/ 2>/dev/null || true
+    n=$(ls tests/fuzz/corpus | wc -l)
+    kb=$(du -sk tests/fuzz/corpus | cut -f1)
+    echo "run-fuzz: tests/fuzz/corpus now holds $n files, ${kb} KB"
+    if [ "$n" -ge 300 ] || [ "$kb" -ge 200 ]; then
+        echo "run-fuzz: the corpus outgrew 300 files / 200 KB: lower -max_len or prune it" >&2
+    fi
+fi
+rm -rf "$scratch"
+echo "run-fuzz: OK"
