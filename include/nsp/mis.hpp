@@ -69,22 +69,27 @@ concept CombiningHeuristic = H::combines && requires(const H& h, float r) {
 /// The weight of one technique among several from the ratios of every technique's pdf to one
 /// common reference pdf: `r_this` for the technique that sampled the path, `r_others` for the
 /// rest (THEORY 5.4: tracking + NEE, tracking + hit, equiangular + NEE). The weights of all
-/// techniques of one path, each computed with its own r_this, sum to 1. Powers that overflow
-/// are handled as limits: an infinite power takes the whole weight (shared between equal
-/// infinities), a zero r_this gets 0. Never NaN for ratios in [0, inf]; a NaN ratio gives NaN,
-/// which the estimator reports as Status::NonFinite.
+/// techniques of one path, each computed with its own r_this, sum to 1. Infinite ratios take the
+/// whole weight (shared between equal infinities), a zero r_this gets 0. The powers are taken of
+/// the ratios over the largest one, numbers in [0, 1] of which one is 1, so they neither overflow
+/// nor all underflow to 0 (with powers of the ratios themselves, three ratios of 1e-30 under
+/// Power(2) gave every technique weight 0; found by the fuzzer, tests/fuzz). Never NaN for
+/// ratios in [0, inf]; a NaN ratio gives NaN, which the estimator reports as Status::NonFinite.
 template <class H, class... R>
 float weight_among(const H& h, float r_this, R... r_others) noexcept {
-    const float p = h.power(r_this);
-    if (!(p > 0.f)) return 0.f;
-    const float powers[] = {h.power(r_others)...};
-    double sum = p;  // finite float powers cannot overflow a double sum
-    int infinite = p == kInfPower ? 1 : 0;
-    for (const float q : powers) {
-        sum += double(q);
+    if (!(r_this > 0.f)) return 0.f;
+    const float others[] = {float(r_others)...};
+    int infinite = r_this == kInfPower ? 1 : 0;
+    float largest = r_this;
+    for (const float q : others) {
         infinite += q == kInfPower ? 1 : 0;
+        largest = q > largest ? q : largest;
     }
-    if (infinite > 0) return p == kInfPower ? 1.f / float(infinite) : 0.f;
+    if (infinite > 0) return r_this == kInfPower ? 1.f / float(infinite) : 0.f;
+    const float p = h.power(r_this / largest);
+    double sum = p;  // at least power(1) = 1: never 0
+    for (const float q : others) sum += double(h.power(q / largest));
+    if (std::isnan(sum)) return std::numeric_limits<float>::quiet_NaN();
     return float(double(p) / sum);
 }
 

@@ -52,8 +52,10 @@ float unidirectional_pdf(float survival, float phase_pdf, float null_pdf_product
 template <PathStrategy St, mis::CombiningHeuristic H>
 float unidirectional_weight(const H& h, float survival, float phase_pdf, float null_pdf_product,
                             float light_pdf) noexcept {
-    const float p_uni = unidirectional_pdf<St>(survival, phase_pdf, null_pdf_product);
-    return p_uni > 0.f ? h.weight(light_pdf / p_uni) : 0.f;
+    // Both weights through weight_among with the same two pdfs, not h.weight of a ratio and of its
+    // inverse: a ratio beyond float range (a denormal p_uni) made the two not sum to 1 under
+    // Power with a small exponent (found by the fuzzer, tests/fuzz).
+    return mis::weight_among(h, unidirectional_pdf<St>(survival, phase_pdf, null_pdf_product), light_pdf);
 }
 
 /// MIS weight of NEE for the same kind of path, sampled by the light (pdf `light_pdf` > 0) with
@@ -62,7 +64,7 @@ float unidirectional_weight(const H& h, float survival, float phase_pdf, float n
 template <PathStrategy St, mis::CombiningHeuristic H>
 float next_event_weight(const H& h, float survival, float phase_pdf, float null_pdf_product,
                         float light_pdf) noexcept {
-    return h.weight(unidirectional_pdf<St>(survival, phase_pdf, null_pdf_product) / light_pdf);
+    return mis::weight_among(h, light_pdf, unidirectional_pdf<St>(survival, phase_pdf, null_pdf_product));
 }
 /// The three techniques that can produce a path's last real vertex x and its light vertex y
 /// when equiangular sampling is on (THEORY 5.4).
@@ -107,12 +109,18 @@ float equiangular_mis_weight(const H& h, VertexTechnique which, float track_nee,
 /// p_uni / p_nee = q p_w [prod P_n] mu_bar(y) / (dist2 p_V(y)), with roulette survival q and phase
 /// pdf p_w at x, the nulls' delta-tracking product (null-scattering strategies only; directional
 /// MIS leaves it out, as it does for lights) and the NEE volume pdf p_V(y). The nulls' mu_bar Tbar
-/// are shared and cancel. The collision estimator weighs with h.weight(1 / r), NEE with
-/// h.weight(r): for one path they sum to 1.
+/// are shared and cancel. The collision estimator weighs with mis::weight_among(h, r, 1), NEE with
+/// mis::weight_among(h, 1, r): for one path they sum to 1 (h.weight(1 / r) and h.weight(r) did not
+/// where 1 / r leaves float range).
 template <PathStrategy St>
 float emission_collision_over_nee(float survival, float phase_pdf, float null_pdf_product, float mu_bar, float dist2,
                                   float volume_pdf) noexcept {
-    return unidirectional_pdf<St>(survival, phase_pdf, null_pdf_product) * mu_bar / (dist2 * volume_pdf);
+    // In double: in float both the product of the numerator and dist2 * volume_pdf can underflow
+    // to 0, and 0 / 0 gave both techniques weight 0 (found by the fuzzer, tests/fuzz).
+    double p = double(survival) * double(phase_pdf) * double(mu_bar);
+    if constexpr (St::null_pdfs) p *= double(null_pdf_product);
+    const double q = double(dist2) * double(volume_pdf);
+    return q > 0.0 ? float(p / q) : kInf;  // NEE cannot draw the point: the collision estimator takes it
 }
 
 /// A path estimator: strategy St, MIS heuristic H (mis::None exactly for single-strategy
@@ -354,7 +362,7 @@ private:
                 if (from_vertex) {
                     const float r = emission_collision_over_nee<St>(survival, phase_pdf, null_pdf_product, mu_bar, t * t,
                                                                     scene.medium.emission_pdf(y));
-                    wt = heuristic.weight(1.f / r);
+                    wt = mis::weight_among(heuristic, r, 1.f);
                 }
             }
             L += beta * w * c.sigma_a * le * (wt / mu_bar);
@@ -379,7 +387,8 @@ private:
         const Vec3& wi = e->shadow.d;
         float w = 1.f;
         if constexpr (St::combines)
-            w = heuristic_.weight(emission_collision_over_nee<St>(survival, scene.phase.pdf(wo, wi), tr.null_pdf_product,
+            w = mis::weight_among(heuristic_, 1.f,
+                                  emission_collision_over_nee<St>(survival, scene.phase.pdf(wo, wi), tr.null_pdf_product,
                                                                   v->mu, e->dist2, e->y.pdf));
         L += beta * tr.transmittance * v->k.sigma_a * le * (w * scene.phase.eval(wo, wi) / (e->dist2 * e->y.pdf));
         return Status::Ok;
