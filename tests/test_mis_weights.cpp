@@ -101,23 +101,23 @@ TEST_CASE_TEMPLATE_DEFINE("MIS weights of unidirectional and NEE sum to 1 for on
                     REQUIRE(nee(t, tracked_coefficients(medium, maj, ray, t, lambda), majorant_at<M>(maj, ray, t, lambda), tau));
                     prev = t;
                 }
-                REQUIRE(double(nee.out.null_pdf_product) == doctest::Approx(p_nulls).epsilon(1e-4));
+                REQUIRE(double(nee.finish().null_pdf_product) == doctest::Approx(p_nulls).epsilon(1e-4));
 
                 const float p_w = phase.pdf(wo, ls.wi);
                 for (const float q : {1.f, 0.5f}) {
                     check_weights<strategy::DirectionalMis>(mis::Balance{}, 1.0, q, p_w, ls.pdf, d.null_pdf_product,
-                                                            nee.out.null_pdf_product, log_track, log_ratio);
+                                                            nee.finish().null_pdf_product, log_track, log_ratio);
                     check_weights<strategy::DirectionalMis>(mis::Power{2.f}, 2.0, q, p_w, ls.pdf,
-                                                            d.null_pdf_product, nee.out.null_pdf_product,
+                                                            d.null_pdf_product, nee.finish().null_pdf_product,
                                                             log_track, log_ratio);
                     check_weights<strategy::NullScatteringMis>(mis::Balance{}, 1.0, q, p_w, ls.pdf,
-                                                               d.null_pdf_product, nee.out.null_pdf_product,
+                                                               d.null_pdf_product, nee.finish().null_pdf_product,
                                                                log_track, log_ratio);
                     check_weights<strategy::NullScatteringMis>(mis::Power{2.f}, 2.0, q, p_w, ls.pdf,
-                                                               d.null_pdf_product, nee.out.null_pdf_product,
+                                                               d.null_pdf_product, nee.finish().null_pdf_product,
                                                                log_track, log_ratio);
                     check_weights<strategy::NullScatteringMis>(mis::Power{3.f}, 3.0, q, p_w, ls.pdf,
-                                                               d.null_pdf_product, nee.out.null_pdf_product,
+                                                               d.null_pdf_product, nee.finish().null_pdf_product,
                                                                log_track, log_ratio);
                 }
             }
@@ -179,7 +179,7 @@ TEST_CASE_TEMPLATE_DEFINE("three-technique weights (tracking + NEE, tracking + h
             }
             const float mu_x = majorant_value_at_point<M>(maj, ray, d.t, lambda);
             const float track_over_eq = tracking_over_equiangular<A>(
-                eq.pdf(d.t), rt.out.null_pdf_product, tracked_coefficients(medium, maj, ray, d.t, lambda), mu_x);
+                eq.pdf(d.t), rt.finish().null_pdf_product, tracked_coefficients(medium, maj, ray, d.t, lambda), mu_x);
             REQUIRE(double(track_over_eq) == doctest::Approx(std::exp(log_track - log_eq)).epsilon(2e-4));
             // The light segment: hitting over NEE, s = q p_w prod P_n / p_l (any positive value
             // the two sides share; the uni/NEE suite above checks how it is formed).

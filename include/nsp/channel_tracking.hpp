@@ -13,6 +13,7 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <type_traits>
@@ -63,23 +64,43 @@ ChannelEventDensities<typename S::Spectrum> channel_event_densities(const Coeffi
     else return {Spec::Zero(), t * scale, n * scale};
 }
 
-/// The event probabilities of spectral tracking (Kutz et al. 2017) under grey majorant mu > 0:
-/// from the channel maxima of mu_a, mu_s and mu_n, or (`weighted`) from sum_c |w_c| mu_x,c with
-/// the path throughput w (falling back to the maxima where w is 0).
-template <AbsorptionPolicy A, bool weighted, SpectralMode S>
-EventProbabilities shared_event_probabilities(const Coefficients<S>& k, float mu,
-                                              const typename S::Spectrum& w) noexcept {
-    using Spec = typename S::Spectrum;
-    const Spec a = k.sigma_a.max(0.f), s = k.sigma_s.max(0.f);
-    const Spec n = (Spec::Constant(mu) - a - s).abs();
-    float pa = 0.f, ps = 0.f, pn = 0.f;
+namespace detail {
+/// Every channel's null density mu_c P_n,c of channel_event_densities (the same formula) and its
+/// null contribution mu_c - mu_t,c, in double: a product over many nulls of factors within 1e-6
+/// of mu_c must not carry float's rounding of each factor (see detail::DoubleSpectrum).
+template <SpectralMode S>
+struct ChannelNullFactors {
+    DoubleSpectrum<typename S::Spectrum> f, density;
+};
+template <SpectralMode S>
+ChannelNullFactors<S> channel_null_factors(const Coefficients<S>& k, const typename S::Spectrum& mu_f) noexcept {
+    using D = DoubleSpectrum<typename S::Spectrum>;
+    const D mu = mu_f.template cast<double>();
+    // Sums in float, as channel_event_densities and the majorants form them: where mu_c = mu_t,c
+    // the null factors are exactly 0.
+    const D t = (k.sigma_a.max(0.f) + k.sigma_s.max(0.f)).template cast<double>();
+    const D n = (mu - t).abs();
+    const D denom = t + n;
+    return {mu - k.sigma_t().template cast<double>(), (denom > 0.0).select(n * mu / denom, 0.0)};
+}
+}  // namespace detail
+
+namespace detail {
+/// shared_event_probabilities (below) computed in scalar type T: {absorb, scatter, null}.
+template <AbsorptionPolicy A, bool weighted, class T, SpectralMode S>
+std::array<T, 3> shared_event_probabilities_in(const Coefficients<S>& k, float mu,
+                                               const typename S::Spectrum& w) noexcept {
+    using Arr = Eigen::Array<T, S::Spectrum::RowsAtCompileTime, 1>;
+    const Arr a = k.sigma_a.max(0.f).template cast<T>(), s = k.sigma_s.max(0.f).template cast<T>();
+    const Arr n = (Arr::Constant(T(mu)) - (k.sigma_a.max(0.f) + k.sigma_s.max(0.f)).template cast<T>()).abs();
+    T pa = 0, ps = 0, pn = 0;
     if constexpr (weighted) {
-        const Spec aw = w.abs();
+        const Arr aw = w.abs().template cast<T>();
         pa = (aw * a).sum();
         ps = (aw * s).sum();
         pn = (aw * n).sum();
     }
-    if (!(pa + ps + pn > 0.f) || !std::isfinite(pa + ps + pn)) {
+    if (!(pa + ps + pn > T(0)) || !std::isfinite(pa + ps + pn)) {
         if constexpr (A::as_event) {
             pa = a.maxCoeff();
             ps = s.maxCoeff();
@@ -90,10 +111,21 @@ EventProbabilities shared_event_probabilities(const Coefficients<S>& k, float mu
     }
     if constexpr (!A::as_event) {
         ps += pa;
-        pa = 0.f;
+        pa = 0;
     }
-    const float inv = 1.f / (pa + ps + pn);  // > 0: some channel has a + s + n >= mu > 0
+    const T inv = T(1) / (pa + ps + pn);  // > 0: some channel has a + s + n >= mu > 0
     return {pa * inv, ps * inv, pn * inv};
+}
+}  // namespace detail
+
+/// The event probabilities of spectral tracking (Kutz et al. 2017) under grey majorant mu > 0:
+/// from the channel maxima of mu_a, mu_s and mu_n, or (`weighted`) from sum_c |w_c| mu_x,c with
+/// the path throughput w (falling back to the maxima where w is 0).
+template <AbsorptionPolicy A, bool weighted, SpectralMode S>
+EventProbabilities shared_event_probabilities(const Coefficients<S>& k, float mu,
+                                              const typename S::Spectrum& w) noexcept {
+    const auto p = detail::shared_event_probabilities_in<A, weighted, float>(k, mu, w);
+    return {p[0], p[1], p[2]};
 }
 
 /// How a per-channel delta-tracked segment ended, and where.
@@ -124,6 +156,7 @@ struct ChannelDeltaCollision {
     bool nee_alternative;
     Visit visit{};
     ChannelTrack out{};
+    std::uint32_t nulls = 0;
 
     template <class V>
     bool operator()(float t, const Coefficients<S>& k, const V& mu_v, const V& tau_v) {
@@ -150,42 +183,72 @@ struct ChannelDeltaCollision {
         const float pa = d.absorb[c] * inv, ps = d.scatter[c] * inv;
         const float u = rng.uniform();
         SegmentEnd event;
-        Spec f_factor, p_factor;
-        if (u < pa) {
-            event = SegmentEnd::Absorbed;
-            f_factor = k.sigma_a;
-            p_factor = d.absorb;
-        } else if (u < pa + ps || !(d.null[c] > 0.f)) {  // rounding never picks a null of probability 0
-            event = SegmentEnd::Scattered;
-            f_factor = k.sigma_s;
-            p_factor = d.scatter;
-        } else {
-            event = SegmentEnd::Passed;  // a null
-            f_factor = mu - k.sigma_t();
-            p_factor = d.null;
+        if (u < pa) event = SegmentEnd::Absorbed;
+        else if (u < pa + ps || !(d.null[c] > 0.f)) event = SegmentEnd::Scattered;  // never a null of probability 0
+        else event = SegmentEnd::Passed;  // a null
+        if constexpr (Rec::enabled) {
+            const float p_c = event == SegmentEnd::Absorbed    ? d.absorb[c]
+                              : event == SegmentEnd::Scattered ? d.scatter[c]
+                                                               : d.null[c];
+            rec.vertex(t, std::log(double(p_c)) - double(channel_of(tau_v, c)));
         }
-        if constexpr (Rec::enabled)
-            rec.vertex(t, std::log(double(p_factor[c])) - double(channel_of(tau_v, c)));
         if (event == SegmentEnd::Absorbed) {  // the path ends without a contribution
             out = {event, t};
             return false;
         }
         Spec nee_factor = mu;  // ratio tracking's pdf of a null, for the NEE alternative (THEORY 5.1)
         if constexpr (!grey) {  // a grey majorant's Tbar is common to every channel and cancels
-            f_factor *= tb;
-            p_factor *= tb;
             nee_factor *= tb;
             if constexpr (kEq)  // Tbar_c alone at the real vertex: it is not a null
                 if (event == SegmentEnd::Scattered) st.eq.vertex *= tb;
         }
-        if (event == SegmentEnd::Passed && nee_alternative) {
-            st.nee *= nee_factor;
-            if constexpr (kEq) st.eq.nee *= nee_factor;
+        if (event == SegmentEnd::Passed) {
+            if (++nulls <= detail::kFloatNulls) {
+                Spec fn = mu - k.sigma_t(), pn = d.null;
+                if constexpr (!grey) {
+                    fn *= tb;
+                    pn *= tb;
+                }
+                st.f *= fn;
+                st.uni *= pn;
+            } else {
+                // Past kFloatNulls nulls (a loose majorant), a null's contribution and pdf, within
+                // 1e-6 of mu_c, are formed and multiplied in in double: the state then rounds once
+                // per null (a random walk) instead of carrying each factor's rounding (a bias that
+                // grows with the number of nulls; see detail::kFloatNulls).
+                using D = detail::DoubleSpectrum<Spec>;
+                D fd, pd;
+                if constexpr (CP::own_pdfs) {
+                    const auto nf = detail::channel_null_factors<S>(k, mu);
+                    fd = nf.f;
+                    pd = nf.density;
+                } else {
+                    fd = mu.template cast<double>() - k.sigma_t().template cast<double>();
+                    pd = D::Constant(double(mu_v) * detail::shared_event_probabilities_in<
+                                                        A, CP::throughput_weighted, double>(k, mu_v, st.f)[2]);
+                }
+                if constexpr (!grey) {
+                    const D tbd = tb.template cast<double>();
+                    fd *= tbd;
+                    pd *= tbd;
+                }
+                st.f = (st.f.template cast<double>() * fd).template cast<float>();
+                st.uni = (st.uni.template cast<double>() * pd).template cast<float>();
+            }
+            if (nee_alternative) {
+                st.nee *= nee_factor;
+                if constexpr (kEq) st.eq.nee *= nee_factor;
+            }
+            if constexpr (kEq) st.eq.vertex *= nee_factor;
+        } else {  // a real scattering vertex: mu_s,c Tbar_c and mu_bar_c P_s,c Tbar_c
+            if constexpr (grey) {
+                st.f *= k.sigma_s;
+                st.uni *= d.scatter;
+            } else {
+                st.f *= k.sigma_s * tb;
+                st.uni *= d.scatter * tb;
+            }
         }
-        if constexpr (kEq)
-            if (event == SegmentEnd::Passed) st.eq.vertex *= nee_factor;
-        st.f *= f_factor;
-        st.uni *= p_factor;
         if (!st.template renormalize<CP>(c)) {
             out = {SegmentEnd::Terminated, t};
             return false;
@@ -254,58 +317,105 @@ struct ChannelShadow {
 
 /// Ratio tracking with channel c's majorant and every channel's pdfs; see ChannelShadow.
 /// `weights` is the path throughput at the segment's start (for throughput-weighted spectral
-/// tracking's null probabilities in `uni`).
+/// tracking's null probabilities in `uni`). After detail::kFloatNulls nulls the products continue
+/// in double; `finish` rounds them.
 template <ChannelPolicy CP, AbsorptionPolicy A, SpectralMode S, class Rec>
 struct ChannelRatioCollision {
     using Spec = typename S::Spectrum;
+    using D = detail::DoubleSpectrum<Spec>;
     Rec& rec;
     int c;
     bool uni_alternative;
     Spec weights;
     ChannelShadow<S> out{};
+    std::uint32_t nulls = 0;
+    D f_d = D::Zero(), nee_d = D::Zero(), uni_d = D::Zero();
 
     template <class V>
     bool operator()(float t, const Coefficients<S>& k, const V& mu_v, const V& tau_v) {
+        if constexpr (Rec::enabled) rec.vertex(t, std::log(double(channel_of(mu_v, c))) - double(channel_of(tau_v, c)));
+        if (++nulls <= detail::kFloatNulls) return multiply<float>(k, mu_v, tau_v, out.f, out.nee, out.uni);
+        if (nulls == detail::kFloatNulls + 1) {
+            f_d = out.f.template cast<double>();
+            nee_d = out.nee.template cast<double>();
+            uni_d = out.uni.template cast<double>();
+        }
+        return multiply<double>(k, mu_v, tau_v, f_d, nee_d, uni_d);
+    }
+
+    /// Multiplies every channel's Tbar over the flight's tail (per-channel majorants).
+    void multiply_tail(const Spec& tb) {
+        if (nulls <= detail::kFloatNulls) {
+            out.f *= tb;
+            out.nee *= tb;
+            out.uni *= tb;
+            normalize(out.f, out.nee, out.uni);
+        } else {
+            const D tbd = tb.template cast<double>();
+            f_d *= tbd;
+            nee_d *= tbd;
+            uni_d *= tbd;
+            normalize(f_d, nee_d, uni_d);
+        }
+    }
+
+    /// The segment's result (rounded to float after long flights).
+    ChannelShadow<S> finish() const noexcept {
+        if (nulls <= detail::kFloatNulls) return out;
+        return {out.end, Spec(f_d.template cast<float>()), Spec(nee_d.template cast<float>()),
+                Spec(uni_d.template cast<float>())};
+    }
+
+private:
+    /// One null's factors, formed and multiplied in T (float or double).
+    template <class T, class V, class Arr>
+    bool multiply(const Coefficients<S>& k, const V& mu_v, const V& tau_v, Arr& f, Arr& nee, Arr& uni) {
         constexpr bool grey = std::is_same_v<V, float>;
         const Spec mu = detail::broadcast_majorant<Spec>(mu_v);
-        Spec f_factor = mu - k.sigma_t(), nee_factor = mu, uni_factor = Spec::Ones();
+        // mu_t in float, as the majorants bound it: where mu_c = mu_t,c the null factor is 0.
+        Arr nee_factor = mu.template cast<T>();
+        Arr f_factor = nee_factor - k.sigma_t().template cast<T>();
+        Arr uni_factor = Arr::Ones();
         if (uni_alternative) {
             if constexpr (CP::own_pdfs) {
-                uni_factor = channel_event_densities<A, S>(k, mu).null;
+                if constexpr (std::is_same_v<T, float>) uni_factor = channel_event_densities<A, S>(k, mu).null;
+                else uni_factor = detail::channel_null_factors<S>(k, mu).density;
             } else {
-                const auto p = shared_event_probabilities<A, CP::throughput_weighted, S>(k, mu_v, weights * out.f);
-                uni_factor = Spec::Constant(mu_v * p.null);
+                const Spec w = weights * f.template cast<float>();
+                uni_factor = Arr::Constant(T(mu_v) *
+                                           detail::shared_event_probabilities_in<A, CP::throughput_weighted, T>(k, mu_v, w)[2]);
             }
         }
-        if constexpr (Rec::enabled) rec.vertex(t, std::log(double(mu[c])) - double(channel_of(tau_v, c)));
         if constexpr (!grey) {
-            const Spec tb = detail::relative_transmittance(tau_v, c);
+            const Arr tb = detail::relative_transmittance(tau_v, c).template cast<T>();
             f_factor *= tb;
             nee_factor *= tb;
             if (uni_alternative) uni_factor *= tb;
         }
-        out.f *= f_factor;
-        out.nee *= nee_factor;
-        if (uni_alternative) out.uni *= uni_factor;
-        return normalize();
+        f *= f_factor;
+        nee *= nee_factor;
+        if (uni_alternative) uni *= uni_factor;
+        return normalize(f, nee, uni);
     }
 
     /// Rescales by the largest ratio-tracking pdf (by channel c's alone for independent tracking);
-    /// stops once every estimated channel's contribution is below the smallest normal float: a
-    /// product of factors above 1/2 would otherwise stall at a denormal and never reach 0.
-    bool normalize() {
-        const float k = CP::mis_over_channels ? out.nee.maxCoeff() : out.nee[c];
-        const bool negligible = CP::mis_over_channels
-                                    ? (out.f.abs() < std::numeric_limits<float>::min() * k).all()
-                                    : !(std::abs(out.f[c]) >= std::numeric_limits<float>::min() * k);
-        if (!(k > 0.f) || !std::isfinite(k) || negligible) {
-            out.f.setZero();
+    /// stops once every estimated channel's contribution is below the smallest normal float
+    /// relative to it: the float result could not hold it, and a product of factors above 1/2
+    /// would otherwise never reach 0.
+    template <class Arr>
+    bool normalize(Arr& f, Arr& nee, Arr& uni) {
+        using T = typename Arr::Scalar;
+        const T k = CP::mis_over_channels ? nee.maxCoeff() : nee[c];
+        constexpr T tiny = std::numeric_limits<float>::min();
+        const bool negligible = CP::mis_over_channels ? (f.abs() < tiny * k).all() : !(std::abs(f[c]) >= tiny * k);
+        if (!(k > T(0)) || !std::isfinite(k) || negligible) {
+            f.setZero();
             out.end = SegmentEnd::Terminated;
             return false;
         }
-        out.f /= k;
-        out.nee /= k;
-        out.uni /= k;
+        f /= k;
+        nee /= k;
+        uni /= k;
         return true;
     }
 };
@@ -322,20 +432,15 @@ ChannelShadow<typename M::Spectral> track_channels_ratio(const M& medium, const 
     ChannelRatioCollision<CP, A, S, RecT> cb{rec, c, uni_alternative, weights};
     const auto f = free_flight(medium, majorant, ray, 0.f, tmax, lambda, rng, counter, cb, kDefaultMaxCollisions, c);
     if (f.aborted) {
-        cb.out.f.setZero();
-        cb.out.end = aborted_end(f);
-        return cb.out;
+        ChannelShadow<S> out = cb.finish();
+        out.f.setZero();
+        out.end = aborted_end(f);
+        return out;
     }
-    if (f.stopped) return cb.out;
-    if constexpr (is_per_channel_majorant_v<Maj, M>) {
-        const auto tb = detail::relative_transmittance(f.tau_tail, c);
-        cb.out.f *= tb;
-        cb.out.nee *= tb;
-        cb.out.uni *= tb;
-        cb.normalize();
-    }
+    if (f.stopped) return cb.finish();
+    if constexpr (is_per_channel_majorant_v<Maj, M>) cb.multiply_tail(detail::relative_transmittance(f.tau_tail, c));
     if constexpr (RecT::enabled) rec.log_pdf -= double(channel_of(f.tau_tail, c));
-    return cb.out;
+    return cb.finish();
 }
 
 }  // namespace nsp

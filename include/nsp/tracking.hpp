@@ -63,10 +63,49 @@ EventProbabilities event_probabilities(const Coefficients<S>& c, float mu_bar) n
     const float a = std::max(0.f, sampling_scalar(c.sigma_a));
     const float s = std::max(0.f, sampling_scalar(c.sigma_s));
     const float n = std::abs(mu_bar - a - s);
-    const float inv = 1.f / (a + s + n);  // > 0 because mu_bar > 0
-    if constexpr (A::as_event) return {a * inv, s * inv, n * inv};
-    else return {0.f, (a + s) * inv, n * inv};
+    // In double: where a + s + n is below 2^-126 (a denormal majorant, met at a zero-length step
+    // from u = 0) the float 1 / (a + s + n) overflowed and the probabilities were inf or NaN
+    // (found by the fuzzer, tests/fuzz).
+    const double inv = 1.0 / (double(a) + double(s) + double(n));  // > 0 because mu_bar > 0
+    if constexpr (A::as_event) return {float(a * inv), float(s * inv), float(n * inv)};
+    else return {0.f, float((double(a) + double(s)) * inv), float(n * inv)};
 }
+
+namespace detail {
+/// Products over the nulls of one flight are formed in double: always by the grey trackers here
+/// (for one to a few channels double costs no more than float), and after the first kFloatNulls
+/// nulls by the channel trackers (channel_tracking.hpp, whose wider state costs more in double).
+/// A null factor mu_n / mu_bar under a majorant 1e6 times the extinction is 1 - 1e-6, which float
+/// rounds by up to 3% of its distance to 1, the same way at every null of a homogeneous stretch:
+/// over 1e6 nulls that was a 3% bias of ratio tracking (a random walk of float roundings of the
+/// product would only be ~1e-5). In double the factor is exact to 1e-10 of that distance. Float
+/// rounds each factor by at most 2^-24 of itself, so over the first 1024 nulls its bias is below
+/// 1024 x 2^-24 = 6e-5 of the product (far less where the roundings differ in sign), below any
+/// estimate's noise: ordinary flights (a few to a few hundred nulls) keep float arithmetic.
+inline constexpr std::uint32_t kFloatNulls = 1024;
+
+/// A spectrum of doubles with Spec's channels (see kFloatNulls).
+template <class Spec>
+using DoubleSpectrum = Eigen::Array<double, Spec::RowsAtCompileTime, 1>;
+
+/// Every channel's mu_n / mu_bar = 1 - mu_t / mu_bar at a collision, in double (see DoubleSpectrum).
+template <SpectralMode S>
+DoubleSpectrum<typename S::Spectrum> null_ratio(const Coefficients<S>& c, float mu_bar) noexcept {
+    // mu_t in float, as the majorants bound it: where mu_bar = mu_t the factor is exactly 0.
+    const double mu = mu_bar;
+    return (mu - c.sigma_t().template cast<double>()) / mu;
+}
+
+/// The null probability P_n of event_probabilities<A> (the same formula), in double.
+template <AbsorptionPolicy A, SpectralMode S>
+double null_probability(const Coefficients<S>& c, float mu_bar) noexcept {
+    const float a = std::max(0.f, sampling_scalar(c.sigma_a));
+    const float s = std::max(0.f, sampling_scalar(c.sigma_s));
+    const double t = a + s;  // in float, as event_probabilities forms it
+    const double n = std::abs(double(mu_bar) - t);
+    return n / (t + n);
+}
+}  // namespace detail
 
 // ---------------------------------------------------------------------------------------------
 // Recording sampled vertices (for pdf tests and debugging; compiled out by default)
@@ -205,13 +244,13 @@ FlightEnd<MajorantValue<Maj, M>> free_flight(const M& medium, const Maj& majoran
             if (++collisions > max_collisions) return {false, true, false, t, V{}};
             counter.lookup();
             auto coeff = medium.coefficients(ray.at(t), lambda);
+            NSP_DEBUG_ASSERT((coeff.sigma_a >= 0.f).all() && (coeff.sigma_s >= 0.f).all() &&
+                                 all_finite(coeff.sigma_a) && all_finite(coeff.sigma_s),
+                             "the medium returned a negative or non-finite coefficient");
             if constexpr (std::is_same_v<B, bound::Clamp>) {
                 detail::clamp_to_majorant(coeff, seg->sigma_maj);
             } else if constexpr (std::is_same_v<B, bound::Reject>) {
-                if (detail::exceeds_majorant(coeff, seg->sigma_maj)) {
-                    NSP_DEBUG_ASSERT(false, "bound::Reject: the extinction exceeds the majorant");
-                    return {false, true, true, t, V{}};
-                }
+                if (detail::exceeds_majorant(coeff, seg->sigma_maj)) return {false, true, true, t, V{}};
             }
             const V tau_step = tau;
             if constexpr (grey) tau = 0.f;
@@ -267,31 +306,50 @@ struct DeltaCollision {
     Rec& rec;
     Visit visit{};
     DeltaTrack<S> out{SegmentEnd::Passed, 0.f, S::Spectrum::Ones(), 1.f};
+    // The weight and P_n product accumulate in double (see detail::kFloatNulls; for one to a few
+    // channels double costs no more than float); `finish` rounds them into `out`.
+    detail::DoubleSpectrum<typename S::Spectrum> weight = decltype(weight)::Ones();
+    double null_pdf_product = 1.0;
 
     bool operator()(float t, const Coefficients<S>& c, float mu_bar, float tau) {
-        if constexpr (Visit::enabled) visit(t, c, mu_bar, out.weight, out.null_pdf_product);
+        if constexpr (Visit::enabled)
+            visit(t, c, mu_bar, typename S::Spectrum(weight.template cast<float>()), float(null_pdf_product));
         const EventProbabilities p = event_probabilities<A>(c, mu_bar);
+        NSP_DEBUG_ASSERT(p.absorb >= 0.f && p.scatter >= 0.f && p.null >= 0.f &&
+                             std::abs(p.absorb + p.scatter + p.null - 1.f) < 1e-5f,
+                         "delta tracking's event probabilities must lie in [0, 1] and sum to 1");
         const float u = rng.uniform();
         float p_event;
         if (u < p.absorb) {
             out.end = SegmentEnd::Absorbed;
-            out.weight *= c.sigma_a / (mu_bar * p.absorb);
+            weight *= (c.sigma_a / (mu_bar * p.absorb)).template cast<double>();
             p_event = p.absorb;
         } else if (u < p.absorb + p.scatter || !(p.null > 0.f)) {
             // The second test keeps rounding from picking a null of probability 0.
             out.end = SegmentEnd::Scattered;
-            out.weight *= c.sigma_s / (mu_bar * p.scatter);
+            weight *= (c.sigma_s / (mu_bar * p.scatter)).template cast<double>();
             p_event = p.scatter;
         } else {
-            out.weight *= (mu_bar - c.sigma_t()) / (mu_bar * p.null);
-            out.null_pdf_product *= p.null;
+            const double p_null = detail::null_probability<A>(c, mu_bar);
+            const double mu = mu_bar;
+            weight *= (mu - c.sigma_t().template cast<double>()) * (1.0 / (mu * p_null));
+            null_pdf_product *= p_null;
             if constexpr (Rec::enabled) rec.vertex(t, std::log(double(mu_bar) * p.null) - tau);
             return true;
         }
+        NSP_DEBUG_ASSERT(p_event > 0.f, "delta tracking chose a real event of probability 0");
         out.t = t;
         out.event_density = mu_bar * p_event;
         if constexpr (Rec::enabled) rec.vertex(t, std::log(double(mu_bar) * p_event) - tau);
         return false;
+    }
+
+    /// `out` with the accumulated weight and null-pdf product rounded to float.
+    DeltaTrack<S> finish() const noexcept {
+        DeltaTrack<S> r = out;
+        r.weight = weight.template cast<float>();
+        r.null_pdf_product = float(null_pdf_product);
+        return r;
     }
 };
 
@@ -309,21 +367,30 @@ struct RatioTrack {
 template <AbsorptionPolicy A, bool kNullRatio, SpectralMode S, class Rec>
 struct RatioCollision {
     Rec& rec;
-    RatioTrack<S> out{SegmentEnd::Passed, S::Spectrum::Ones(), 1.f};
+    SegmentEnd end = SegmentEnd::Passed;
+    // The products accumulate in double (see detail::kFloatNulls; for one to a few channels
+    // double costs no more than float); `finish` rounds them.
+    detail::DoubleSpectrum<typename S::Spectrum> transmittance = decltype(transmittance)::Ones();
+    double null_pdf_product = 1.0;
 
     bool operator()(float t, const Coefficients<S>& c, float mu_bar, float tau) {
-        out.transmittance *= (mu_bar - c.sigma_t()) / mu_bar;
-        if constexpr (kNullRatio) out.null_pdf_product *= event_probabilities<A>(c, mu_bar).null;
+        transmittance *= detail::null_ratio(c, mu_bar);
+        if constexpr (kNullRatio) null_pdf_product *= detail::null_probability<A>(c, mu_bar);
         if constexpr (Rec::enabled) rec.vertex(t, std::log(double(mu_bar)) - tau);
-        // Stop once every channel is below the smallest normal float: a product of factors above
-        // 1/2 stalls at the smallest denormal (1.4e-45 * f rounds back to 1.4e-45) and never
-        // reaches exactly 0, which made thick media cost a lookup per majorant optical depth.
-        if ((out.transmittance.abs() < std::numeric_limits<float>::min()).all()) {
-            out.transmittance.setZero();
-            out.end = SegmentEnd::Terminated;
+        // Stop once every channel is below the smallest normal float, what the float result can
+        // hold: a float product of factors above 1/2 stalls at the smallest denormal and never
+        // reaches 0, which made thick media cost a lookup per majorant optical depth.
+        if ((transmittance.abs() < double(std::numeric_limits<float>::min())).all()) {
+            transmittance.setZero();
+            end = SegmentEnd::Terminated;
             return false;
         }
         return true;
+    }
+
+    /// The segment's result, rounded to float.
+    RatioTrack<S> finish() const noexcept {
+        return {end, typename S::Spectrum(transmittance.template cast<float>()), float(null_pdf_product)};
     }
 };
 
@@ -343,7 +410,7 @@ DeltaTrack<typename M::Spectral> track_delta_visiting(const M& medium, const Maj
         cb.out.t = tmax;
         if constexpr (std::remove_reference_t<Rec>::enabled) rec.log_pdf -= f.tau_tail;
     }
-    return cb.out;
+    return cb.finish();
 }
 
 /// Delta-tracks `ray` over [0, tmax] inside the medium. A `Passed` result means the ray reached
@@ -369,7 +436,7 @@ RatioTrack<typename M::Spectral> track_ratio(const M& medium, const Maj& majoran
     if (f.aborted) return {aborted_end(f), S::Spectrum::Zero(), 1.f};
     if constexpr (std::remove_reference_t<Rec>::enabled)
         if (!f.stopped) rec.log_pdf -= f.tau_tail;
-    return cb.out;
+    return cb.finish();
 }
 
 /// Ratio-tracking transmittance estimate between two points (Novak et al. 2014).
