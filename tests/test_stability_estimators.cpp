@@ -319,7 +319,7 @@ void furnace_and_absorber() {
                 return !std::is_same_v<typename Ec::Estimator::Channels, channels::SpectralTrackingMax>;
             else return false;
         }();
-        check_estimates<Ec>(scene, cam.ray, compare ? 500 : 60, ++seed, expected, kRoundingFloor, false, compare);
+        check_estimates<Ec>(scene, cam.ray, compare ? 300 : 40, ++seed, expected, kRoundingFloor, false, compare);
     }
 }
 

@@ -71,10 +71,11 @@ const Ray kAlongX{Vec3(-2.f, 0.1f, -0.2f), Vec3(1.f, 0.f, 0.f)};
 // collisions per flight, each null factor 1 - 1e-6.
 // Float precision needed: a float factor 1 - 1e-6 is rounded by up to 2^-25 = 3e-8, 3% of its
 // distance to 1, and the same way at every null of a homogeneous stretch, so float products are
-// off by ~3% of tau (T by ~7e-3, ~100 standard errors here); the product must be formed and
-// accumulated with the factor's deficit mu_t / mu_bar kept to ~1e-4 relative (e.g. in double,
-// where the factor is exact to 1e-10 of it).
-// Tolerance: kSigmas standard errors of 32 flights (SE ~7e-5: T-hat = prod (1 - eps), whose
+// off by a few % of tau; the product must be formed and accumulated with the factor's deficit
+// mu_t / mu_bar kept to ~1e-4 relative (e.g. in double, where the factor is exact to 1e-10 of it).
+// Measured with the float products of f788fdb (this test's first commit): 0.73745 with the grey
+// majorant (59 SE off at 32 flights) and 0.73115 with per-channel majorants (135 SE off).
+// Tolerance: kSigmas standard errors of 24 flights (SE ~8e-5: T-hat = prod (1 - eps), whose
 // spread comes from the Poisson count of nulls, sd = T sqrt(N) eps ~ 4e-4) plus kRoundingFloor.
 TEST_CASE_TEMPLATE("known limitation: ratio tracking through 3e5 nulls under a majorant 1e6 x the extinction is "
                    "unbiased",
@@ -82,7 +83,7 @@ TEST_CASE_TEMPLATE("known limitation: ratio tracking through 3e5 nulls under a m
     using H = HomogeneousMedium<S>;
     const H medium = slab<S>(constant_coefficient<S>(0.15f));
     const double exact = std::exp(-0.3);
-    const int n = 32;
+    const int n = 24;
     auto check_mean = [&](const SpecStat<S>& st, const std::string& what) {
         for (int c = 0; c < S::channels; ++c) {
             const Stat& s = st.ch[std::size_t(c)];
@@ -111,7 +112,7 @@ TEST_CASE_TEMPLATE("known limitation: ratio tracking through 3e5 nulls under a m
         CHECK(lookups.count() > std::uint64_t(n) * 250000);  // hundreds of thousands of nulls per flight
         check_mean(ratio, "ratio tracking, global majorant");
         int delta_bad = 0;
-        for (int i = 0; i < 16; ++i) {
+        for (int i = 0; i < 8; ++i) {
             const auto l = draw_wavelengths<S>(rng);
             const auto d = track_delta<absorption::Weight>(medium, maj, kAlongX, kInf, l, rng, lookups);
             delta_bad += !all_finite(d.weight) || !(d.null_pdf_product > 0.f) || d.end == SegmentEnd::Aborted;
