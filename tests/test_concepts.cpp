@@ -121,4 +121,15 @@ TEST_CASE("Pcg32 gives floats in [0, 1), deterministic per seed, different per s
     CHECK(std::abs(sum / n - 0.5) < 5.0 * std::sqrt(1.0 / 12.0 / n));
 }
 
+#if !defined(NSP_DEBUG) && defined(NDEBUG)
+// Release without NSP_DEBUG: debug checks compile to nothing (tests/debug/ covers them on).
+static_assert(!nsp::kDebugChecks, "a release build must not run nsp's debug checks");
+
+TEST_CASE("release: NSP_DEBUG_ASSERT compiles away and never evaluates its condition") {
+    int evaluated = 0;
+    NSP_DEBUG_ASSERT((++evaluated, false), "not evaluated in a release build");
+    CHECK(evaluated == 0);
+}
+#endif
+
 }  // namespace

@@ -217,6 +217,7 @@ public:
                             }
                         }
                     }
+                    NSP_DEBUG_ASSERT(!(w < 0.f) && !(w > 1.f), "an MIS weight left [0, 1]");
                     L += w * beta * scene.lights.emitted(hit, lambda);
                 }
                 break;
@@ -299,6 +300,7 @@ private:
                                           tr.null_pdf_product, ls.pdf);
             }
         }
+        NSP_DEBUG_ASSERT(!(w < 0.f) && !(w > 1.f), "an MIS weight left [0, 1]");
         L += beta * tr.transmittance * ls.radiance * (w * scene.phase.eval(wo, ls.wi) / ls.pdf);
         return Status::Ok;
     }
