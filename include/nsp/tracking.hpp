@@ -62,7 +62,10 @@ template <AbsorptionPolicy A, SpectralMode S>
 EventProbabilities event_probabilities(const Coefficients<S>& c, float mu_bar) noexcept {
     const float a = std::max(0.f, sampling_scalar(c.sigma_a));
     const float s = std::max(0.f, sampling_scalar(c.sigma_s));
-    const float n = std::abs(mu_bar - a - s);
+    // mu_bar - (a + s), not (mu_bar - a) - s: detail::null_probability divides by the same n, and
+    // where the two roundings differed (a clamped lookup with a + s == mu_bar) a null was chosen
+    // with float P_n > 0 while its weight divided by P_n = 0: NaN (found by the fuzzer, tests/fuzz).
+    const float n = std::abs(mu_bar - (a + s));
     // In double: where a + s + n is below 2^-126 (a denormal majorant, met at a zero-length step
     // from u = 0) the float 1 / (a + s + n) overflowed and the probabilities were inf or NaN
     // (found by the fuzzer, tests/fuzz).
