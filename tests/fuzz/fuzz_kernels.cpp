@@ -42,6 +42,14 @@ using namespace nsp;
 constexpr float kBudget = 256.f;
 /// Tolerance of "the weights of one path sum to 1": absolute, about 100 float ulps at 1.
 constexpr float kWeightTol = 1e-5f;
+/// The smallest positive value among `v` (inf if none; the smallest majorant, for diagnostics).
+template <class Spec>
+float min_positive(const Spec& v) {
+    float m = kInf;
+    for (int i = 0; i < v.size(); ++i)
+        if (v[i] > 0.f) m = std::min(m, float(v[i]));
+    return m;
+}
 
 template <class T>
 struct Tag {
@@ -276,7 +284,7 @@ float scale_choice(Input& in) {
 /// largest majorant value it gives, at wavelengths `lambda`.
 template <class Fam, class B, class M>
 std::optional<typename Fam::template type<M, B>> make_majorant(Input& in, const M& medium, const typename M::Spectral::Wavelengths& lambda,
-                                        float& maj_max) {
+                                        float& maj_max, float& maj_min) {
     using Maj = typename Fam::template type<M, B>;
     constexpr MajKind kind = Fam::kind;
     const float ext = medium.max_extinction();
@@ -301,6 +309,7 @@ std::optional<typename Fam::template type<M, B>> make_majorant(Input& in, const 
             Maj maj = mode == 0 ? Maj(medium) : Maj(medium, v);
             NSP_FUZZ_CHECK(!expect_throw);
             maj_max = maj.value();
+            maj_min = maj_max > 0.f ? maj_max : kInf;
             return maj;
         } catch (const InvalidArgument&) {
             return std::nullopt;  // bad values, or a rule beyond those predicted (overflow, rounding to 0)
@@ -316,6 +325,7 @@ std::optional<typename Fam::template type<M, B>> make_majorant(Input& in, const 
                 const auto v = maj.value(lambda);
                 NSP_FUZZ_CHECK(finite_all(v) && (v >= 0.f).all());
                 maj_max = v.maxCoeff();
+                maj_min = min_positive(v);
                 return maj;
             } else {
                 const std::array<int, 3> res = make_res(in, 5);
@@ -323,16 +333,19 @@ std::optional<typename Fam::template type<M, B>> make_majorant(Input& in, const 
                 NSP_FUZZ_CHECK(!expect_throw);
                 // Every cell of a majorant is finite and >= 0 (MajorantSegment's contract).
                 maj_max = 0.f;
+                maj_min = kInf;
                 for (int z = 0; z < res[2]; ++z)
                     for (int y = 0; y < res[1]; ++y)
                         for (int x = 0; x < res[0]; ++x) {
                             float m;
                             if constexpr (kind == MajKind::Grid) {
                                 m = maj.cell(x, y, z);
+                                if (m > 0.f) maj_min = std::min(maj_min, m);
                             } else {
                                 const auto v = maj.cell(x, y, z, lambda);
                                 NSP_FUZZ_CHECK(no_nan(v));
                                 m = v.maxCoeff();
+                                maj_min = std::min(maj_min, min_positive(v));
                             }
                             NSP_FUZZ_CHECK(!std::isnan(m) && m >= 0.f);
                             maj_max = std::max(maj_max, m);
@@ -503,7 +516,7 @@ void drive_free_flight(Input& in, FuzzRng& rng, const M& medium, const Maj& maj,
 /// Delta and ratio tracking with a grey majorant, and their pdfs re-evaluated from the vertices.
 template <class S, class A, class M, class Maj, class Lambda>
 void drive_grey(FuzzRng& rng, const M& medium, const Maj& maj, const Ray& ray, float tmax, const Lambda& lambda,
-                float maj_max) {
+                float maj_max, float maj_min) {
     using B = bound_policy_t<Maj>;
     constexpr bool kSigned = std::is_same_v<B, bound::Signed>;
     constexpr bool kMono = S::channels == 1;
@@ -515,6 +528,11 @@ void drive_grey(FuzzRng& rng, const M& medium, const Maj& maj, const Ray& ray, f
         NSP_FUZZ_CHECK(d.end != SegmentEnd::Terminated && d.end != SegmentEnd::Aborted);
         if (d.end == SegmentEnd::Absorbed) NSP_FUZZ_CHECK(A::as_event);
         if (d.end == SegmentEnd::Rejected) NSP_FUZZ_CHECK((std::is_same_v<B, bound::Reject>) && (d.weight == 0.f).all());
+        if (!finite_all(d.weight))
+            std::fprintf(stderr, "nsp fuzz: delta weight[0] %g, end %d, t %g, tmax %g, P_n product %g, event density %g, "
+                         "majorant %g..%g, %zu vertices\n", double(d.weight[0]), int(d.end), double(d.t), double(tmax),
+                         double(d.null_pdf_product), double(d.event_density), double(maj_min), double(maj_max),
+                         rec.t.size());
         if constexpr (kSigned) NSP_FUZZ_CHECK(no_nan(d.weight));
         else NSP_FUZZ_CHECK(finite_all(d.weight));
         // Grey media with a bounding majorant: the weight is 1 up to rounding-sized negative nulls
@@ -652,11 +670,11 @@ void drive_channels(Input& in, FuzzRng& rng, const M& medium, const Maj& maj, co
 
 template <class S, class M, class Maj, class Lambda>
 void drive_tracking(Input& in, FuzzRng& rng, const M& medium, const Maj& maj, const Ray& ray, float tmax,
-                    const Lambda& lambda, float maj_max) {
+                    const Lambda& lambda, float maj_max, float maj_min) {
     drive_free_flight<S>(in, rng, medium, maj, ray, tmax, lambda);
     if constexpr (!is_per_channel_majorant_v<Maj, M>) {
-        drive_grey<S, absorption::Event>(rng, medium, maj, ray, tmax, lambda, maj_max);
-        drive_grey<S, absorption::Weight>(rng, medium, maj, ray, tmax, lambda, maj_max);
+        drive_grey<S, absorption::Event>(rng, medium, maj, ray, tmax, lambda, maj_max, maj_min);
+        drive_grey<S, absorption::Weight>(rng, medium, maj, ray, tmax, lambda, maj_max, maj_min);
         drive_channels<S, channels::SpectralTrackingAverage, absorption::Event, false>(in, rng, medium, maj, ray, tmax,
                                                                                        lambda, maj_max);
         drive_channels<S, channels::SpectralTrackingMax, absorption::Weight, false>(in, rng, medium, maj, ray, tmax,
@@ -672,15 +690,15 @@ void drive_tracking(Input& in, FuzzRng& rng, const M& medium, const Maj& maj, co
 /// few rays.
 template <class S, class Fam, class B, class M, class Lambda>
 void run_tracking(Input& in, FuzzRng& rng, const M& medium, const std::array<int, 3>& res, const Lambda& lambda) {
-    float maj_max = 0.f;
-    const auto maj = make_majorant<Fam, B>(in, medium, lambda, maj_max);
+    float maj_max = 0.f, maj_min = kInf;
+    const auto maj = make_majorant<Fam, B>(in, medium, lambda, maj_max, maj_min);
     if (!maj) return;
     const Box b = medium.bounds();
     if (!(maj_max * glm::length(b.hi - b.lo) <= kBudget)) return;
     for (int i = 1 + in.pick(3); i > 0; --i) {
         const Ray ray = make_ray(in, b, res);
         const float tmax = make_tmax(in, b);
-        drive_tracking<S>(in, rng, medium, *maj, ray, tmax, lambda, maj_max);
+        drive_tracking<S>(in, rng, medium, *maj, ray, tmax, lambda, maj_max, maj_min);
     }
 }
 
@@ -779,8 +797,8 @@ void run_estimator(Input& in, FuzzRng& rng, const Base& base, const Box& box, co
     const auto go = [&](const auto& medium) {
         using M = std::remove_cvref_t<decltype(medium)>;
         using Maj = typename Case::Fam::template type<M, typename Case::Bound>;
-        float maj_max = 0.f;
-        auto maj = make_majorant<typename Case::Fam, typename Case::Bound>(in, medium, lambda, maj_max);
+        float maj_max = 0.f, maj_min = kInf;
+        auto maj = make_majorant<typename Case::Fam, typename Case::Bound>(in, medium, lambda, maj_max, maj_min);
         // Path estimators track many segments: a tenth of the tracking budget per crossing.
         if (!maj || !(maj_max * glm::length(box.hi - box.lo) <= 0.1f * kBudget)) return;
         const float gs[] = {0.f, 0.5f, -0.9f, 0.999f, 1e-4f};
