@@ -113,8 +113,10 @@ std::array<T, 3> shared_event_probabilities_in(const Coefficients<S>& k, float m
         ps += pa;
         pa = 0;
     }
-    const T inv = T(1) / (pa + ps + pn);  // > 0: some channel has a + s + n >= mu > 0
-    return {pa * inv, ps * inv, pn * inv};
+    // Divided in double: a denormal sum (a denormal majorant) made float's 1 / sum overflow
+    // (found by the fuzzer). The sum is > 0: some channel has a + s + n >= mu > 0.
+    const double sum = double(pa) + double(ps) + double(pn);
+    return {T(double(pa) / sum), T(double(ps) / sum), T(double(pn) / sum)};
 }
 }  // namespace detail
 
@@ -179,8 +181,10 @@ struct ChannelDeltaCollision {
             const EventProbabilities p = shared_event_probabilities<A, CP::throughput_weighted, S>(k, mu_v, st.f);
             d = {Spec::Constant(mu_v * p.absorb), Spec::Constant(mu_v * p.scatter), Spec::Constant(mu_v * p.null)};
         }
-        const float inv = 1.f / mu[c];  // mu_c* > 0: free flight samples nothing where it is 0
-        const float pa = d.absorb[c] * inv, ps = d.scatter[c] * inv;
+        // mu_c* > 0: free flight samples nothing where it is 0. In double: a denormal mu_c* made
+        // float's 1 / mu_c* overflow (found by the fuzzer).
+        const double inv = 1.0 / double(mu[c]);
+        const float pa = float(d.absorb[c] * inv), ps = float(d.scatter[c] * inv);
         const float u = rng.uniform();
         SegmentEnd event;
         if (u < pa) event = SegmentEnd::Absorbed;

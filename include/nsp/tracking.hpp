@@ -52,9 +52,26 @@ struct EventProbabilities {
     float null = 0.f;
 };
 
+namespace detail {
+/// The null coefficient that drives delta tracking's null probability: the channel mean of
+/// |mu_bar - mu_t,c|, which is mu_bar - mean(mu_t) wherever the majorant bounds every channel.
+/// Not |mu_bar - mean(mu_t)|: under bound::Signed on a chromatic medium that is 0 where the
+/// channels' excesses and deficits cancel, no null is ever drawn there, and the channels' null
+/// terms were lost (T_red 0.21 against 0.37; found by the stability suite). mu_t in float as
+/// mu_bar - (a + s) everywhere, so event_probabilities and null_probability agree on whether it is
+/// 0 (where they differed, a null was chosen with P_n > 0 in float and weighed with P_n = 0: NaN;
+/// found by the fuzzer).
+template <SpectralMode S>
+float null_coefficient(const Coefficients<S>& c, float mu_bar) noexcept {
+    if constexpr (S::channels == 1) return std::abs(mu_bar - (c.sigma_a[0] + c.sigma_s[0]));
+    else return sampling_scalar(typename S::Spectrum((mu_bar - c.sigma_t()).abs()));
+}
+}  // namespace detail
+
 /// The event probabilities delta tracking uses at a collision with coefficients `c` under
-/// majorant `mu_bar` > 0. One pdf serves all channels, driven by the channel means. They are
-/// |mu_x| / (mu_a + mu_s + |mu_n|): mu_x / mu_bar where the majorant bounds the extinction, and
+/// majorant `mu_bar` > 0. One pdf serves all channels, driven by the channel means (of mu_a, mu_s
+/// and |mu_n,c|, see detail::null_coefficient). They are |mu_x| / (mu_a + mu_s + |mu_n|): mu_x /
+/// mu_bar where the majorant bounds the extinction, and
 /// where it does not (mu_n < 0, bound::Signed) still in [0, 1] with a null probability that is
 /// not 0, so the tracking weights mu_x / (mu_bar P_x) carry the sign and the estimate stays
 /// unbiased (THEORY 1, 4.3). Clamping P_n at 0 there would drop the negative null term.
@@ -62,10 +79,7 @@ template <AbsorptionPolicy A, SpectralMode S>
 EventProbabilities event_probabilities(const Coefficients<S>& c, float mu_bar) noexcept {
     const float a = std::max(0.f, sampling_scalar(c.sigma_a));
     const float s = std::max(0.f, sampling_scalar(c.sigma_s));
-    // mu_bar - (a + s), not (mu_bar - a) - s: detail::null_probability divides by the same n, and
-    // where the two roundings differed (a clamped lookup with a + s == mu_bar) a null was chosen
-    // with float P_n > 0 while its weight divided by P_n = 0: NaN (found by the fuzzer, tests/fuzz).
-    const float n = std::abs(mu_bar - (a + s));
+    const float n = detail::null_coefficient(c, mu_bar);
     // In double: where a + s + n is below 2^-126 (a denormal majorant, met at a zero-length step
     // from u = 0) the float 1 / (a + s + n) overflowed and the probabilities were inf or NaN
     // (found by the fuzzer, tests/fuzz).
@@ -105,7 +119,7 @@ double null_probability(const Coefficients<S>& c, float mu_bar) noexcept {
     const float a = std::max(0.f, sampling_scalar(c.sigma_a));
     const float s = std::max(0.f, sampling_scalar(c.sigma_s));
     const double t = a + s;  // in float, as event_probabilities forms it
-    const double n = std::abs(double(mu_bar) - t);
+    const double n = null_coefficient(c, mu_bar);
     return n / (t + n);
 }
 }  // namespace detail
