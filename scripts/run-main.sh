@@ -8,6 +8,8 @@
 #     tracking + NEE, equiangular + NEE and their three-way MIS, and the flame in the plume
 #     (set-up P1, rgb, 64x64) with the collision estimator, emission NEE and their MIS, each under
 #     the global and the grid majorant; EXRs in ./out, one efficiency table per set-up and mode;
+# With --with-references it then also runs (about 105 s more, which would take the default run past
+# five minutes on 2 cores with the renderer's build; README's heavy-tail tables come from it):
 #  2. the heavy-tail comparison: the grey-majorant baseline against spectral MIS + NEE (per-channel
 #     and global majorant, uniform selection) on the chromatic cloud, 3 runs each at 32x32. The
 #     baseline's variance is practically infinite: in a typical run it misses the rare huge
@@ -20,18 +22,30 @@
 #     fog: a 1/r^2 tail) and P1 (the collision estimator rarely reaches the flame): 3 runs each,
 #     2048-spp references (fog: uni-nee-eq-mis_balance_absorb-event; plume:
 #     directional-mis_grid_balance_absorb-weight), time x variance from the effective variance.
-# Renders in about 250 s on 2 cores (measured 2026-11-30 at ecb55af, build up to date).
-# With arguments, runs nsp_render once with them instead (see build/examples/nsp_render --help).
+# Step 1 renders in about 140 s on 2 cores, all three in about 250 s (measured 2026-11-30 at
+# ecb55af, build up to date).
+# With other arguments, runs nsp_render once with them instead (see build/examples/nsp_render --help).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh nsp_render
 
+references=0
+if [ "${1:-}" = --with-references ]; then
+    references=1
+    shift
+fi
 if [ $# -gt 0 ]; then
     exec build/examples/nsp_render --out out "$@"
 fi
 
 start=$SECONDS
 build/examples/nsp_render --out out
+if [ "$references" = 0 ]; then
+    echo
+    echo "main job: $((SECONDS - start)) s of rendering (scripts/run-main.sh --with-references adds the"
+    echo "heavy-tail comparisons against 2048-spp references, about 105 s more)"
+    exit 0
+fi
 echo
 echo "Heavy-tail comparison: grey-majorant baseline vs spectral MIS + NEE (per-channel and global"
 echo "majorant), 3 runs, effective variance against a 2048-spp reference"
