@@ -46,8 +46,11 @@ echo "run-fuzz: ${seconds} s over a copy of tests/fuzz/corpus in $scratch"
 # -max_len bounds the structure and the random numbers an input may carry; -timeout (s) catches an
 # input whose work the harness failed to bound; -rss_limit_mb a runaway allocation.
 status=0
+# -seed fixes libFuzzer's mutations (NSP_FUZZ_SEED, default 1): a CI run explores the same inputs
+# every time (as far as its time allows), so a red run is reproducible, not luck; fuzz with other
+# seeds locally to find new inputs.
 (cd "$scratch" && "$repo/build-fuzz/tests/fuzz/nsp_fuzz_kernels" -max_len=1024 -timeout=10 -rss_limit_mb=2048 \
-    -max_total_time="$seconds" -print_final_stats=1 -artifact_prefix="$scratch/artifacts/" corpus) || status=$?
+    -seed="${NSP_FUZZ_SEED:-1}" -max_total_time="$seconds" -print_final_stats=1 -artifact_prefix="$scratch/artifacts/" corpus) || status=$?
 if [ "$status" -ne 0 ] || [ -n "$(ls -A "$scratch/artifacts")" ]; then
     echo "run-fuzz: FAILED (exit $status); inputs in $scratch/artifacts:" >&2
     for f in "$scratch"/artifacts/*; do

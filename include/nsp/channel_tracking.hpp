@@ -313,7 +313,7 @@ ChannelTrack track_channels_delta(const M& medium, const Maj& majorant, const Ra
 template <SpectralMode S>
 struct ChannelShadow {
     using Spec = typename S::Spectrum;
-    SegmentEnd end = SegmentEnd::Passed;  ///< Passed, Terminated (f below FLT_MIN: set to 0) or Aborted
+    SegmentEnd end = SegmentEnd::Passed;  ///< Passed, Terminated (f below FLT_MIN or a pdf overflowed: f, nee and uni set to 0) or Aborted
     Spec f = Spec::Ones();
     Spec nee = Spec::Ones();
     Spec uni = Spec::Ones();
@@ -413,7 +413,10 @@ private:
         constexpr T tiny = std::numeric_limits<float>::min();
         const bool negligible = CP::mis_over_channels ? (f.abs() < tiny * k).all() : !(std::abs(f[c]) >= tiny * k);
         if (!(k > T(0)) || !std::isfinite(k) || negligible) {
+            // The pdfs go with it: where k overflowed they would be inf (found by the fuzzer).
             f.setZero();
+            nee.setZero();
+            uni.setZero();
             out.end = SegmentEnd::Terminated;
             return false;
         }
