@@ -18,6 +18,8 @@ case "${1:-}" in
     *) echo "usage: $0 [--update-corpus]" >&2; exit 2 ;;
 esac
 seconds="${NSP_FUZZ_SECONDS:-120}"
+runs="${NSP_FUZZ_RUNS:-30000}"
+[ "$runs" != 0 ] || runs=-1  # libFuzzer: -runs=-1 is unlimited
 
 packages=(cmake ninja-build clang libclang-rt-dev libglm-dev libeigen3-dev)
 missing=()
@@ -46,11 +48,12 @@ echo "run-fuzz: ${seconds} s over a copy of tests/fuzz/corpus in $scratch"
 # -max_len bounds the structure and the random numbers an input may carry; -timeout (s) catches an
 # input whose work the harness failed to bound; -rss_limit_mb a runaway allocation.
 status=0
-# -seed fixes libFuzzer's mutations (NSP_FUZZ_SEED, default 1): a CI run explores the same inputs
-# every time (as far as its time allows), so a red run is reproducible, not luck; fuzz with other
-# seeds locally to find new inputs.
+# -seed and -runs fix what a run explores (NSP_FUZZ_SEED, default 1; NSP_FUZZ_RUNS, default 30000
+# inputs, about a minute here; 0 = no limit, only NSP_FUZZ_SECONDS): CI runs the same sequence every
+# time, so a red run is reproducible, not luck. To look for new inputs, fuzz locally with other
+# seeds, NSP_FUZZ_RUNS=0 and a longer NSP_FUZZ_SECONDS, then --update-corpus.
 (cd "$scratch" && "$repo/build-fuzz/tests/fuzz/nsp_fuzz_kernels" -max_len=1024 -timeout=10 -rss_limit_mb=2048 \
-    -seed="${NSP_FUZZ_SEED:-1}" -max_total_time="$seconds" -print_final_stats=1 -artifact_prefix="$scratch/artifacts/" corpus) || status=$?
+    -seed="${NSP_FUZZ_SEED:-1}" -runs="$runs" -max_total_time="$seconds" -print_final_stats=1 -artifact_prefix="$scratch/artifacts/" corpus) || status=$?
 if [ "$status" -ne 0 ] || [ -n "$(ls -A "$scratch/artifacts")" ]; then
     echo "run-fuzz: FAILED (exit $status); inputs in $scratch/artifacts:" >&2
     for f in "$scratch"/artifacts/*; do

@@ -35,7 +35,9 @@ namespace detail {
 template <class Spec>
 Spec relative_transmittance(const Spec& tau, int c) noexcept {
     const float ref = std::min(tau[c], tau.minCoeff() + 80.f);
-    return (ref - tau).exp();
+    // An optical depth that overflowed to inf gives inf - inf = NaN: its Tbar is 0 (fuzzer finding 10).
+    const Spec d = ref - tau;
+    return (d == d).select(d.exp(), Spec::Zero());
 }
 }  // namespace detail
 

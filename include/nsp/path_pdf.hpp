@@ -176,13 +176,35 @@ struct ChannelPathState {
         float k = CP::mis_over_channels ? std::max(uni.maxCoeff(), nee.maxCoeff()) : uni[c];
         if constexpr (kEquiangular)
             if (CP::mis_over_channels) k = std::max(k, std::max(eq.vertex.maxCoeff(), eq.nee.maxCoeff()));
-        if (!(k > 0.f) || !std::isfinite(k)) return false;
+        if (!(k > 0.f) || !std::isfinite(k)) {  // dead: zero it all, so no inf is left (fuzzer finding 10)
+            f.setZero();
+            uni.setZero();
+            nee.setZero();
+            if constexpr (kEquiangular) {
+                eq.vertex.setZero();
+                eq.nee.setZero();
+            }
+            return false;
+        }
         f /= k;
         uni /= k;
         nee /= k;
         if constexpr (kEquiangular) {
             eq.vertex /= k;
             eq.nee /= k;
+        }
+        // Independent tracking scales by channel c alone, and an optical depth that overflowed can
+        // leave NaN: a channel whose values are not finite carries nothing the estimate can use,
+        // and is zeroed (fuzzer finding 10). Rare: one test per vertex, the fix only when needed.
+        if (!(f.allFinite() && uni.allFinite() && nee.allFinite())) {
+            const auto ok = f.isFinite() && uni.isFinite() && nee.isFinite();
+            f = ok.select(f, 0.f);
+            uni = ok.select(uni, 0.f);
+            nee = ok.select(nee, 0.f);
+            if constexpr (kEquiangular) {
+                eq.vertex = ok.select(eq.vertex, 0.f);
+                eq.nee = ok.select(eq.nee, 0.f);
+            }
         }
         return true;
     }
