@@ -197,7 +197,7 @@ struct ChannelPathState {
         // leave NaN: a channel whose values are not finite carries nothing the estimate can use,
         // and is zeroed (fuzzer finding 10). Rare: one test per vertex, the fix only when needed.
         if (!(f.allFinite() && uni.allFinite() && nee.allFinite())) {
-            const auto ok = f.isFinite() && uni.isFinite() && nee.isFinite();
+            const auto ok = (f.isFinite() && uni.isFinite() && nee.isFinite()).eval();  // before f changes
             f = ok.select(f, 0.f);
             uni = ok.select(uni, 0.f);
             nee = ok.select(nee, 0.f);
