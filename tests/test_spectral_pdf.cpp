@@ -2,7 +2,8 @@
 // segments with nulls, every channel's pdf, contribution and NEE-alternative pdf that the channel
 // trackers report equal an independent evaluation (pdf.hpp, in double); the spectral-MIS weights
 // over channels x {uni, NEE} sum to 1 and equal the balance heuristic on the independent pdfs;
-// ratios stay finite when channels differ by 1e6 or one has majorant 0.
+// ratios stay finite when channels differ by 1e6 or one has majorant 0; a state whose f / p leaves
+// float's range ends Overflowed and zeroed, and the estimator reports the sample NonFinite.
 #include <cmath>
 #include <limits>
 #include <span>
@@ -333,6 +334,81 @@ TEST_CASE("per-channel pdf ratios stay finite when majorants differ by 1e6 or on
         REQUIRE(r.status == Status::Ok);
         REQUIRE(all_finite(r.value));
     }
+}
+
+TEST_CASE_TEMPLATE("a path state whose f / p leaves float's range ends Overflowed, zeroed, and the estimator says NonFinite",
+                   CP, channels::SpectralMis, channels::Independent) {
+    // Fuzzer finding 10. Extinction 1e30 under bound::Signed with a majorant 1e-25 of it (1e5):
+    // P_n = |mu_n| / (mu_t + |mu_n|) = 1/2 to 1e-25, and one null multiplies f / p by
+    // (mu_bar - mu_t) / (mu_bar P_n) = -2e25, a real collision (absorption weighted: pdf
+    // mu_bar mu_t / (mu_t + |mu_n|), contribution mu_s) by mu_s / mu_t x 2e25 = 1.6e25. So a flight
+    // whose first event is real scatters (f / p = 1.6e25, finite) and one whose first event is a
+    // null overflows at its next event: each with probability 1/2.
+    using M = DenseGridMedium<Rgb>;
+    const M medium(kBox, {2, 2, 2}, std::vector<float>(8, 1e30f), grey<Rgb>(0.2f), grey<Rgb>(0.8f));
+    const ChannelMajorant<M, bound::Signed> maj(medium, 1e-25f);
+    Pcg32 rng(10, 10);
+    NoLookupCount none;
+    constexpr int kFlights = 2000;
+    int scattered = 0, overflowed = 0;
+    for (int i = 0; i < kFlights; ++i) {
+        const Ray ray{Vec3(0.f, 0.f, -1.f), Vec3(0.f, 0.f, 1.f)};
+        const int c = i % 3;
+        ChannelPathState<Rgb> st;
+        st.nee = st.uni;
+        const auto tr = track_channels_delta<CP, absorption::Weight>(medium, maj, ray, 2.f, {}, c, st, true, rng, none);
+        REQUIRE((tr.end == SegmentEnd::Scattered || tr.end == SegmentEnd::Overflowed));
+        REQUIRE(all_finite(st.f));
+        REQUIRE(all_finite(st.uni));
+        REQUIRE(all_finite(st.nee));
+        if (tr.end == SegmentEnd::Overflowed) {
+            ++overflowed;
+            REQUIRE((st.f == 0.f).all());
+            REQUIRE((st.uni == 0.f).all());
+            REQUIRE((st.nee == 0.f).all());
+        } else {
+            ++scattered;
+            REQUIRE(st.uni[c] > 0.f);
+            REQUIRE(st.f[c] / st.uni[c] == doctest::Approx(1.6e25f).epsilon(1e-4));
+        }
+    }
+    // Binomial(2000, 1/2): sd 22.4; 5 sd either side.
+    CHECK(std::abs(overflowed - kFlights / 2) <= 112);
+    CHECK(scattered + overflowed == kFlights);
+
+    // Ratio tracking over the same medium: f / nee = (mu_bar - mu_t) / mu_bar = -1e25 per null and
+    // 1e5 expected nulls over the length 1: past FLT_MAX at the second, so every shadow overflows
+    // (no null at all has probability e^-1e5).
+    for (int i = 0; i < 200; ++i) {
+        const Ray ray{Vec3(0.f, 0.f, -1.f), Vec3(0.f, 0.f, 1.f)};
+        const auto sh = track_channels_ratio<CP, absorption::Weight>(medium, maj, ray, 1.f, {}, i % 3,
+                                                                     Rgb::Spectrum::Ones().eval(), true, rng, none);
+        REQUIRE(sh.end == SegmentEnd::Overflowed);
+        REQUIRE((sh.f == 0.f).all());
+        REQUIRE((sh.nee == 0.f).all());
+    }
+
+    // The estimator discards such a sample and says so; every value it returns is finite.
+    const Scene<M, ChannelMajorant<M, bound::Signed>, HenyeyGreensteinPhase> scene(
+        medium, maj, HenyeyGreensteinPhase(0.f), [] {
+            Lights<Rgb> l;
+            l.set(EnvironmentLight<Rgb>{grey<Rgb>(1.f)});
+            return l;
+        }());
+    const SpectralPathEstimator<CP, strategy::Unidirectional, mis::None> est;
+    int non_finite = 0;
+    for (int i = 0; i < 500; ++i) {
+        const auto r = est.radiance(scene, Ray{Vec3(0.f, 0.f, -3.f), Vec3(0.f, 0.f, 1.f)}, {}, rng, none);
+        REQUIRE(all_finite(r.value));
+        REQUIRE((r.status == Status::Ok || r.status == Status::NonFinite));
+        if (r.status == Status::NonFinite) {
+            ++non_finite;
+            REQUIRE((r.value == 0.f).all());
+        }
+    }
+    // At least every path whose first flight overflows (half of them; 5 sd of Binomial(500, 1/2)
+    // below 250 is 194); later flights overflow too, so this is a lower bound.
+    CHECK(non_finite >= 194);
 }
 
 TEST_CASE("ChannelSelection: probabilities, sampling frequencies (chi-square) and rejected weights") {

@@ -134,7 +134,7 @@ EventProbabilities shared_event_probabilities(const Coefficients<S>& k, float mu
 
 /// How a per-channel delta-tracked segment ended, and where.
 struct ChannelTrack {
-    SegmentEnd end = SegmentEnd::Passed;  ///< Passed, Scattered, Absorbed, Terminated (weight 0) or Aborted
+    SegmentEnd end = SegmentEnd::Passed;  ///< Passed, Scattered, Absorbed, Terminated (weight 0), Overflowed or Aborted
     float t = 0.f;                        ///< the real collision, or tmax
 };
 
@@ -255,8 +255,8 @@ struct ChannelDeltaCollision {
                 st.uni *= d.scatter * tb;
             }
         }
-        if (!st.template renormalize<CP>(c)) {
-            out = {SegmentEnd::Terminated, t};
+        if (const StateScale r = st.template renormalize<CP>(c); r != StateScale::Ok) {
+            out = {r == StateScale::Dead ? SegmentEnd::Terminated : SegmentEnd::Overflowed, t};
             return false;
         }
         if (event == SegmentEnd::Scattered) {
@@ -289,7 +289,8 @@ ChannelTrack track_channels_delta_visiting(const M& medium, const Maj& majorant,
             st.eq.vertex *= tb;
             st.eq.nee *= tb;
         }
-        if (!st.template renormalize<CP>(c)) return {SegmentEnd::Terminated, tmax};
+        if (const StateScale r = st.template renormalize<CP>(c); r != StateScale::Ok)
+            return {r == StateScale::Dead ? SegmentEnd::Terminated : SegmentEnd::Overflowed, tmax};
     }
     if constexpr (RecT::enabled) rec.log_pdf -= double(channel_of(f.tau_tail, c));
     return {SegmentEnd::Passed, tmax};
@@ -315,7 +316,7 @@ ChannelTrack track_channels_delta(const M& medium, const Maj& majorant, const Ra
 template <SpectralMode S>
 struct ChannelShadow {
     using Spec = typename S::Spectrum;
-    SegmentEnd end = SegmentEnd::Passed;  ///< Passed, Terminated (f below FLT_MIN or a pdf overflowed: f, nee and uni set to 0) or Aborted
+    SegmentEnd end = SegmentEnd::Passed;  ///< Passed, Terminated (f below FLT_MIN: f, nee and uni set to 0), Overflowed (a value left float's range; zeroed) or Aborted
     Spec f = Spec::Ones();
     Spec nee = Spec::Ones();
     Spec uni = Spec::Ones();
@@ -405,9 +406,11 @@ private:
     }
 
     /// Rescales by the largest ratio-tracking pdf (by channel c's alone for independent tracking);
-    /// stops once every estimated channel's contribution is below the smallest normal float
-    /// relative to it: the float result could not hold it, and a product of factors above 1/2
-    /// would otherwise never reach 0.
+    /// stops (Terminated) once every estimated channel's contribution is below the smallest normal
+    /// float relative to it: the float result could not hold it, and a product of factors above
+    /// 1/2 would otherwise never reach 0. Where a pdf, or an estimated contribution relative to
+    /// the pdfs, left the range (f / p past FLT_MAX needs mu_t > 2 mu_bar, a majorant that does
+    /// not bound), the value cannot be represented: Overflowed, zeroed, the estimate discarded.
     template <class Arr>
     bool normalize(Arr& f, Arr& nee, Arr& uni) {
         using T = typename Arr::Scalar;
@@ -416,16 +419,27 @@ private:
         const bool negligible = CP::mis_over_channels ? (f.abs() < tiny * k).all() : !(std::abs(f[c]) >= tiny * k);
         if (!(k > T(0)) || !std::isfinite(k) || negligible) {
             // The pdfs go with it: where k overflowed they would be inf (found by the fuzzer).
-            f.setZero();
-            nee.setZero();
-            uni.setZero();
-            out.end = SegmentEnd::Terminated;
+            zero(f, nee, uni, std::isfinite(k) ? SegmentEnd::Terminated : SegmentEnd::Overflowed);
             return false;
         }
         f /= k;
         nee /= k;
         uni /= k;
+        // In float: f / k past FLT_MAX (in double the products have the range to recover).
+        if constexpr (std::is_same_v<T, float>)
+            if (!(CP::mis_over_channels ? f.allFinite() : std::isfinite(f[c]))) [[unlikely]] {
+                zero(f, nee, uni, SegmentEnd::Overflowed);
+                return false;
+            }
         return true;
+    }
+
+    template <class Arr>
+    void zero(Arr& f, Arr& nee, Arr& uni, SegmentEnd end) {
+        f.setZero();
+        nee.setZero();
+        uni.setZero();
+        out.end = end;
     }
 };
 

@@ -16,6 +16,7 @@
 #include <algorithm>
 #include <cmath>
 #include <concepts>
+#include <cstdint>
 #include <type_traits>
 
 #include "core/error.hpp"
@@ -136,6 +137,13 @@ private:
 // ---------------------------------------------------------------------------------------------
 // The state
 
+/// What ChannelPathState::renormalize found.
+enum class StateScale : std::uint8_t {
+    Ok,          ///< rescaled; the path goes on
+    Dead,        ///< no positive pdf was left: the path has weight 0 (the state is zeroed)
+    Overflowed,  ///< a value the estimate needs left float's range: the state is zeroed and the sample discarded
+};
+
 namespace detail {
 /// The equiangular pdf slot of a state whose strategy draws no equiangular vertices: nothing.
 struct NoEquiangularPdf {};
@@ -170,21 +178,20 @@ struct ChannelPathState {
 
     /// Rescales every pdf and f by one factor: by the sampling channel's pdf `uni[c]` when only
     /// that channel is ever estimated (independent tracking), else so that the largest pdf is 1.
-    /// Returns false if there is no positive finite pdf left to scale by (the path is dead).
+    /// A common factor cancels in every ratio the estimate forms; what it cannot rescue is a ratio
+    /// beyond float's range (f / p past FLT_MAX, a NaN from an optical depth that overflowed). Then
+    /// the sample's value cannot be represented, the state is zeroed and `Overflowed` returned: the
+    /// estimator discards the sample and reports it (Status::NonFinite), as it does a non-finite
+    /// estimate. Under independent tracking only channel c counts; the others, never estimated,
+    /// are zeroed where they overflowed. `Dead` (zeroed) when no positive pdf is left.
     template <ChannelPolicy CP>
-    bool renormalize(int c) noexcept {
+    StateScale renormalize(int c) noexcept {
         float k = CP::mis_over_channels ? std::max(uni.maxCoeff(), nee.maxCoeff()) : uni[c];
         if constexpr (kEquiangular)
             if (CP::mis_over_channels) k = std::max(k, std::max(eq.vertex.maxCoeff(), eq.nee.maxCoeff()));
-        if (!(k > 0.f) || !std::isfinite(k)) {  // dead: zero it all, so no inf is left (fuzzer finding 10)
-            f.setZero();
-            uni.setZero();
-            nee.setZero();
-            if constexpr (kEquiangular) {
-                eq.vertex.setZero();
-                eq.nee.setZero();
-            }
-            return false;
+        if (!(k > 0.f) || !std::isfinite(k)) {
+            set_zero();
+            return k == 0.f ? StateScale::Dead : StateScale::Overflowed;
         }
         f /= k;
         uni /= k;
@@ -193,20 +200,43 @@ struct ChannelPathState {
             eq.vertex /= k;
             eq.nee /= k;
         }
-        // Independent tracking scales by channel c alone, and an optical depth that overflowed can
-        // leave NaN: a channel whose values are not finite carries nothing the estimate can use,
-        // and is zeroed (fuzzer finding 10). Rare: one test per vertex, the fix only when needed.
-        if (!(f.allFinite() && uni.allFinite() && nee.allFinite())) {
-            const auto ok = (f.isFinite() && uni.isFinite() && nee.isFinite()).eval();  // before f changes
-            f = ok.select(f, 0.f);
-            uni = ok.select(uni, 0.f);
-            nee = ok.select(nee, 0.f);
-            if constexpr (kEquiangular) {
-                eq.vertex = ok.select(eq.vertex, 0.f);
-                eq.nee = ok.select(eq.nee, 0.f);
+        if (!all_finite()) [[unlikely]] {  // one test per vertex; the rest only when a value overflowed
+            if constexpr (CP::mis_over_channels) {
+                set_zero();  // every channel is estimated: the sample is lost (fuzzer finding 10)
+                return StateScale::Overflowed;
+            } else {
+                auto ok = (f.isFinite() && uni.isFinite() && nee.isFinite()).eval();  // before f changes
+                if constexpr (kEquiangular) ok = ok && eq.vertex.isFinite() && eq.nee.isFinite();
+                if (!ok[c]) {
+                    set_zero();
+                    return StateScale::Overflowed;
+                }
+                f = ok.select(f, 0.f);
+                uni = ok.select(uni, 0.f);
+                nee = ok.select(nee, 0.f);
+                if constexpr (kEquiangular) {
+                    eq.vertex = ok.select(eq.vertex, 0.f);
+                    eq.nee = ok.select(eq.nee, 0.f);
+                }
             }
         }
-        return true;
+        return StateScale::Ok;
+    }
+
+private:
+    bool all_finite() const noexcept {
+        bool ok = f.allFinite() && uni.allFinite() && nee.allFinite();
+        if constexpr (kEquiangular) ok = ok && eq.vertex.allFinite() && eq.nee.allFinite();
+        return ok;
+    }
+    void set_zero() noexcept {
+        f.setZero();
+        uni.setZero();
+        nee.setZero();
+        if constexpr (kEquiangular) {
+            eq.vertex.setZero();
+            eq.nee.setZero();
+        }
     }
 };
 

@@ -289,6 +289,7 @@ enum class SegmentEnd : std::uint8_t {
     Terminated,  ///< ratio tracking: every channel's weight fell below the smallest normal float (set to 0)
     Aborted,     ///< the collision limit was reached; the estimate is discarded (weight 0)
     Rejected,    ///< bound::Reject met mu_t > mu_bar; the estimate is discarded (weight 0)
+    Overflowed,  ///< per-channel tracking: a contribution or pdf left float's range; the estimate is discarded (weight 0)
 };
 
 /// How an aborted flight ends a segment: Rejected (bound::Reject) or Aborted (collision limit).

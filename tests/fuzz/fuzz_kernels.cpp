@@ -615,12 +615,14 @@ void drive_channels(Input& in, FuzzRng& rng, const M& medium, const Maj& maj, co
         if (tr.end == SegmentEnd::Absorbed) NSP_FUZZ_CHECK(A::as_event);
         if (tr.end == SegmentEnd::Rejected) NSP_FUZZ_CHECK((std::is_same_v<B, bound::Reject>));
         if (tr.end == SegmentEnd::Passed) NSP_FUZZ_CHECK(tr.t == tmax);
+        // A state that ends dead or overflowed is zeroed (finding 10: f / p overflowed float).
+        if (tr.end == SegmentEnd::Terminated || tr.end == SegmentEnd::Overflowed)
+            NSP_FUZZ_CHECK((st.f == 0.f).all() && (st.uni == 0.f).all() && (st.nee == 0.f).all());
         // Pdfs are finite and >= 0; contributions finite (any sign under bound::Signed).
         NSP_FUZZ_CHECK(finite_all(st.uni) && (st.uni >= 0.f).all());
         NSP_FUZZ_CHECK(finite_all(st.nee) && (st.nee >= 0.f).all());
         if constexpr (kEq) NSP_FUZZ_CHECK(finite_all(st.eq.vertex) && (st.eq.vertex >= 0.f).all());
-        if constexpr (kSigned) NSP_FUZZ_CHECK(no_nan(st.f));
-        else NSP_FUZZ_CHECK(finite_all(st.f));
+        NSP_FUZZ_CHECK(finite_all(st.f));
         if (tr.end == SegmentEnd::Scattered || tr.end == SegmentEnd::Passed) {
             // A sample is taken (or the segment passed): the pdf the estimate divides by is > 0.
             NSP_FUZZ_CHECK(tr.t >= 0.f && tr.t <= tmax);
@@ -653,7 +655,7 @@ void drive_channels(Input& in, FuzzRng& rng, const M& medium, const Maj& maj, co
         const auto sh = track_channels_ratio<CP, A>(medium, maj, ray, tmax, lambda, c, weights, uni_alternative, rng,
                                                     counter);
         NSP_FUZZ_CHECK(sh.end == SegmentEnd::Passed || sh.end == SegmentEnd::Terminated ||
-                       sh.end == SegmentEnd::Rejected);
+                       sh.end == SegmentEnd::Overflowed || sh.end == SegmentEnd::Rejected);
         if (sh.end == SegmentEnd::Rejected) NSP_FUZZ_CHECK((std::is_same_v<B, bound::Reject>));
         if (sh.end != SegmentEnd::Passed) NSP_FUZZ_CHECK((sh.f == 0.f).all());
         if constexpr (kSigned) NSP_FUZZ_CHECK(no_nan(sh.f));

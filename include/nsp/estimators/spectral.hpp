@@ -178,7 +178,10 @@ public:
             }
             st.f *= ps.value;
             st.uni *= rr * ps.pdf;
-            if (!st.template renormalize<CP>(c)) break;
+            if (const StateScale r = st.template renormalize<CP>(c); r != StateScale::Ok) {
+                if (r == StateScale::Overflowed) status = Status::NonFinite;
+                break;
+            }
             prev_x = x;
             from_camera = false;
             ray = Ray{x, ps.wi};
@@ -205,7 +208,7 @@ private:
         const bool uni_alternative = St::combines && !ls.delta;  // a point light cannot be hit
         const auto sh = track_channels_ratio<CP, A>(scene.medium, scene.majorant, shadow, ls.distance, lambda, c,
                                                     f_x, uni_alternative, rng, counter);
-        if (sh.end == SegmentEnd::Aborted || sh.end == SegmentEnd::Rejected) return flight_status(sh.end);
+        if (const Status fs = flight_status(sh.end); fs != Status::Ok) return fs;
         if (sh.end == SegmentEnd::Terminated) return Status::Ok;
         using Spectrum = typename Sc::Spectrum;
         const Spectrum f = f_x * sh.f * scene.phase.eval(wo, ls.wi);
@@ -264,7 +267,7 @@ private:
         if (!e) return Status::Ok;
         const auto sh = track_channels_ratio<CP, A>(scene.medium, scene.majorant, e->shadow, e->dist, lambda, c, st.f,
                                                     St::combines, rng, counter);
-        if (sh.end == SegmentEnd::Aborted || sh.end == SegmentEnd::Rejected) return flight_status(sh.end);
+        if (const Status fs = flight_status(sh.end); fs != Status::Ok) return fs;
         if (sh.end == SegmentEnd::Terminated) return Status::Ok;
         const auto v = lookup_untracked(scene.medium, scene.majorant, e->shadow, e->dist, lambda, counter);
         if (!v) return Status::Rejected;
@@ -292,7 +295,7 @@ private:
         if (!(ds.pdf > 0.f)) return Status::Ok;
         const auto sh = track_channels_ratio<CP, A>(scene.medium, scene.majorant, ray, ds.t, lambda, c, st.f,
                                                     St::combines, rng, counter);
-        if (sh.end == SegmentEnd::Aborted || sh.end == SegmentEnd::Rejected) return flight_status(sh.end);
+        if (const Status fs = flight_status(sh.end); fs != Status::Ok) return fs;
         if (sh.end == SegmentEnd::Terminated) return Status::Ok;
         const Vec3 x = ray.at(ds.t);
         const auto v = lookup_untracked(scene.medium, scene.majorant, ray, ds.t, lambda, counter);
