@@ -21,19 +21,7 @@ seconds="${NSP_FUZZ_SECONDS:-120}"
 runs="${NSP_FUZZ_RUNS:-30000}"
 [ "$runs" != 0 ] || runs=-1  # libFuzzer: -runs=-1 is unlimited
 
-packages=(cmake ninja-build clang libclang-rt-dev libglm-dev libeigen3-dev)
-missing=()
-for p in "${packages[@]}"; do
-    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
-done
-if [ ${#missing[@]} -gt 0 ]; then
-    echo "run-fuzz: installing ${missing[*]}"
-    sudo_cmd=()
-    [ "$(id -u)" -eq 0 ] || sudo_cmd=(sudo)
-    export DEBIAN_FRONTEND=noninteractive
-    "${sudo_cmd[@]}" apt-get update -qq
-    "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
-fi
+scripts/install-packages.sh run-fuzz cmake ninja-build clang libclang-rt-dev libglm-dev libeigen3-dev
 
 generator=()
 command -v ninja >/dev/null && generator=(-G Ninja)

@@ -24,19 +24,7 @@ read -r -a tests <<< "${*:-${NSP_SANITIZE_TESTS:-$default_tests}}"
 
 # clang, not g++: with the sanitizers on, g++ took several times its Release time on these
 # template-heavy files (the fuzz harness over 25 minutes); clang compiles them in about that time.
-packages=(clang libclang-rt-dev)
-missing=()
-for p in "${packages[@]}"; do
-    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
-done
-if [ ${#missing[@]} -gt 0 ]; then
-    echo "run-sanitizers: installing ${missing[*]}"
-    sudo_cmd=()
-    [ "$(id -u)" -eq 0 ] || sudo_cmd=(sudo)
-    export DEBIAN_FRONTEND=noninteractive
-    "${sudo_cmd[@]}" apt-get update -qq
-    "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
-fi
+scripts/install-packages.sh run-sanitizers clang libclang-rt-dev
 
 CC=clang CXX=clang++ NSP_BUILD_DIR=build-asan NSP_CMAKE_ARGS="-DCMAKE_BUILD_TYPE=Debug \
 -DCMAKE_CXX_FLAGS_DEBUG=-O1 -DNSP_SANITIZE=address,undefined -DNSP_BUILD_EXAMPLES=OFF \

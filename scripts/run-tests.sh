@@ -27,18 +27,7 @@ export NSP_FUZZ_SECONDS="${NSP_FUZZ_SECONDS:-120}"
 [ $((sanitize + fuzz)) -gt 0 ] || exit 0
 
 # Both stages need clang; install it once here, not from both at the same time (apt's lock).
-missing=()
-for p in clang libclang-rt-dev; do
-    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
-done
-if [ ${#missing[@]} -gt 0 ]; then
-    echo "run-tests: installing ${missing[*]}"
-    sudo_cmd=()
-    [ "$(id -u)" -eq 0 ] || sudo_cmd=(sudo)
-    export DEBIAN_FRONTEND=noninteractive
-    "${sudo_cmd[@]}" apt-get update -qq
-    "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
-fi
+scripts/install-packages.sh run-tests clang libclang-rt-dev
 
 logs="$(mktemp -d "${TMPDIR:-/tmp}/nsp-tests.XXXXXX")"
 san_status=0 fuzz_status=0
