@@ -32,5 +32,6 @@ CC=clang CXX=clang++ NSP_BUILD_DIR=build-asan NSP_CMAKE_ARGS="-DCMAKE_BUILD_TYPE
 
 export ASAN_OPTIONS="halt_on_error=1:abort_on_error=1:detect_leaks=1:detect_stack_use_after_return=1"
 export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1"
-regex="^($(IFS='|'; echo "${tests[*]}"))\$"
+# A suite may run as several ctest entries (NAME, NAME_part2: see tests/CMakeLists.txt).
+regex="^($(IFS='|'; echo "${tests[*]}"))(_part2)?\$"
 ctest --test-dir build-asan --output-on-failure --timeout 1500 -j "$(nproc)" -R "$regex"
