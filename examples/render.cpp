@@ -334,6 +334,9 @@ usage: nsp_render [flags]
                      on --threads
   --max-depth N      most real scattering vertices on a path, N >= 0 (default 1000; 0 renders
                      the directly transmitted light only); Russian roulette from depth 3 on
+  --equiangular-every-segment
+                     the three-way MIS (uni-nee-eq-mis) draws an equiangular vertex on every
+                     segment, not with probability min(1, p_eq / mu_bar) at the density's peak
   --out DIR          directory for the EXR images (default out), created if missing; one linear
                      RGB image (linear sRGB in hero mode) per row, from its first run, named
                      SETUP_ROW[_rgb|_hero].exr, e.g. C1_uni-nee-mis_balance_absorb-weight_hero.exr
@@ -459,6 +462,9 @@ Options parse(int argc, char** argv) {
             o.runs = parse_number<int>(flag, value(), 1, 1000);
         } else if (flag == "--max-depth") {
             o.estimator.max_depth = parse_number<int>(flag, value(), 0, 1 << 20);
+        } else if (flag == "--equiangular-every-segment") {
+            no_value();
+            o.estimator.adaptive_equiangular = false;
         } else if (flag == "--out") {
             o.out = std::string(value());
             if (o.out.empty()) usage_error("--out needs a directory name");

@@ -1,7 +1,9 @@
 // tests/test_equiangular_estimators.cpp: the equiangular path strategies (THEORY 5.4) are
 // unbiased: single scattering from a point light against quadrature of the closed-form
-// integrand, a furnace whose point light aims the equiangular vertices, and multiple scattering
-// with roulette and a sphere light against null-scattering MIS; finite at the extremes.
+// integrand (also in a dense medium, where the three-way MIS draws the equiangular vertex on a
+// fraction of the segments), a furnace whose point light aims the equiangular vertices, and
+// multiple scattering with roulette and a sphere light against null-scattering MIS; finite at
+// the extremes.
 #include <cmath>
 #include <string>
 #include <tuple>
@@ -70,6 +72,79 @@ TEST_CASE_TEMPLATE_DEFINE("equiangular strategies: single scattering from a poin
         [&](auto kind) { run(decltype(kind)::make(medium), decltype(kind)::name); });
 }
 TEST_CASE_TEMPLATE_APPLY(eq_single, AnalyticMediaCombos);
+
+TEST_CASE("equiangular_probability: min(1, p_eq / mu_bar) at the equiangular density's peak") {
+    const Box box{Vec3(-1.f), Vec3(1.f)};
+    const Ray ray{Vec3(-3.f, 0.f, 0.f), Vec3(1.f, 0.f, 0.f)};
+    const Vec3 light(0.25f, 0.4f, 0.f);  // foot point t = 3.25, D = 0.4; the stretch is [2, 4]
+    const EquiangularSampler eq(ray, light, 2.f, 4.f);
+    CHECK(eq.peak() == doctest::Approx(3.25f));
+    // p_eq(peak) = D / ((theta1 - theta0) D^2) = 1 / ((theta1 - theta0) D).
+    const double span = std::atan(0.75 / 0.4) - std::atan(-1.25 / 0.4);
+    const double peak_pdf = 1.0 / (span * 0.4);
+    for (const float mu : {0.5f, 1.f, 4.f, 40.f}) {
+        const auto medium = make_medium<HomogeneousMedium<Mono>>(box, 1.f, grey<Mono>(0.1f * mu), grey<Mono>(0.9f * mu));
+        const float p = equiangular_probability<HomogeneousMedium<Mono>>(GlobalMajorant<HomogeneousMedium<Mono>>(medium),
+                                                                         ray, eq, {});
+        CAPTURE(mu);
+        CHECK(p == doctest::Approx(std::min(1.0, peak_pdf / mu)).epsilon(1e-5));
+    }
+    // The peak clamped to the stretch: the foot point beyond it.
+    const EquiangularSampler beyond(ray, Vec3(6.f, 0.5f, 0.f), 2.f, 4.f);
+    CHECK(beyond.peak() == 4.f);
+    // A majorant of 0 where the density peaks (an empty medium): 1, never NaN.
+    const auto empty = make_medium<HomogeneousMedium<Mono>>(box, 0.f, grey<Mono>(0.f), grey<Mono>(0.f));
+    CHECK(equiangular_probability<HomogeneousMedium<Mono>>(GlobalMajorant<HomogeneousMedium<Mono>>(empty), ray, eq, {}) ==
+          1.f);
+}
+
+TEST_CASE_TEMPLATE_DEFINE("equiangular MIS in a dense medium: the vertex drawn on a fraction of the segments, = quadrature",
+                          C, eq_dense) {
+    using S = typename C::Spectral;
+    using M = typename C::Medium;
+    using A = typename C::Absorption;
+    const Box box{Vec3(-1.f), Vec3(1.f)};
+    // Optical thickness about 6-10 across the box: at the equiangular peak the majorant (3-5) is
+    // above the density p_eq ~ 1.3 of a light 0.3 from the ray, so the camera segment draws its
+    // equiangular vertex with probability p < 1 (about 0.3-0.45, checked), and the equiangular
+    // technique's pdf carries that factor in every weight. Both settings must match the quadrature.
+    const M medium = make_medium<M>(box, 3.f, spec<S>(0.2f, 0.1f, 0.4f), spec<S>(0.8f, 0.4f, 1.2f));
+    const Vec3 light(0.2f, 0.25f, -0.1f);
+    Lights<S> lights;
+    lights.set(PointLight<S>{light, grey<S>(2.f)});
+    const Ray ray{Vec3(-3.f, 0.05f, -0.05f), glm::normalize(Vec3(1.f, 0.01f, -0.02f))};
+    const auto ref = single_scatter_reference(medium, ray, light, 2.f);
+    EstimatorOptions adaptive, every;
+    adaptive.max_depth = every.max_depth = 1;
+    every.adaptive_equiangular = false;
+    auto run = [&](const auto& maj, const std::string& maj_name) {
+        const Interval in = medium.bounds().clip(ray, 0.f, kInf);
+        const float p = equiangular_probability<M>(maj, ray, EquiangularSampler(ray, light, in.t0, in.t1), {});
+        MESSAGE(maj_name << ": camera segment draws its equiangular vertex with probability " << p);
+        CHECK(p > 0.f);
+        CHECK(p < 1.f);
+        const auto scene = Scene(medium, maj, IsotropicPhase{}, lights);
+        auto check = [&](const auto& est, const char* setting, int seed) {
+            using E = std::remove_cvref_t<decltype(est)>;
+            const auto res = estimate_radiance(est, scene, ray, 20000, std::uint64_t(seed));
+            CHECK(res.not_ok == 0);
+            for (int c = 0; c < S::channels; ++c) {
+                const Stat& s = res.stat.ch[c];
+                CAPTURE(c);
+                MESSAGE(combo_name<C>() << " " << maj_name << " " << estimator_name<E>() << " " << setting << ": "
+                                        << s.mean << " (SE " << s.se() << "), quadrature " << ref[c]);
+                CHECK(ref[c] > 1e-4);  // a non-trivial answer
+                CHECK(std::abs(s.mean - ref[c]) <= kSigmas * s.se() + kRoundingFloor);
+            }
+        };
+        check(PathEstimator<strategy::EquiangularMis, mis::Balance, A>(adaptive), "adaptive", 51);
+        check(PathEstimator<strategy::EquiangularMis, mis::Power, A>(adaptive), "adaptive", 52);
+        check(PathEstimator<strategy::EquiangularMis, mis::Balance, A>(every), "every segment", 53);
+    };
+    run(GlobalMajorant<M>(medium), "global");
+    for_each_kind<std::tuple<GridKind>, M>([&](auto kind) { run(decltype(kind)::make(medium), decltype(kind)::name); });
+}
+TEST_CASE_TEMPLATE_APPLY(eq_dense, AnalyticMediaCombos);
 
 TEST_CASE_TEMPLATE_DEFINE("equiangular strategies: furnace with the point light as target gives 1", C, eq_furnace) {
     using S = typename C::Spectral;

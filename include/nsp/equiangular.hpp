@@ -54,6 +54,10 @@ public:
     /// The density of distance t (0 outside [t0, t1] or for an empty stretch).
     float pdf(float t) const noexcept { return valid_ && t >= t0_ && t <= t1_ ? density(t) : 0.f; }
 
+    /// The distance in [t0, t1] where the density is largest: the foot point, clamped (0 for an
+    /// empty stretch).
+    float peak() const noexcept { return valid_ ? std::clamp(delta_, t0_, t1_) : 0.f; }
+
     float distance_to_ray() const noexcept { return d_; }  ///< D (floored)
     float foot() const noexcept { return delta_; }         ///< Delta
 

@@ -9,6 +9,7 @@
 #include <type_traits>
 
 #include "../core/error.hpp"
+#include "../equiangular.hpp"
 #include "../light.hpp"
 #include "../media/emissive.hpp"
 #include "../pdf.hpp"
@@ -80,6 +81,9 @@ struct EstimatorOptions {
     bool russian_roulette = true;  ///< roulette at real vertices from `rr_start_depth` on
     int rr_start_depth = 3;        ///< first real vertex (1-based) at which roulette may stop a path
     float rr_max_survival = 0.95f; ///< survival q = min(rr_max_survival, max_c |throughput_c|), in (0, 1]
+    /// strategy::EquiangularMis: draw the equiangular vertex of a segment with the probability of
+    /// equiangular_probability (below) instead of on every segment. Off: on every segment.
+    bool adaptive_equiangular = true;
 };
 
 /// How a radiance estimate ended.
@@ -114,6 +118,30 @@ struct UntrackedVertex {
     Coefficients<typename M::Spectral> k;  ///< the lookup, clamped to the majorant under bound::Clamp
     MajorantValue<Maj, M> mu;              ///< the majorant there (grey or per channel)
 };
+
+/// The probability with which the three-way MIS (strategy::EquiangularMis) draws an equiangular
+/// vertex on a segment: min(1, p_eq(t*) / mu_bar(t*)) at the equiangular density's peak t*, with
+/// the largest channel's majorant there. p_eq(t*) / mu_bar(t*) compares the equiangular density
+/// with the largest density tracking can have where equiangular sampling concentrates: above 1
+/// (a thin medium at the scale of the light's distance from the ray) tracking rarely puts a vertex
+/// where the light's 1 / r^2 peaks, and every segment draws one; below it (a dense medium) tracking
+/// already does, and an equiangular vertex, which costs a second flight and a second shadow ray,
+/// is drawn on that fraction of the segments. One-sample MIS with an expected sample count (Veach
+/// 1997, 9.2): the equiangular technique's pdf is this probability x its density in every weight
+/// and every pdf sum, which keeps the estimator unbiased for any probability in (0, 1]. A function
+/// of the segment alone (ray, stretch, light, majorant), so every technique evaluates the same
+/// value. 1 where the majorant is 0 at the peak.
+template <Medium M, MajorantPolicy<M> Maj>
+float equiangular_probability(const Maj& majorant, const Ray& ray, const EquiangularSampler& eq,
+                              const typename M::Spectral::Wavelengths& lambda) noexcept {
+    const float t = eq.peak();
+    const auto mu = majorant_value_at_point<M>(majorant, ray, t, lambda);
+    float mu_max;
+    if constexpr (std::is_same_v<std::remove_cvref_t<decltype(mu)>, float>) mu_max = mu;
+    else mu_max = mu.maxCoeff();
+    const float r = eq.pdf(t) / mu_max;  // inf where mu_max = 0; NaN only for pdf 0 and mu 0
+    return r < 1.f ? r : 1.f;            // NaN and inf give 1
+}
 
 /// One density lookup (counted) at distance t on `ray` with the majorant there, treated as
 /// free_flight treats its lookups: clamped under bound::Clamp; std::nullopt under bound::Reject

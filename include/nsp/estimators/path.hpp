@@ -171,12 +171,16 @@ public:
             const LightHit hit = scene.lights.intersect(ray);
             // Equiangular: a real vertex on this segment aimed at the light, and NEE from it.
             EquiangularSampler eq;
+            float eq_select = 1.f;  // the probability of drawing this segment's equiangular vertex
             if constexpr (St::equiangular) {
                 if (target) {
                     const Interval in = scene.medium.bounds().clip(ray, 0.f, hit.t);
                     eq = EquiangularSampler(ray, *target, in.t0, in.t1);
-                    if (depth < opts_.max_depth) {
-                        const Status es = equiangular_vertex(scene, ray, eq, depth + 1, beta, lambda, rng, counter, L);
+                    if (St::combines && opts_.adaptive_equiangular)
+                        eq_select = equiangular_probability<typename Sc::MediumType>(scene.majorant, ray, eq, lambda);
+                    if (depth < opts_.max_depth && (eq_select >= 1.f || rng.uniform() < eq_select)) {
+                        const Status es =
+                            equiangular_vertex(scene, ray, eq, eq_select, depth + 1, beta, lambda, rng, counter, L);
                         if (es != Status::Ok) status = es;
                     }
                 }
@@ -230,7 +234,8 @@ public:
             // density (THEORY 5.4); inf if the tracking pdf underflowed.
             float eq_ratio = 0.f;
             if constexpr (St::equiangular)
-                if (target) eq_ratio = equiangular_over_tracking(eq.pdf(seg.t), seg.null_pdf_product, seg.event_density);
+                if (target)
+                    eq_ratio = equiangular_over_tracking(eq_select * eq.pdf(seg.t), seg.null_pdf_product, seg.event_density);
             // Roulette survival is fixed before NEE: the continuing unidirectional path carries it.
             float q = 1.f;
             if (opts_.russian_roulette && depth >= opts_.rr_start_depth)
@@ -307,12 +312,15 @@ private:
 
     /// Equiangular + NEE on the segment `ray` (THEORY 5.4): draws t with `eq`, ratio-tracks the
     /// nulls on [0, t), makes t a real scattering vertex at path depth `depth` and does NEE from
-    /// it. `beta` is the throughput of the prefix (up to the ray's origin).
+    /// it. `beta` is the throughput of the prefix (up to the ray's origin); `select` the
+    /// probability with which this segment draws an equiangular vertex at all (its density is
+    /// select x eq's).
     template <class Sc, UniformRng R, LookupCounter C>
-    Status equiangular_vertex(const Sc& scene, const Ray& ray, const EquiangularSampler& eq, int depth,
+    Status equiangular_vertex(const Sc& scene, const Ray& ray, const EquiangularSampler& eq, float select, int depth,
                               const typename Sc::Spectrum& beta, const typename Sc::Spectral::Wavelengths& lambda,
                               R& rng, C& counter, typename Sc::Spectrum& L) const {
-        const DistanceSample ds = eq.sample(rng.uniform());
+        DistanceSample ds = eq.sample(rng.uniform());
+        ds.pdf *= select;
         if (!(ds.pdf > 0.f)) return Status::Ok;
         const auto tr = track_ratio<A, St::combines>(scene.medium, scene.majorant, ray, ds.t, lambda, rng, counter);
         if (tr.end == SegmentEnd::Aborted || tr.end == SegmentEnd::Rejected) return flight_status(tr.end);

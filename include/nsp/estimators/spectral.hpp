@@ -101,13 +101,17 @@ public:
             // Equiangular: a real vertex on this segment aimed at the light, NEE from it; and the
             // equiangular pdf of the vertex tracking is about to draw starts from the same prefix.
             EquiangularSampler eq;
+            float eq_select = 1.f;  // the probability of drawing this segment's equiangular vertex
             if constexpr (St::equiangular) {
                 st.eq.vertex = st.uni;
                 if (target) {
                     const Interval in = scene.medium.bounds().clip(ray, 0.f, hit.t);
                     eq = EquiangularSampler(ray, *target, in.t0, in.t1);
-                    if (depth < opts_.max_depth) {
-                        const Status es = equiangular_vertex(scene, ray, eq, depth + 1, lambda, q, c, st, rng, counter, L);
+                    if (St::combines && opts_.adaptive_equiangular)
+                        eq_select = equiangular_probability<typename Sc::MediumType>(scene.majorant, ray, eq, lambda);
+                    if (depth < opts_.max_depth && (eq_select >= 1.f || rng.uniform() < eq_select)) {
+                        const Status es =
+                            equiangular_vertex(scene, ray, eq, eq_select, depth + 1, lambda, q, c, st, rng, counter, L);
                         if (es != Status::Ok) status = es;
                     }
                 }
@@ -147,7 +151,7 @@ public:
             // Every channel's equiangular pdf of x (same prefix and normaliser as st.uni).
             Spectrum eq_pdf = Spectrum::Zero();
             if constexpr (St::equiangular)
-                if (target) eq_pdf = st.eq.vertex * eq.pdf(seg.t);
+                if (target) eq_pdf = st.eq.vertex * (eq_select * eq.pdf(seg.t));
             // Roulette survival is fixed before NEE: the continuing unidirectional path carries it.
             // It follows what the path would contribute per unit of incident light, the largest
             // channel estimate, as PathEstimator's max |beta| does.
@@ -284,14 +288,16 @@ private:
     /// Equiangular + NEE on the segment `ray` (THEORY 5.4 per channel): draws t with `eq`,
     /// ratio-tracks the nulls on [0, t) with channel c's majorant and every channel's pdfs, makes t
     /// a real scattering vertex at path depth `depth` and does NEE from it. `st` is the prefix up
-    /// to the ray's origin, its direction included.
+    /// to the ray's origin, its direction included; `select` the probability with which this
+    /// segment draws an equiangular vertex at all (its density is select x eq's).
     template <class Sc, UniformRng R, LookupCounter C, class State>
-    Status equiangular_vertex(const Sc& scene, const Ray& ray, const EquiangularSampler& eq, int depth,
+    Status equiangular_vertex(const Sc& scene, const Ray& ray, const EquiangularSampler& eq, float select, int depth,
                               const typename Sc::Spectral::Wavelengths& lambda, const typename Sc::Spectrum& q, int c,
                               const State& st, R& rng, C& counter, typename Sc::Spectrum& L) const {
         using S = typename Sc::Spectral;
         using Spectrum = typename Sc::Spectrum;
-        const DistanceSample ds = eq.sample(rng.uniform());
+        DistanceSample ds = eq.sample(rng.uniform());
+        ds.pdf *= select;
         if (!(ds.pdf > 0.f)) return Status::Ok;
         const auto sh = track_channels_ratio<CP, A>(scene.medium, scene.majorant, ray, ds.t, lambda, c, st.f,
                                                     St::combines, rng, counter);
