@@ -8,6 +8,7 @@
 // Statistical checks: fixed seeds (deterministic), k = 5 standard errors estimated from the
 // samples (combined for two independent runs), plus kRoundingFloor where every sample may equal
 // the expected value.
+#include <array>
 #include <cmath>
 #include <string>
 #include <tuple>
@@ -22,6 +23,20 @@ using namespace nsp_test;
 
 constexpr double kSigmas = 5.0;
 const Box kBox{Vec3(-1.f), Vec3(1.f)};
+
+/// Checks every channel's mean of `res` against the single-scattering quadrature `ref` x the
+/// light's intensity per channel, within kSigmas standard errors.
+template <class Res>
+void check_against_quadrature(const Res& res, const std::array<double, 3>& ref,
+                              const std::array<double, 3>& intensity, const std::string& label) {
+    for (int c = 0; c < 3; ++c) {
+        const Stat& s = res.stat.ch[std::size_t(c)];
+        const double expected = ref[std::size_t(c)] * intensity[std::size_t(c)];
+        CAPTURE(c);
+        MESSAGE(label << ": " << s.mean << " (SE " << s.se() << "), quadrature " << expected);
+        CHECK(std::abs(s.mean - expected) <= kSigmas * s.se() + kRoundingFloor);
+    }
+}
 
 template <ChannelPolicy CP, AbsorptionPolicy A>
 using EquiangularOf = std::tuple<SpectralPathEstimator<CP, strategy::EquiangularNextEvent, mis::None, A>,
@@ -69,14 +84,7 @@ TEST_CASE_TEMPLATE_DEFINE("spectral equiangular: single scattering from a point 
             const auto scene = Scene(medium, maj, IsotropicPhase{}, lights);
             const auto res = estimate_radiance(est, scene, ray, 20000, std::uint64_t(++seed));
             CHECK(res.not_ok == 0);
-            for (int c = 0; c < 3; ++c) {
-                const Stat& s = res.stat.ch[std::size_t(c)];
-                const double expected = ref[std::size_t(c)] * intensity[std::size_t(c)];
-                CAPTURE(c);
-                MESSAGE(name << " " << std::string(medium_name) << " " << std::string(maj_name) << ": " << s.mean << " (SE " << s.se()
-                             << "), quadrature " << expected);
-                CHECK(std::abs(s.mean - expected) <= kSigmas * s.se() + kRoundingFloor);
-            }
+            check_against_quadrature(res, ref, intensity, name + " " + medium_name + " " + maj_name);
         });
         (void)sizeof(M);
     };
@@ -115,14 +123,8 @@ TEST_CASE("spectral equiangular MIS in a dense medium: the vertex drawn on a fra
         const auto scene = Scene(medium, maj, IsotropicPhase{}, lights);
         const auto res = estimate_radiance(est, scene, ray, 20000, std::uint64_t(++seed));
         CHECK(res.not_ok == 0);
-        for (int c = 0; c < 3; ++c) {
-            const Stat& s = res.stat.ch[std::size_t(c)];
-            const double expected = ref[std::size_t(c)] * intensity[std::size_t(c)];
-            CAPTURE(c);
-            MESSAGE(std::string(name) << ": " << s.mean << " (SE " << s.se() << "), quadrature " << expected);
-            CHECK(expected > 0.0);
-            CHECK(std::abs(s.mean - expected) <= kSigmas * s.se() + kRoundingFloor);
-        }
+        for (const double r : ref) CHECK(r > 0.0);
+        check_against_quadrature(res, ref, intensity, name);
     };
     const SpectralPathEstimator<channels::SpectralMis, strategy::EquiangularMis, mis::Balance> mis_est(opts);
     const SpectralPathEstimator<channels::Independent, strategy::EquiangularMis, mis::Balance> indep_est(opts);
