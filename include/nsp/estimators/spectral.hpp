@@ -112,6 +112,7 @@ public:
                     if (depth < opts_.max_depth && (eq_select >= 1.f || rng.uniform() < eq_select)) {
                         const Status es =
                             equiangular_vertex(scene, ray, eq, eq_select, depth + 1, lambda, q, c, st, rng, counter, L);
+                        if (es == Status::NonFinite) return {Spectrum::Zero(), es};  // an overflowed flight: see below
                         if (es != Status::Ok) status = es;
                     }
                 }
@@ -162,10 +163,12 @@ public:
                 // Equiangular + NEE alone leaves the lights to its own vertices when it has a target.
                 if (St::combines || !St::equiangular || !target) {
                     const Status ns = next_event(scene, x, ray.d, rr, lambda, q, c, st.f, st.uni, eq_pdf, rng, counter, L);
+                    if (ns == Status::NonFinite) return {Spectrum::Zero(), ns};  // an overflowed flight: see below
                     if (ns != Status::Ok) status = ns;
                 }
                 if constexpr (EmissiveMedium<M>) {
                     const Status es = emission_event(scene, x, ray.d, rr, lambda, q, c, st, rng, counter, L);
+                    if (es == Status::NonFinite) return {Spectrum::Zero(), es};  // an overflowed flight: see below
                     if (es != Status::Ok) status = es;
                 }
             }
@@ -190,7 +193,9 @@ public:
             from_camera = false;
             ray = Ray{x, ps.wi};
         }
-        if (!all_finite(L)) return {Spectrum::Zero(), Status::NonFinite};
+        // A flight or path state that overflowed (NonFinite) had a value beyond float's range: the
+        // whole estimate is replaced by 0, as a non-finite sum would be.
+        if (status == Status::NonFinite || !all_finite(L)) return {Spectrum::Zero(), Status::NonFinite};
         return {L, status};
     }
 
