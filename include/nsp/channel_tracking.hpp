@@ -29,6 +29,11 @@
 namespace nsp {
 
 namespace detail {
+/// How a segment ends whose path state renormalize found dead (Terminated) or overflowed.
+inline SegmentEnd segment_end(StateScale r) noexcept {
+    return r == StateScale::Dead ? SegmentEnd::Terminated : SegmentEnd::Overflowed;
+}
+
 /// exp(-(tau_c - ref)) per channel, with ref = min(tau_c*, min_c tau_c + 80): every factor is at
 /// most e^80 (no overflow) and the sampling channel's at least e^-80 (it never underflows). A
 /// common factor of all channels cancels in every ratio the state forms.
@@ -256,7 +261,7 @@ struct ChannelDeltaCollision {
             }
         }
         if (const StateScale r = st.template renormalize<CP>(c); r != StateScale::Ok) {
-            out = {r == StateScale::Dead ? SegmentEnd::Terminated : SegmentEnd::Overflowed, t};
+            out = {detail::segment_end(r), t};
             return false;
         }
         if (event == SegmentEnd::Scattered) {
@@ -290,7 +295,7 @@ ChannelTrack track_channels_delta_visiting(const M& medium, const Maj& majorant,
             st.eq.nee *= tb;
         }
         if (const StateScale r = st.template renormalize<CP>(c); r != StateScale::Ok)
-            return {r == StateScale::Dead ? SegmentEnd::Terminated : SegmentEnd::Overflowed, tmax};
+            return {detail::segment_end(r), tmax};
     }
     if constexpr (RecT::enabled) rec.log_pdf -= double(channel_of(f.tau_tail, c));
     return {SegmentEnd::Passed, tmax};

@@ -143,6 +143,15 @@ float equiangular_probability(const Maj& majorant, const Ray& ray, const Equiang
     return r < 1.f ? r : 1.f;            // NaN and inf give 1
 }
 
+/// The probability with which strategy St draws a segment's equiangular vertex under `opts`:
+/// equiangular_probability for the three-way MIS with adaptive_equiangular, else 1.
+template <PathStrategy St, class Sc>
+float equiangular_selection(const EstimatorOptions& opts, const Sc& scene, const Ray& ray, const EquiangularSampler& eq,
+                            const typename Sc::Spectral::Wavelengths& lambda) noexcept {
+    if (!St::combines || !opts.adaptive_equiangular) return 1.f;
+    return equiangular_probability<typename Sc::MediumType>(scene.majorant, ray, eq, lambda);
+}
+
 /// One density lookup (counted) at distance t on `ray` with the majorant there, treated as
 /// free_flight treats its lookups: clamped under bound::Clamp; std::nullopt under bound::Reject
 /// where mu_t exceeds mu_bar (the estimator reports Status::Rejected).

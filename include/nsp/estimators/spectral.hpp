@@ -107,8 +107,7 @@ public:
                 if (target) {
                     const Interval in = scene.medium.bounds().clip(ray, 0.f, hit.t);
                     eq = EquiangularSampler(ray, *target, in.t0, in.t1);
-                    if (St::combines && opts_.adaptive_equiangular)
-                        eq_select = equiangular_probability<typename Sc::MediumType>(scene.majorant, ray, eq, lambda);
+                    eq_select = equiangular_selection<St>(opts_, scene, ray, eq, lambda);
                     if (depth < opts_.max_depth && (eq_select >= 1.f || rng.uniform() < eq_select)) {
                         const Status es =
                             equiangular_vertex(scene, ray, eq, eq_select, depth + 1, lambda, q, c, st, rng, counter, L);
