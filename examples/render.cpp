@@ -337,6 +337,10 @@ usage: nsp_render [flags]
   --equiangular-every-segment
                      the three-way MIS (uni-nee-eq-mis) draws an equiangular vertex on every
                      segment, not with probability min(1, p_eq / mu_bar) at the density's peak
+  --no-emission-segments
+                     the combining strategies on the plume leave out the segment technique (a
+                     point drawn on every segment in proportion to the emitted power along it):
+                     emission by collisions and NEE toward the volume only
   --out DIR          directory for the EXR images (default out), created if missing; one linear
                      RGB image (linear sRGB in hero mode) per row, from its first run, named
                      SETUP_ROW[_rgb|_hero].exr, e.g. C1_uni-nee-mis_balance_absorb-weight_hero.exr
@@ -465,6 +469,9 @@ Options parse(int argc, char** argv) {
         } else if (flag == "--equiangular-every-segment") {
             no_value();
             o.estimator.adaptive_equiangular = false;
+        } else if (flag == "--no-emission-segments") {
+            no_value();
+            o.estimator.emission_along_segments = false;
         } else if (flag == "--out") {
             o.out = std::string(value());
             if (o.out.empty()) usage_error("--out needs a directory name");

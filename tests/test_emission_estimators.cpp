@@ -2,8 +2,9 @@
 // collision estimator, NEE toward the emitting volume and their MIS are unbiased: an emissive
 // furnace (L_e equal to the environment: radiance L_e everywhere, for any density and albedo), an
 // emitting absorber with analytic optical depth against quadrature, and NEE + MIS against the
-// collision estimator on a scattering medium with a spatially varying emission grid. The MIS
-// weights of the two techniques sum to 1 for one path.
+// collision estimator on a scattering medium with a spatially varying emission grid; the
+// combining strategies with the segment technique on (the default) and off. The MIS weights of
+// the three techniques sum to 1 for one path.
 #include <cmath>
 #include <string>
 #include <tuple>
@@ -47,14 +48,16 @@ EmissionGrid make_emission(const Box& b, std::array<int, 3> res, float mean, std
 /// channel's mean against `expected(c)`.
 template <class C, class Sc, class F>
 void check_all(const Sc& scene, const Ray& ray, const EstimatorOptions& opts, int n, int seed0,
-               const std::string& what, F expected) {
+               const std::string& what, F expected, bool combining_only = false) {
     using S = typename C::Spectral;
     std::apply(
         [&](auto... est) {
             int seed = seed0;
             ((void)[&] {
                 using E = decltype(est);
-                const auto res = estimate_radiance(E(opts), scene, ray, n, std::uint64_t(++seed));
+                ++seed;
+                if (combining_only && !E::Strategy::combines) return;
+                const auto res = estimate_radiance(E(opts), scene, ray, n, std::uint64_t(seed));
                 CHECK(res.not_ok == 0);
                 for (int c = 0; c < S::channels; ++c) {
                     const Stat& s = res.stat.ch[c];
@@ -90,6 +93,14 @@ TEST_CASE_TEMPLATE_DEFINE("emissive furnace: L_e equal to the environment gives 
         check_all<C>(scene, ray, rr, 6000, 50, maj_name + " roulette", [&](int c) { return double(le[c]); });
     };
     run(GlobalMajorant<Emissive<M>>(medium), "global");
+    {
+        const auto scene = Scene(medium, GlobalMajorant<Emissive<M>>(medium), HenyeyGreensteinPhase(0.3f), lights);
+        EstimatorOptions off;
+        off.emission_along_segments = false;
+        // The option changes the combining strategies only (the others were run above).
+        check_all<C>(scene, ray, off, 6000, 140, "global, no segment technique", [&](int c) { return double(le[c]); },
+                     true);
+    }
     for_each_kind<std::tuple<GridKind, SignedGridKind>, Emissive<M>>(
         [&](auto kind) { run(decltype(kind)::make(medium), decltype(kind)::name); });
 }
@@ -110,6 +121,10 @@ TEST_CASE_TEMPLATE_DEFINE("emitting absorber with analytic optical depth = quadr
     auto run = [&](const auto& maj, const std::string& maj_name) {
         const auto scene = Scene(medium, maj, IsotropicPhase{}, Lights<S>{});
         check_all<C>(scene, ray, EstimatorOptions{}, 20000, 60, maj_name, [&](int c) { return ref[c]; });
+        // Without the segment technique: the camera ray has the collision estimator alone.
+        EstimatorOptions off;
+        off.emission_along_segments = false;
+        check_all<C>(scene, ray, off, 20000, 160, maj_name + " no segment technique", [&](int c) { return ref[c]; }, true);
     };
     run(GlobalMajorant<Emissive<M>>(medium), "global");
     for_each_kind<std::tuple<SignedGlobalKind, GridKind, SignedGridKind>, Emissive<M>>(
@@ -155,30 +170,49 @@ TEST_CASE_TEMPLATE_DEFINE("emission NEE and MIS agree with the collision estimat
 }
 TEST_CASE_TEMPLATE_APPLY(emissive_scattering, AllCombos);
 
-TEST_CASE("emission MIS: the collision and NEE weights of one path sum to 1 and follow the pdfs") {
-    // A real vertex x, a direction and a point y with nulls between them: the collision side and
-    // the NEE side each form the ratio from their own quantities (tracking's null product vs ratio
-    // tracking's for the same nulls; both equal here by construction), and the weights must sum
-    // to 1 and equal the heuristic of the absolute pdfs
-    // p_uni = q p_w / d^2 prod P_n mu_bar(y) (volume measure) and p_nee = p_V(y).
+TEST_CASE("emission MIS: the collision, segment and NEE weights of one path sum to 1 and follow the pdfs") {
+    // A real vertex x, a direction and a point y with nulls between them. Each technique forms the
+    // pdfs from its own quantities (tracking's null product vs ratio tracking's for the same nulls;
+    // equal here by construction); the three weights must sum to 1 and equal the heuristic of the
+    // absolute pdfs in volume measure: p_col = q p_w / d^2 prod P_n mu_bar(y), p_seg = q p_w / d^2
+    // p_seg(y) and p_nee = p_V(y). Tolerance 1e-5 relative: float rounding of the ratios.
     Pcg32 rng(4, 4);
     for (int i = 0; i < 1000; ++i) {
         const float q = 0.3f + 0.7f * rng.uniform(), p_w = 0.05f + 2.f * rng.uniform();
         const float pn = std::pow(rng.uniform(), 3.f), mu = 0.1f + 20.f * rng.uniform();
         const float d = 0.01f + 3.f * rng.uniform(), p_v = 0.01f + 5.f * rng.uniform();
+        const float p_seg = i % 4 == 0 ? 0.f : 0.01f + 3.f * rng.uniform();  // 0: the technique did not run
         CAPTURE(i);
         for (const double beta : {1.0, 2.0}) {
             const mis::Power h{float(beta)};
-            const float r = emission_collision_over_nee<strategy::NullScatteringMis>(q, p_w, pn, mu, d * d, p_v);
-            const double w_col = h.weight(1.f / r), w_nee = h.weight(r);
-            CHECK(w_col + w_nee == doctest::Approx(1.0).epsilon(1e-5));
-            const double p_uni = double(q) * p_w / (double(d) * d) * pn * mu, p_nee = p_v;
-            CHECK(w_nee == doctest::Approx(std::pow(p_nee, beta) / (std::pow(p_nee, beta) + std::pow(p_uni, beta))).epsilon(1e-4));
+            const EmissionPdfs p = emission_pdfs<strategy::NullScatteringMis>(q, p_w, pn, mu, p_seg, d * d, p_v);
+            const double w_col = emission_weight(h, EmissionTechnique::Collision, p);
+            const double w_seg = emission_weight(h, EmissionTechnique::Segment, p);
+            const double w_nee = emission_weight(h, EmissionTechnique::Nee, p);
+            CHECK(w_col + w_seg + w_nee == doctest::Approx(1.0).epsilon(1e-5));
+            const double scale = double(q) * p_w / (double(d) * d);
+            const double pc = std::pow(scale * pn * mu, beta), ps = std::pow(scale * p_seg, beta), pv = std::pow(p_v, beta);
+            CHECK(w_nee == doctest::Approx(pv / (pc + ps + pv)).epsilon(1e-4));
+            CHECK(w_seg == doctest::Approx(ps / (pc + ps + pv)).epsilon(1e-4));
+            if (p_seg == 0.f) CHECK(w_seg == 0.0);
             // Directional MIS leaves the null product out, as it does for lights.
-            const float rd = emission_collision_over_nee<strategy::DirectionalMis>(q, p_w, pn, mu, d * d, p_v);
-            CHECK(double(rd) == doctest::Approx(double(q) * p_w * mu / (double(d) * d * p_v)).epsilon(1e-5));
+            const EmissionPdfs pd = emission_pdfs<strategy::DirectionalMis>(q, p_w, pn, mu, p_seg, d * d, p_v);
+            CHECK(double(pd.collision) / double(pd.nee) ==
+                  doctest::Approx(double(q) * p_w * mu / (double(d) * d * p_v)).epsilon(1e-5));
         }
+        // From the camera: no NEE alternative; collision and segment share the whole weight.
+        const EmissionPdfs pc = emission_pdfs<strategy::NullScatteringMis>(1.f, 1.f, pn, mu, p_seg, 0.f, 0.f);
+        const double wc = emission_weight(mis::Balance{}, EmissionTechnique::Collision, pc);
+        CHECK(emission_weight(mis::Balance{}, EmissionTechnique::Nee, pc) == 0.f);
+        CHECK(wc == doctest::Approx(double(pn) * mu / (double(pn) * mu + p_seg)).epsilon(1e-5));
     }
+    // Underflow: pdfs far below float's range keep their ratios (computed in double): collision
+    // 1e-40 x 1e-5 x 1e-20 = 1e-65, segment 1e-40 x 1e-30 = 1e-70, NEE 1e-30 x 1e-30 = 1e-60.
+    const EmissionPdfs tiny = emission_pdfs<strategy::NullScatteringMis>(1e-20f, 1e-20f, 1e-20f, 1e-5f, 1e-30f, 1e-30f, 1e-30f);
+    CHECK(tiny.nee == 1.f);
+    CHECK(tiny.collision == doctest::Approx(1e-5).epsilon(1e-4));
+    CHECK(tiny.segment == doctest::Approx(1e-10).epsilon(1e-4));
+    CHECK(emission_weight(mis::Balance{}, EmissionTechnique::Collision, tiny) == doctest::Approx(1e-5).epsilon(1e-3));
 }
 
 }  // namespace

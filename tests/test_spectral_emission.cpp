@@ -1,5 +1,6 @@
 // tests/test_spectral_emission.cpp: volume emission over channels (THEORY 5.7 with 5.3):
-// SpectralPathEstimator's collision estimator, NEE toward the emitting volume and their MIS are
+// SpectralPathEstimator's collision estimator, NEE toward the emitting volume, the segment
+// technique (a point drawn along each segment by the power grid) and their MIS are
 // unbiased in every channel for every channel policy and majorant: a chromatic emissive furnace
 // (L_e equal to the environment gives L_e, Rgb and Hero), with equiangular MIS aiming at a dark
 // point light beside it, and a chromatic emitting absorber against quadrature.
@@ -107,16 +108,24 @@ TEST_CASE_TEMPLATE_DEFINE("spectral emitting absorber = quadrature per channel",
     const Ray ray{Vec3(-3.f, 0.25f, -0.3f), glm::normalize(Vec3(1.f, -0.05f, 0.12f))};
     const auto ref = emitting_absorber_reference(base, medium, ray);
     int seed = 500;
+    // The combining strategies with the segment technique (the default, the only sampler of the
+    // camera ray's emission besides collisions) and without it.
+    EstimatorOptions off;
+    off.emission_along_segments = false;
+    const E est_off(off);
     for_each_majorant<typename E::Channels>(medium, [&](const auto& maj, const char* maj_name) {
         const auto scene = Scene(medium, maj, IsotropicPhase{}, Lights<Rgb>{});
-        const auto res = estimate_radiance(est, scene, ray, 20000, std::uint64_t(++seed));
-        CHECK(res.not_ok == 0);
-        for (int c = 0; c < 3; ++c) {
-            const Stat& s = res.stat.ch[std::size_t(c)];
-            CAPTURE(c);
-            MESSAGE(name << " " << std::string(maj_name) << ": " << s.mean << " (SE " << s.se() << "), quadrature "
-                         << ref[std::size_t(c)]);
-            CHECK(std::abs(s.mean - ref[std::size_t(c)]) <= kSigmas * s.se() + kRoundingFloor);
+        for (const E* e_ : {&est, &est_off}) {
+            if (e_ == &est_off && !E::Strategy::combines) continue;
+            const auto res = estimate_radiance(*e_, scene, ray, 20000, std::uint64_t(++seed));
+            CHECK(res.not_ok == 0);
+            for (int c = 0; c < 3; ++c) {
+                const Stat& s = res.stat.ch[std::size_t(c)];
+                CAPTURE(c);
+                MESSAGE(name << " " << std::string(maj_name) << (e_ == &est_off ? " no segment technique" : "") << ": "
+                             << s.mean << " (SE " << s.se() << "), quadrature " << ref[std::size_t(c)]);
+                CHECK(std::abs(s.mean - ref[std::size_t(c)]) <= kSigmas * s.se() + kRoundingFloor);
+            }
         }
     });
 }

@@ -167,11 +167,16 @@ void check_heuristic(Input& in, const H& h) {
     for (const float x : {wa, wb, wc}) NSP_FUZZ_CHECK(x >= 0.f && x <= 1.f);
     if (a > 0.f || b > 0.f || c > 0.f) NSP_FUZZ_CHECK(std::abs(wa + wb + wc - 1.f) <= kWeightTol);
 
-    // Emission: collision estimator against NEE toward the volume (THEORY 5.7).
+    // Emission: the collision estimator, the segment technique and NEE toward the volume (THEORY 5.7).
     const float mu_bar = positive(in), dist2 = positive(in), volume_pdf = positive(in);
-    const float re = emission_collision_over_nee<strategy::NullScatteringMis>(survival, phase_pdf, nulls, mu_bar,
-                                                                              dist2, volume_pdf);
-    NSP_FUZZ_CHECK(std::abs(mis::weight_among(h, re, 1.f) + mis::weight_among(h, 1.f, re) - 1.f) <= kWeightTol);
+    const float segment_pdf = ratio(in);
+    const EmissionPdfs ep = emission_pdfs<strategy::NullScatteringMis>(survival, phase_pdf, nulls, mu_bar, segment_pdf,
+                                                                       dist2, volume_pdf);
+    const float ec = emission_weight(h, EmissionTechnique::Collision, ep);
+    const float es = emission_weight(h, EmissionTechnique::Segment, ep);
+    const float en = emission_weight(h, EmissionTechnique::Nee, ep);
+    for (const float x : {ec, es, en}) NSP_FUZZ_CHECK(x >= 0.f && x <= 1.f);
+    if (ep.collision > 0.f || ep.segment > 0.f || ep.nee > 0.f) NSP_FUZZ_CHECK(std::abs(ec + es + en - 1.f) <= kWeightTol);
 }
 
 void check_mis(Input& in) {

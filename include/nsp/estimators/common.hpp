@@ -84,6 +84,12 @@ struct EstimatorOptions {
     /// strategy::EquiangularMis: draw the equiangular vertex of a segment with the probability of
     /// equiangular_probability (below) instead of on every segment. Off: on every segment.
     bool adaptive_equiangular = true;
+    /// The combining strategies on an emissive medium: on every segment also draw one point in
+    /// proportion to the emitted power along the segment (the segment technique of THEORY 5.7,
+    /// the nulls before it ratio-tracked), combined with the collision estimator and NEE toward
+    /// the volume by MIS. It is the only sampling technique for the emission a camera ray sees
+    /// directly. Off: collisions and NEE only. No effect on other media or strategies.
+    bool emission_along_segments = true;
 };
 
 /// How a radiance estimate ended.

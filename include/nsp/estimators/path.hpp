@@ -12,8 +12,10 @@
 // - EquiangularMis: tracking + NEE, tracking + hit and equiangular + NEE, by their path pdfs.
 // An emissive medium (media/emissive.hpp) adds emission the same way: collected at every
 // tentative collision where the strategy counts hits, sampled by NEE toward the volume where it
-// samples lights, weighted by the analytic ratio of the two where it combines (THEORY 5.7). A
-// medium without emission compiles none of that code.
+// samples lights, and, where it combines, also by the segment technique (a point drawn on each
+// segment in proportion to the power grid along it, the nulls before it ratio-tracked), the three
+// weighted by their analytic path pdfs (THEORY 5.7). A medium without emission compiles none of
+// that code.
 // Exact for Mono and grey media; on chromatic media the per-channel weights multiply along a
 // path, which is what estimators/spectral.hpp is for.
 #pragma once
@@ -21,6 +23,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <type_traits>
 
@@ -104,23 +107,58 @@ float equiangular_mis_weight(const H& h, VertexTechnique which, float track_nee,
     }
 }
 
-/// For volume emission at a point y at squared distance `dist2` from the real vertex x the
-/// segment left from: the collision estimator's pdf over NEE's toward the volume (THEORY 5.7),
-/// p_uni / p_nee = q p_w [prod P_n] mu_bar(y) / (dist2 p_V(y)), with roulette survival q and phase
-/// pdf p_w at x, the nulls' delta-tracking product (null-scattering strategies only; directional
-/// MIS leaves it out, as it does for lights) and the NEE volume pdf p_V(y). The nulls' mu_bar Tbar
-/// are shared and cancel. The collision estimator weighs with mis::weight_among(h, r, 1), NEE with
-/// mis::weight_among(h, 1, r): for one path they sum to 1 (h.weight(1 / r) and h.weight(r) did not
-/// where 1 / r leaves float range).
+/// The three techniques that can produce volume emission at a point y of a segment (THEORY 5.7).
+enum class EmissionTechnique : std::uint8_t {
+    Collision,  ///< y a tentative collision of the delta-tracked segment (the collision estimator)
+    Segment,    ///< y drawn on the segment in proportion to the power grid along it, nulls ratio-tracked
+    Nee,        ///< y drawn in the volume by the power grid from the segment's real vertex x, nulls ratio-tracked
+};
+
+/// The pdfs of the three emission techniques for one path whose last segment, from a real vertex
+/// x (or the camera), reaches y at distance d, on a common scale, the largest 1. In volume measure
+/// times d^2, the nulls' shared mu_bar Tbar factors left out (they cancel):
+/// - collision: q p_w [prod_j P_n(n_j)] mu_bar(y), the product for null-scattering strategies only
+///   (directional MIS leaves it out, as it does for lights);
+/// - segment:   q p_w p_seg(y), p_seg the segment technique's density along the ray (0 where it
+///   does not run);
+/// - nee:       d^2 p_V(y) (volume_pdf 0 where NEE has no vertex to start from: the camera).
+/// With roulette survival q and phase pdf p_w at x (1 and 1 for the camera ray). In double, so
+/// neither the products nor d^2 p_V underflow into 0 / 0 (found by the fuzzer, tests/fuzz). All
+/// zero when every pdf is; an infinite pdf stays inf and the others become 0 (emission_weight gives
+/// it the whole weight); NaN in, NaN out (and inf x 0, e.g. an infinite p_seg with q = 0).
+struct EmissionPdfs {
+    float collision = 0.f, segment = 0.f, nee = 0.f;
+};
+
 template <PathStrategy St>
-float emission_collision_over_nee(float survival, float phase_pdf, float null_pdf_product, float mu_bar, float dist2,
-                                  float volume_pdf) noexcept {
-    // In double: in float both the product of the numerator and dist2 * volume_pdf can underflow
-    // to 0, and 0 / 0 gave both techniques weight 0 (found by the fuzzer, tests/fuzz).
-    double p = double(survival) * double(phase_pdf) * double(mu_bar);
-    if constexpr (St::null_pdfs) p *= double(null_pdf_product);
-    const double q = double(dist2) * double(volume_pdf);
-    return q > 0.0 ? float(p / q) : kInf;  // NEE cannot draw the point: the collision estimator takes it
+EmissionPdfs emission_pdfs(float survival, float phase_pdf, float null_pdf_product, float mu_bar, float segment_pdf,
+                           float dist2, float volume_pdf) noexcept {
+    const double direction = double(survival) * double(phase_pdf);
+    double collision = direction * double(mu_bar);
+    if constexpr (St::null_pdfs) collision *= double(null_pdf_product);
+    const double segment = direction * double(segment_pdf), nee = double(dist2) * double(volume_pdf);
+    const double largest = std::max({collision, segment, nee});
+    if (std::isnan(collision + segment + nee)) {
+        constexpr float nan = std::numeric_limits<float>::quiet_NaN();
+        return {nan, nan, nan};
+    }
+    if (!(largest > 0.0)) return {};
+    if (std::isinf(largest)) {  // an infinite pdf (a float input of inf) takes the weight: keep it inf, the rest 0
+        auto keep = [](double x) { return std::isinf(x) ? kInf : 0.f; };
+        return {keep(collision), keep(segment), keep(nee)};
+    }
+    return {float(collision / largest), float(segment / largest), float(nee / largest)};
+}
+
+/// The MIS weight of emission technique `which` for a path with pdfs `p`; the three weights of
+/// one path sum to 1 (0 for a technique whose pdf is 0).
+template <mis::CombiningHeuristic H>
+float emission_weight(const H& h, EmissionTechnique which, const EmissionPdfs& p) noexcept {
+    switch (which) {
+        case EmissionTechnique::Collision: return mis::weight_among(h, p.collision, p.segment, p.nee);
+        case EmissionTechnique::Segment: return mis::weight_among(h, p.segment, p.collision, p.nee);
+        default: return mis::weight_among(h, p.nee, p.collision, p.segment);
+    }
 }
 
 /// A path estimator: strategy St, MIS heuristic H (mis::None exactly for single-strategy
@@ -186,11 +224,25 @@ public:
             }
             DeltaTrack<typename Sc::Spectral> seg;
             if constexpr (kEmissive) {
+                // The segment technique: a point drawn on this segment in proportion to the power
+                // grid along it (W: its normaliser; 0 where it does not run).
+                float along = 0.f;
+                if constexpr (St::combines) {
+                    if (opts_.emission_along_segments) {
+                        along = scene.medium.emission_along(ray, 0.f, hit.t);
+                        if (along > 0.f) {
+                            const Status es = emission_segment(scene, ray, hit.t, along, !from_camera, prev_survival,
+                                                               prev_phase_pdf, lambda, rng, counter, beta, L);
+                            if (es != Status::Ok) status = es;
+                        }
+                    }
+                }
                 if (from_camera || St::hits_lights) {
                     // The NEE alternative of emission exists from real vertices only (THEORY 5.7).
                     seg = track_delta_visiting<A>(scene.medium, scene.majorant, ray, hit.t, lambda, rng, counter,
                                                   EmissionCollector<Sc>{scene, ray, lambda, beta, L, heuristic_,
-                                                                        !from_camera, prev_survival, prev_phase_pdf});
+                                                                        !from_camera, prev_survival, prev_phase_pdf,
+                                                                        along});
                 } else {
                     seg = track_delta<A>(scene.medium, scene.majorant, ray, hit.t, lambda, rng, counter);
                 }
@@ -346,7 +398,8 @@ private:
 
     /// The collision estimator of volume emission (THEORY 5.7): at every tentative collision y of
     /// a delta-tracked segment, beta mu_a(y) L_e(y) / mu_bar(y), weighted against NEE toward the
-    /// emission where the segment left a real vertex.
+    /// emission where the segment left a real vertex and against the segment technique where it
+    /// ran (`along` > 0, its normaliser on this segment).
     template <class Sc>
     struct EmissionCollector {
         static constexpr bool enabled = true;
@@ -359,6 +412,7 @@ private:
         const H& heuristic;
         bool from_vertex;  ///< the segment left a real vertex (else the camera: no NEE alternative)
         float survival, phase_pdf;
+        float along;
 
         void operator()(float t, const Coefficients<S>& c, float mu_bar, const typename S::Spectrum& w,
                         float null_pdf_product) const {
@@ -368,19 +422,49 @@ private:
             if (!(le > 0.f).any()) return;
             float wt = 1.f;
             if constexpr (St::combines) {
-                if (from_vertex) {
-                    const float r = emission_collision_over_nee<St>(survival, phase_pdf, null_pdf_product, mu_bar, t * t,
-                                                                    scene.medium.emission_pdf(y));
-                    wt = mis::weight_among(heuristic, r, 1.f);
-                }
+                const float p_v = scene.medium.emission_pdf(y);
+                const float p_seg = along > 0.f ? p_v / along : 0.f;
+                wt = emission_weight(heuristic, EmissionTechnique::Collision,
+                                     from_vertex ? emission_pdfs<St>(survival, phase_pdf, null_pdf_product, mu_bar,
+                                                                     p_seg, t * t, p_v)
+                                                 : emission_pdfs<St>(1.f, 1.f, null_pdf_product, mu_bar, p_seg, 0.f, 0.f));
             }
             L += beta * w * c.sigma_a * le * (wt / mu_bar);
         }
     };
 
+    /// The segment technique of volume emission on `ray` over [0, tmax) (THEORY 5.7): y drawn with
+    /// the density p_seg = emission_pdf / `along` along the ray, the nulls before it ratio-tracked,
+    /// beta Tbar-ratio mu_a(y) L_e(y) / p_seg(y), weighted against the collision estimator of the
+    /// same segment and, from a real vertex (`from_vertex`, with roulette survival and phase pdf
+    /// there), against NEE toward the volume.
+    template <class Sc, UniformRng R, LookupCounter C>
+    Status emission_segment(const Sc& scene, const Ray& ray, float tmax, float along, bool from_vertex, float survival,
+                            float phase_pdf, const typename Sc::Spectral::Wavelengths& lambda, R& rng, C& counter,
+                            const typename Sc::Spectrum& beta, typename Sc::Spectrum& L) const {
+        const DistanceSample ds = scene.medium.sample_emission_along(ray, 0.f, tmax, along, rng.uniform());
+        if (!(ds.pdf > 0.f)) return Status::Ok;
+        const auto tr = track_ratio<A, St::null_pdfs>(scene.medium, scene.majorant, ray, ds.t, lambda, rng, counter);
+        if (tr.end == SegmentEnd::Aborted || tr.end == SegmentEnd::Rejected) return flight_status(tr.end);
+        if (tr.end == SegmentEnd::Terminated) return Status::Ok;
+        const auto v = lookup_untracked(scene.medium, scene.majorant, ray, ds.t, lambda, counter);
+        if (!v) return Status::Rejected;
+        if (!(v->k.sigma_a > 0.f).any()) return Status::Ok;
+        const Vec3 y = ray.at(ds.t);
+        const typename Sc::Spectrum le = scene.medium.emission(y, lambda);
+        // The weight takes p_seg where every technique evaluates it: at the point's own cell.
+        const float p_v = scene.medium.emission_pdf(y);
+        const EmissionPdfs p = from_vertex ? emission_pdfs<St>(survival, phase_pdf, tr.null_pdf_product, v->mu,
+                                                               p_v / along, ds.t * ds.t, p_v)
+                                           : emission_pdfs<St>(1.f, 1.f, tr.null_pdf_product, v->mu, p_v / along, 0.f, 0.f);
+        const float w = emission_weight(heuristic_, EmissionTechnique::Segment, p);
+        L += beta * tr.transmittance * v->k.sigma_a * le * (w / ds.pdf);
+        return Status::Ok;
+    }
+
     /// NEE toward the emitting volume at real vertex x (THEORY 5.7): a point y drawn by the
     /// medium's emitted-power grid, the nulls to it ratio-tracked, weighted against the collision
-    /// estimator.
+    /// estimator and the segment technique (on the ray from x toward y, to the light it would hit).
     template <class Sc, UniformRng R, LookupCounter C>
     Status emission_event(const Sc& scene, const Vec3& x, const Vec3& wo, float survival,
                           const typename Sc::Spectral::Wavelengths& lambda, R& rng, C& counter,
@@ -395,10 +479,18 @@ private:
         const typename Sc::Spectrum le = scene.medium.emission(e->y.p, lambda);
         const Vec3& wi = e->shadow.d;
         float w = 1.f;
-        if constexpr (St::combines)
-            w = mis::weight_among(heuristic_, 1.f,
-                                  emission_collision_over_nee<St>(survival, scene.phase.pdf(wo, wi), tr.null_pdf_product,
-                                                                  v->mu, e->dist2, e->y.pdf));
+        if constexpr (St::combines) {
+            float p_seg = 0.f;
+            if (opts_.emission_along_segments) {
+                // sample_emission_from left y before the sphere light, if any: the segment from x
+                // toward y runs to the light or leaves the medium.
+                const float along = scene.medium.emission_along(e->shadow, 0.f, scene.lights.intersect(e->shadow).t);
+                if (along > 0.f) p_seg = e->y.pdf / along;
+            }
+            w = emission_weight(heuristic_, EmissionTechnique::Nee,
+                                emission_pdfs<St>(survival, scene.phase.pdf(wo, wi), tr.null_pdf_product, v->mu, p_seg,
+                                                  e->dist2, e->y.pdf));
+        }
         L += beta * tr.transmittance * v->k.sigma_a * le * (w * scene.phase.eval(wo, wi) / (e->dist2 * e->y.pdf));
         return Status::Ok;
     }

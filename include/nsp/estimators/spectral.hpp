@@ -39,7 +39,8 @@ namespace nsp {
 /// strategy, mis::Balance for the combining ones: the weights are the one-sample balance heuristic
 /// over channels and techniques) and absorption policy A. An emissive medium adds emission as
 /// PathEstimator does (collisions where the strategy counts hits, NEE toward the volume where it
-/// samples lights), every channel's pdfs of both in the same sum.
+/// samples lights, the segment technique where it combines), every channel's pdfs of all of them
+/// in the same sum.
 template <ChannelPolicy CP, PathStrategy St, mis::Heuristic H = mis::None, AbsorptionPolicy A = absorption::Weight>
 class SpectralPathEstimator {
     static_assert(St::null_pdfs || !St::combines,
@@ -91,6 +92,7 @@ public:
         Status status = Status::Ok;
         Ray ray = camera_ray;
         Vec3 prev_x(0.f);  // the real vertex the current ray left from
+        float dir_pdf = 1.f;  // rr p_w of the current ray's direction (1 for the camera ray)
         bool from_camera = true;
         std::optional<Vec3> target;
         if constexpr (St::equiangular) target = scene.lights.equiangular_target();
@@ -118,10 +120,27 @@ public:
             }
             ChannelTrack seg;
             if constexpr (EmissiveMedium<M>) {
+                // The segment technique (THEORY 5.7): a point drawn on this segment in proportion to
+                // the power grid along it (`along`: its normaliser; 0 where it does not run). Its
+                // nulls are ratio-tracked: their pdfs are st.nee's, so the tracker keeps st.nee on
+                // the camera ray too, from the prefix without the direction (dir_pdf apart).
+                float along = 0.f;
+                if constexpr (St::combines) {
+                    if (opts_.emission_along_segments) {
+                        along = scene.medium.emission_along(ray, 0.f, hit.t);
+                        if (along > 0.f) {
+                            if (from_camera) st.nee = st.uni;
+                            const Status es = emission_segment(scene, ray, hit.t, along, nee_alternative, dir_pdf,
+                                                               lambda, q, c, st, rng, counter, L);
+                            if (es == Status::NonFinite) return {Spectrum::Zero(), es};  // an overflowed flight: see below
+                            if (es != Status::Ok) status = es;
+                        }
+                    }
+                }
                 if (from_camera || St::hits_lights)
                     seg = track_channels_delta_visiting<CP, A>(
-                        scene.medium, scene.majorant, ray, hit.t, lambda, c, st, nee_alternative, rng, counter,
-                        EmissionCollector<Sc>{scene, ray, lambda, q, c, L, nee_alternative});
+                        scene.medium, scene.majorant, ray, hit.t, lambda, c, st, nee_alternative || along > 0.f, rng,
+                        counter, EmissionCollector<Sc>{scene, ray, lambda, q, c, L, nee_alternative, along, dir_pdf});
                 else
                     seg = track_channels_delta<CP, A>(scene.medium, scene.majorant, ray, hit.t, lambda, c, st,
                                                       nee_alternative, rng, counter);
@@ -183,7 +202,8 @@ public:
                 if constexpr (St::equiangular) st.eq.nee = eq_pdf;
             }
             st.f *= ps.value;
-            st.uni *= rr * ps.pdf;
+            dir_pdf = rr * ps.pdf;
+            st.uni *= dir_pdf;
             if (const StateScale r = st.template renormalize<CP>(c); r != StateScale::Ok) {
                 if (r == StateScale::Overflowed) status = Status::NonFinite;
                 break;
@@ -237,7 +257,8 @@ private:
     /// The collision estimator of volume emission over channels (THEORY 5.7 with 5.3): at every
     /// tentative collision y, f_c = f_c(prefix) Tbar_c mu_a,c L_e,c and the collision pdf
     /// mu_bar_c Tbar_c of every channel; with `nee_alternative` also NEE's pdf of y toward the
-    /// volume (ratio-tracked nulls from the last real vertex, p_V(y) t^2 in the same measure).
+    /// volume (ratio-tracked nulls from the last real vertex, p_V(y) t^2 in the same measure), and
+    /// where the segment technique ran (`along` > 0) its pdf: the same nulls, dir_pdf p_seg(y).
     template <class Sc>
     struct EmissionCollector {
         static constexpr bool enabled = true;
@@ -250,6 +271,7 @@ private:
         int c;
         Spec& L;
         bool nee_alternative;
+        float along, dir_pdf;
 
         template <class State>
         void operator()(float t, const Coefficients<S>& k, const Spec& mu, const Spec& tbar, const State& st) const {
@@ -258,7 +280,11 @@ private:
             const Spec le = scene.medium.emission(y, lambda);
             if (!(le > 0.f).any()) return;
             Spec pdf = st.uni * tbar * mu;
-            if (nee_alternative) pdf += st.nee * tbar * (scene.medium.emission_pdf(y) * t * t);
+            if (nee_alternative || along > 0.f) {
+                const float p_v = scene.medium.emission_pdf(y);
+                const float other = (nee_alternative ? p_v * t * t : 0.f) + (along > 0.f ? dir_pdf * (p_v / along) : 0.f);
+                pdf += st.nee * tbar * other;
+            }
             L += channel_estimate<CP, Spec>(Spec(st.f * tbar * k.sigma_a * le), pdf, q, c);
         }
     };
@@ -283,9 +309,51 @@ private:
         const Spectrum le = scene.medium.emission(e->y.p, lambda);
         const Spectrum f = st.f * sh.f * v->k.sigma_a * le * scene.phase.eval(wo, wi);
         Spectrum pdf = sh.nee * (e->y.pdf * e->dist2);
-        if constexpr (St::combines)
-            pdf += sh.uni * detail::broadcast_majorant<Spectrum>(v->mu) * (rr * scene.phase.pdf(wo, wi));
+        if constexpr (St::combines) {
+            const float dir = rr * scene.phase.pdf(wo, wi);
+            pdf += sh.uni * detail::broadcast_majorant<Spectrum>(v->mu) * dir;
+            if (opts_.emission_along_segments) {
+                // The segment technique on the ray from x toward y (sample_emission_from left y
+                // before the sphere light, if any), with the same ratio-tracked nulls.
+                const float along = scene.medium.emission_along(e->shadow, 0.f, scene.lights.intersect(e->shadow).t);
+                if (along > 0.f) pdf += sh.nee * (dir * (e->y.pdf / along));
+            }
+        }
         L += channel_estimate<CP, Spectrum>(f, Spectrum(st.uni * pdf), q, c);
+        return Status::Ok;
+    }
+
+    /// The segment technique of volume emission over channels on `ray` over [0, tmax) (THEORY 5.7
+    /// with 5.3): y drawn with density p_seg = emission_pdf / `along` along the ray, the nulls
+    /// ratio-tracked with c's majorant and every channel's pdfs, against the collision estimator
+    /// of the segment and, with `nee_alternative`, NEE toward the volume from its real vertex. `st`
+    /// is the state at the segment's start: uni with the direction's pdf `dir_pdf` (rr p_w), nee
+    /// without it.
+    template <class Sc, UniformRng R, LookupCounter C, class State>
+    Status emission_segment(const Sc& scene, const Ray& ray, float tmax, float along, bool nee_alternative,
+                            float dir_pdf, const typename Sc::Spectral::Wavelengths& lambda,
+                            const typename Sc::Spectrum& q, int c, const State& st, R& rng, C& counter,
+                            typename Sc::Spectrum& L) const {
+        using Spectrum = typename Sc::Spectrum;
+        const DistanceSample ds = scene.medium.sample_emission_along(ray, 0.f, tmax, along, rng.uniform());
+        if (!(ds.pdf > 0.f)) return Status::Ok;
+        const auto sh = track_channels_ratio<CP, A>(scene.medium, scene.majorant, ray, ds.t, lambda, c, st.f, true, rng,
+                                                    counter);
+        if (const Status fs = flight_status(sh.end); fs != Status::Ok) return fs;
+        if (sh.end == SegmentEnd::Terminated) return Status::Ok;
+        const auto v = lookup_untracked(scene.medium, scene.majorant, ray, ds.t, lambda, counter);
+        if (!v) return Status::Rejected;
+        if (!(v->k.sigma_a > 0.f).any()) return Status::Ok;
+        const Vec3 y = ray.at(ds.t);
+        const Spectrum f = st.f * sh.f * v->k.sigma_a * scene.medium.emission(y, lambda);
+        // Every channel's pdf of the three techniques; p_seg where each technique evaluates it
+        // (the point's own cell), and the sampled density ds.pdf for this sample's own share.
+        const float p_v = scene.medium.emission_pdf(y);
+        Spectrum pdf = st.uni * sh.uni * detail::broadcast_majorant<Spectrum>(v->mu);
+        pdf += st.nee * sh.nee * ((nee_alternative ? p_v * ds.t * ds.t : 0.f) + dir_pdf * (p_v / along));
+        // channel_estimate divides by this technique's pdf in the sum; the density actually
+        // sampled is ds.pdf, which differs from p_v / along only within rounding of a cell face.
+        L += channel_estimate<CP, Spectrum>(f, pdf, q, c);
         return Status::Ok;
     }
 

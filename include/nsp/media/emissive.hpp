@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "../core/error.hpp"
+#include "../equiangular.hpp"
 #include "../majorant.hpp"
 #include "../majorants/grid.hpp"
 #include "../medium.hpp"
@@ -36,13 +37,18 @@ struct VolumeSample {
 /// - `sample_emission(u0, u1, u2, u3)`: a point y with its volume pdf p_V(y), > 0 wherever
 ///   mu_a L_e can be > 0 (pdf 0 when nothing emits);
 /// - `emission_pdf(p)`: the density with which sample_emission draws p, equal to the pdf it
-///   reports for that point.
+///   reports for that point;
+/// - `emission_along(ray, t0, t1)`: W, the integral of emission_pdf(ray.at(t)) over [t0, t1)
+///   (ray.d a unit vector), and `sample_emission_along(ray, t0, t1, W, u)`: a distance drawn with
+///   density emission_pdf(ray.at(t)) / W there, the segment technique of the estimators.
 template <class M>
 concept EmissiveMedium = Medium<M> &&
-    requires(const M& m, const Vec3& p, const typename M::Spectral::Wavelengths& l, float u) {
+    requires(const M& m, const Vec3& p, const typename M::Spectral::Wavelengths& l, float u, const Ray& r) {
         { m.emission(p, l) } -> std::same_as<typename M::Spectral::Spectrum>;
         { m.sample_emission(u, u, u, u) } -> std::same_as<VolumeSample>;
         { m.emission_pdf(p) } -> std::same_as<float>;
+        { m.emission_along(r, u, u) } -> std::same_as<float>;
+        { m.sample_emission_along(r, u, u, u, u) } -> std::same_as<DistanceSample>;
     };
 
 /// A dense scalar grid over a box, e.g. an emission strength derived from temperature, stored
@@ -238,6 +244,48 @@ public:
                               std::size_t(res_[0]) * (std::size_t(cell_on_axis(1, p.y)) +
                                                       std::size_t(res_[1]) * std::size_t(cell_on_axis(2, p.z)));
         return prob_[i] * inv_cell_volume_;
+    }
+
+    /// W = the integral of emission_pdf(ray.at(t)) over t in [t0, t1) (ray.d a unit vector): the
+    /// normaliser of the segment technique, which draws a point on a ray in proportion to the
+    /// power grid (THEORY 5.7). Walked cell by cell through the power grid; 0 when the stretch
+    /// meets no cell that may emit (or t0 >= t1).
+    float emission_along(const Ray& ray, float t0, float t1) const noexcept {
+        if (prob_.empty()) return 0.f;
+        detail::GridWalk walk(box_, res_, cell_, ray, box_.clip(ray, t0, t1));
+        double sum = 0.0;  // prob x length: the cell volume divides once at the end
+        std::size_t i;
+        float a, b;
+        while (walk.next(i, a, b)) sum += double(prob_[i]) * double(b - a);
+        return float(sum * double(inv_cell_volume_));
+    }
+
+    /// A distance t in [t0, t1) on `ray` drawn from u in [0, 1) with density emission_pdf(ray.at(t))
+    /// / total, where total = emission_along(ray, t0, t1): a cell of the walk chosen in proportion
+    /// to prob x length, then t uniform in its stretch. The pdf returned is that cell's density
+    /// over total (where t lies on a cell face within rounding, emission_pdf may locate ray.at(t)
+    /// in the neighbour). pdf 0 when total is not > 0.
+    DistanceSample sample_emission_along(const Ray& ray, float t0, float t1, float total, float u) const noexcept {
+        if (prob_.empty() || !(total > 0.f)) return {};
+        detail::GridWalk walk(box_, res_, cell_, ray, box_.clip(ray, t0, t1));
+        const double target = double(unit(u)) * double(total) / double(inv_cell_volume_);
+        double run = 0.0;
+        std::size_t i;
+        float a, b;
+        DistanceSample last;
+        while (walk.next(i, a, b)) {
+            const double m = double(prob_[i]) * double(b - a);
+            if (!(m > 0.0)) continue;
+            const float pdf = prob_[i] * inv_cell_volume_ / total;
+            const float end = std::nextafter(b, a);  // b > a here: the stretch is [a, b)
+            if (run + m > target) {
+                const float t = a + float((target - run) / double(prob_[i]));
+                return {std::clamp(t, a, end), pdf};
+            }
+            run += m;
+            last = {end, pdf};
+        }
+        return last;  // target rounded past the last cell: the end of the last one that may emit
     }
 
     /// The estimated integral over the power grid of the channel mean of mu_a L_e (radiance
