@@ -4,7 +4,10 @@
 // BM_Emission/<strategy[:heuristic]>/<mode>: time per radiance() call (one sample) and density
 // lookups per sample (NEE toward the volume counts its lookup at the emitting point). The
 // collision estimator looks emission up at every tentative collision where mu_a > 0; NEE adds a
-// power-grid sample, a shadow flight and two lookups per real vertex. Which of them wins per unit
+// power-grid sample, a shadow flight and two lookups per real vertex; the combining strategies also
+// draw a point on every segment that crosses the power grid (the segment technique: a DDA over the
+// power grid, a ratio-tracked flight, a lookup), measured against the same MIS without it
+// (`:no-segments`). Which of them wins per unit
 // of variance is the plume table's business (examples, README); the rows here separate the cost.
 #include <string>
 
@@ -41,11 +44,13 @@ const auto& emissive_scene() {
     return scene;
 }
 
-template <nsp::PathStrategy St, nsp::mis::Heuristic H, nsp::SpectralMode S>
+template <nsp::PathStrategy St, nsp::mis::Heuristic H, nsp::SpectralMode S, bool kSegments = true>
 void BM_Emission(benchmark::State& state) {
     const auto& scene = emissive_scene<S>();
     const std::vector<nsp::Ray>& rays = camera_rays();
-    const nsp::PathEstimator<St, H> estimator;
+    nsp::EstimatorOptions opts;
+    opts.emission_along_segments = kSegments;
+    const nsp::PathEstimator<St, H> estimator(opts);
     nsp::Pcg32 rng(7, 77);
     nsp::LookupCount counter;
     std::size_t i = 0;
@@ -69,6 +74,12 @@ const bool registered = [] {
     register_emission<nsp::strategy::Unidirectional>();
     register_emission<nsp::strategy::NextEvent>();
     register_emission<nsp::strategy::NullScatteringMis, nsp::mis::Balance>();
+    // The same MIS without the segment technique: collisions and NEE toward the volume only.
+    using NoSegments = nsp::strategy::NullScatteringMis;
+    benchmark::RegisterBenchmark("BM_Emission/uni-nee-mis:balance:no-segments/mono",
+                                 BM_Emission<NoSegments, nsp::mis::Balance, nsp::Mono, false>)->MinTime(kMinTime);
+    benchmark::RegisterBenchmark("BM_Emission/uni-nee-mis:balance:no-segments/rgb",
+                                 BM_Emission<NoSegments, nsp::mis::Balance, nsp::Rgb, false>)->MinTime(kMinTime);
     return true;
 }();
 

@@ -189,7 +189,8 @@ the grid majorant (8 renders); then the fog, set-ups F1, F2 (64x64, 128 spp) and
 spp), mono: ratio-nee, uni-nee-mis balance, equiangular-nee and uni-nee-eq-mis balance and power
 (absorb-weight) with the global and the grid majorant (30 renders); then the plume, set-up P1,
 rgb, 64x64, 256 spp: unidirectional (the collision estimator of emission alone), ratio-nee (NEE
-toward the emitting volume), uni-nee-mis balance and power (absorb-weight), global and grid
+toward the emitting volume), uni-nee-mis balance and power (collisions, NEE and the segment
+technique; absorb-weight), global and grid
 majorant (8 renders). scripts/run-main.sh then adds two comparisons with effective variances
 against reference images: the chromatic heavy-tail one (baseline against spectral MIS + NEE with
 each majorant, --runs 3 at 32x32 with a 2048-spp reference; the second-to-last example below,
