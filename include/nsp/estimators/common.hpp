@@ -200,6 +200,17 @@ std::optional<EmissionSample> sample_emission_from(const M& medium, const Lights
     return e;
 }
 
+/// The segment technique's density p_seg(y) = p_V(y) / W for an emission NEE sample from x: W along
+/// the ray from x toward y, to the sphere light it would hit or out of the medium (the segment
+/// tracking would take; sample_emission_from left y before that light). 0 where the technique
+/// does not run (`opts.emission_along_segments` off, or W = 0).
+template <class Sc>
+float emission_segment_pdf(const EstimatorOptions& opts, const Sc& scene, const EmissionSample& e) noexcept {
+    if (!opts.emission_along_segments) return 0.f;
+    const float along = scene.medium.emission_along(e.shadow, 0.f, scene.lights.intersect(e.shadow).t);
+    return along > 0.f ? e.y.pdf / along : 0.f;
+}
+
 /// Throws InvalidArgument on max_depth < 0, rr_start_depth < 1 or rr_max_survival outside (0, 1].
 inline void validate(const EstimatorOptions& opts) {
     if (opts.max_depth < 0)

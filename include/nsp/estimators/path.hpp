@@ -479,18 +479,10 @@ private:
         const typename Sc::Spectrum le = scene.medium.emission(e->y.p, lambda);
         const Vec3& wi = e->shadow.d;
         float w = 1.f;
-        if constexpr (St::combines) {
-            float p_seg = 0.f;
-            if (opts_.emission_along_segments) {
-                // sample_emission_from left y before the sphere light, if any: the segment from x
-                // toward y runs to the light or leaves the medium.
-                const float along = scene.medium.emission_along(e->shadow, 0.f, scene.lights.intersect(e->shadow).t);
-                if (along > 0.f) p_seg = e->y.pdf / along;
-            }
+        if constexpr (St::combines)
             w = emission_weight(heuristic_, EmissionTechnique::Nee,
-                                emission_pdfs<St>(survival, scene.phase.pdf(wo, wi), tr.null_pdf_product, v->mu, p_seg,
-                                                  e->dist2, e->y.pdf));
-        }
+                                emission_pdfs<St>(survival, scene.phase.pdf(wo, wi), tr.null_pdf_product, v->mu,
+                                                  emission_segment_pdf(opts_, scene, *e), e->dist2, e->y.pdf));
         L += beta * tr.transmittance * v->k.sigma_a * le * (w * scene.phase.eval(wo, wi) / (e->dist2 * e->y.pdf));
         return Status::Ok;
     }

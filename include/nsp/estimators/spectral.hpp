@@ -312,12 +312,8 @@ private:
         if constexpr (St::combines) {
             const float dir = rr * scene.phase.pdf(wo, wi);
             pdf += sh.uni * detail::broadcast_majorant<Spectrum>(v->mu) * dir;
-            if (opts_.emission_along_segments) {
-                // The segment technique on the ray from x toward y (sample_emission_from left y
-                // before the sphere light, if any), with the same ratio-tracked nulls.
-                const float along = scene.medium.emission_along(e->shadow, 0.f, scene.lights.intersect(e->shadow).t);
-                if (along > 0.f) pdf += sh.nee * (dir * (e->y.pdf / along));
-            }
+            // The segment technique on the ray from x toward y, with the same ratio-tracked nulls.
+            pdf += sh.nee * (dir * emission_segment_pdf(opts_, scene, *e));
         }
         L += channel_estimate<CP, Spectrum>(f, Spectrum(st.uni * pdf), q, c);
         return Status::Ok;
@@ -346,8 +342,8 @@ private:
         if (!(v->k.sigma_a > 0.f).any()) return Status::Ok;
         const Vec3 y = ray.at(ds.t);
         const Spectrum f = st.f * sh.f * v->k.sigma_a * scene.medium.emission(y, lambda);
-        // Every channel's pdf of the three techniques; p_seg where each technique evaluates it
-        // (the point's own cell), and the sampled density ds.pdf for this sample's own share.
+        // Every channel's pdf of the three techniques, p_seg where each technique evaluates it (the
+        // point's own cell).
         const float p_v = scene.medium.emission_pdf(y);
         Spectrum pdf = st.uni * sh.uni * detail::broadcast_majorant<Spectrum>(v->mu);
         pdf += st.nee * sh.nee * ((nee_alternative ? p_v * ds.t * ds.t : 0.f) + dir_pdf * (p_v / along));
