@@ -206,8 +206,8 @@ struct StepReport {
 /// Samples tentative collisions with density mu_bar(t) Tbar(tmin, t) along `ray` over
 /// [tmin, tmax], segment by segment, and calls `on_collision` at each (THEORY 4.1). With a
 /// per-channel majorant, `channel` is the sampling channel c*: distances are drawn with its
-/// majorant and every channel's optical depth is accumulated over the same stretches (THEORY
-/// 5.3). The majorant's bound policy acts on each lookup before the callback sees it
+/// majorant and every channel's optical depth is accumulated over the same stretches
+/// (THEORY 5.3). The majorant's bound policy acts on each lookup before the callback sees it
 /// (bound::Clamp clamps it, bound::Reject ends the flight with `rejected`). Counts one density
 /// lookup per tentative collision, and the DDA steps of a grid majorant if the counter records
 /// them. Never throws.

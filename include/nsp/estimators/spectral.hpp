@@ -10,9 +10,9 @@
 //
 //     estimate_lambda = f_lambda / sum_c q_c (p_uni,c + p_nee,c),
 //
-// and the 3 x C of spectral MIS + NEE + equiangular sampling (strategy::EquiangularMis, THEORY
-// 5.4): a real vertex drawn toward the point light, its nulls ratio-tracked with c*'s majorant,
-// every channel's tracking and equiangular pdf of it in the same sum.
+// and the 3 x C of spectral MIS + NEE + equiangular sampling (strategy::EquiangularMis,
+// THEORY 5.4): a real vertex drawn toward the point light, its nulls ratio-tracked with c*'s
+// majorant, every channel's tracking and equiangular pdf of it in the same sum.
 #pragma once
 
 #include <algorithm>
