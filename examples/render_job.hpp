@@ -11,12 +11,12 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <nsp/nsp.hpp>
 
-#include "combinations.hpp"
-#include "default_scene.hpp"
+#include "scene_choice.hpp"
 
 namespace nsp_examples {
 
@@ -81,5 +81,13 @@ RenderStats render_combination(std::size_t index, const RenderRequest& request, 
 extern template RenderStats render_combination<nsp::Mono>(std::size_t, const RenderRequest&, std::vector<float>&);
 extern template RenderStats render_combination<nsp::Rgb>(std::size_t, const RenderRequest&, std::vector<float>&);
 extern template RenderStats render_combination<Hero4>(std::size_t, const RenderRequest&, std::vector<float>&);
+
+/// render_combination in the spectral mode named `mode` (mono, rgb or hero).
+inline RenderStats render_in_mode(std::string_view mode, std::size_t index, const RenderRequest& rq,
+                                  std::vector<float>& rgb) {
+    if (mode == nsp::Mono::name) return render_combination<nsp::Mono>(index, rq, rgb);
+    if (mode == nsp::Rgb::name) return render_combination<nsp::Rgb>(index, rq, rgb);
+    return render_combination<Hero4>(index, rq, rgb);
+}
 
 }  // namespace nsp_examples

@@ -7,7 +7,11 @@
 #     and the grid majorant, the fog lit by a lamp (set-ups F1, F2, F3, mono, 64x64) with
 #     tracking + NEE, equiangular + NEE and their three-way MIS, and the flame in the plume
 #     (set-up P1, rgb, 64x64) with the collision estimator, emission NEE and their MIS, each under
-#     the global and the grid majorant; EXRs in ./out, one efficiency table per set-up and mode;
+#     the global and the grid majorant; one efficiency table per set-up and mode, then a summary
+#     (per table the best row and the scene's MIS against its best single strategy). In ./out: an
+#     EXR per row, a PNG contact sheet per table (SETUP[_mode]_sheet.png, the rows in table order)
+#     and a larger PNG picture of each scene (cloud.png, chromatic.png, sparse.png, fog.png,
+#     plume.png; --picture-res, 256 by default). docs/renderer.md explains every flag;
 # With --with-references it then also runs (about 105 s more, which would take the default run past
 # five minutes on 2 cores with the renderer's build; README's heavy-tail tables come from it):
 #  2. the heavy-tail comparison: the grey-majorant baseline against spectral MIS + NEE (per-channel
@@ -22,8 +26,9 @@
 #     fog: a 1/r^2 tail) and P1 (the collision estimator rarely reaches the flame): 3 runs each,
 #     2048-spp references (fog: uni-nee-eq-mis_balance_absorb-event; plume:
 #     directional-mis_grid_balance_absorb-weight), time x variance from the effective variance.
-# Step 1 renders in about 140 s on 2 cores, all three in about 250 s (measured 2026-11-30 at
-# ecb55af, build up to date).
+# Step 1 renders in about 160 s on 2 cores (its pictures about 17 s of it), all three in about
+# 270 s, with the build up to date; the renderer's build takes about 2.5 minutes more on a fresh
+# machine.
 # With other arguments, runs nsp_render once with them instead (see build/examples/nsp_render --help).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -50,10 +55,10 @@ echo
 echo "Heavy-tail comparison: grey-majorant baseline vs spectral MIS + NEE (per-channel and global"
 echo "majorant), 3 runs, effective variance against a 2048-spp reference"
 build/examples/nsp_render --scene chromatic --runs 3 --res 32x32 --spp 128 --no-exr \
-    --reference-spp 2048 --selection uniform \
+    --reference-spp 2048 --selection uniform --no-png \
     --estimators uni-nee-mis_grey_balance_absorb-weight,uni-nee-mis_spectral-mis_absorb-weight
 echo
 echo "Lamp in fog (F1) and flame in smoke (P1): 3 runs, effective variance against 2048-spp references"
-build/examples/nsp_render --scene fog,plume --setup F1,P1 --runs 3 --reference-spp 2048 --no-exr
+build/examples/nsp_render --scene fog,plume --setup F1,P1 --runs 3 --reference-spp 2048 --no-exr --no-png
 echo
 echo "main job: $((SECONDS - start)) s of rendering"

@@ -1,0 +1,51 @@
+// examples/cli.hpp: nsp_render's command line: the options of a run and their parser (CLI11).
+// docs/renderer.md explains every flag at length; --help is the one-screen summary.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "render_job.hpp"
+#include "scene_choice.hpp"
+
+namespace nsp_examples {
+
+/// Everything a run of nsp_render is asked to do.
+struct Options {
+    std::optional<int> width, height, spp;  ///< empty: the scene's default
+    int threads = 1;                        ///< default: hardware concurrency
+    std::uint64_t seed = 1;
+    int runs = 1;
+    std::optional<int> reference_spp;  ///< --reference-spp: effective (error-based) variance
+    nsp::EstimatorOptions estimator;   ///< max depth, equiangular and emission-segment settings
+    std::string out = "out";
+    bool write_exr = true;
+    bool write_png = true;
+    int picture_res = 256;  ///< the larger picture of each scene; 0: none
+    bool list = false;
+    std::vector<SceneKind> scenes;        ///< default: every scene of the catalogue
+    std::vector<std::string> setups;      ///< default: the catalogue's default set-ups
+    std::vector<std::string> majorants;   ///< majorant names (empty: the scene's defaults)
+    bool all_majorants = false;           ///< --majorant all: names without a row in a mode are no error
+    MajorantSettings majorant;            ///< --grid-res, --majorant-scale
+    std::vector<std::string_view> modes;  ///< empty: the scene's default modes
+    std::vector<std::string> estimators;  ///< filter tokens (empty: the scene's defaults)
+    std::vector<SelectionRule> selections{SelectionRule::Uniform, SelectionRule::Luminance};
+    LightOverrides lights;
+};
+
+/// Parses the command line. Prints the help and exits 0 on --help; prints a message naming the
+/// bad flag or value and what is allowed, and exits 2, on any error.
+Options parse_command_line(int argc, char** argv);
+
+/// Prints "nsp_render: msg" and the pointer to --help on stderr and exits 2 (also for the
+/// planner's errors, which only show once the flags are combined).
+[[noreturn]] void usage_error(const std::string& msg);
+
+/// The parts of `s` between separators `sep` (an empty part where two separators meet).
+std::vector<std::string_view> split(std::string_view s, char sep);
+
+}  // namespace nsp_examples
