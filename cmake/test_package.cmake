@@ -1,11 +1,17 @@
 # ctest script: install nsp from the build tree into a scratch prefix, then build and run the
-# consumer project against it with find_package, and again with add_subdirectory.
-# Inputs: NSP_SOURCE_DIR, NSP_BINARY_DIR, WORK_DIR, GENERATOR.
+# consumer project against it with find_package, and again with add_subdirectory. Both builds
+# compile and run the code snippets of the README (cmake/consumer/CMakeLists.txt): the installed
+# build is given the README's path, the subdirectory build finds it in NSP_SOURCE_DIR.
+# Inputs: NSP_SOURCE_DIR, NSP_BINARY_DIR, WORK_DIR, GENERATOR; optional NSP_README (default
+# ${NSP_SOURCE_DIR}/README.md).
 foreach(v NSP_SOURCE_DIR NSP_BINARY_DIR WORK_DIR)
     if(NOT DEFINED ${v})
         message(FATAL_ERROR "test_package.cmake needs -D${v}=...")
     endif()
 endforeach()
+if(NOT DEFINED NSP_README)
+    set(NSP_README ${NSP_SOURCE_DIR}/README.md)
+endif()
 file(REMOVE_RECURSE ${WORK_DIR})
 
 function(run)
@@ -18,7 +24,7 @@ endfunction()
 
 run(${CMAKE_COMMAND} --install ${NSP_BINARY_DIR} --prefix ${WORK_DIR}/prefix)
 run(${CMAKE_COMMAND} -S ${NSP_SOURCE_DIR}/cmake/consumer -B ${WORK_DIR}/installed -G ${GENERATOR}
-    -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH=${WORK_DIR}/prefix)
+    -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH=${WORK_DIR}/prefix -DNSP_README=${NSP_README})
 run(${CMAKE_COMMAND} --build ${WORK_DIR}/installed)
 run(${WORK_DIR}/installed/consumer)
 

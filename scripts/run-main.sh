@@ -12,7 +12,7 @@
 #     EXR per row, a PNG contact sheet per table (SETUP[_mode]_sheet.png, the rows in table order)
 #     and a larger PNG picture of each scene (cloud.png, chromatic.png, sparse.png, fog.png,
 #     plume.png; --picture-res, 256 by default). docs/renderer.md explains every flag;
-# With --with-references it then also runs (about 105 s more, which would take the default run past
+# With --with-references it then also runs (about 90 s more, which would take the default run past
 # five minutes on 2 cores with the renderer's build; README's heavy-tail tables come from it):
 #  2. the heavy-tail comparison: the grey-majorant baseline against spectral MIS + NEE (per-channel
 #     and global majorant, uniform selection) on the chromatic cloud, 3 runs each at 32x32. The
@@ -48,7 +48,7 @@ build/examples/nsp_render --out out
 if [ "$references" = 0 ]; then
     echo
     echo "main job: $((SECONDS - start)) s of rendering (scripts/run-main.sh --with-references adds the"
-    echo "heavy-tail comparisons against 2048-spp references, about 105 s more)"
+    echo "heavy-tail comparisons against 2048-spp references, about 90 s more)"
     exit 0
 fi
 echo

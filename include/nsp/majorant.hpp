@@ -32,9 +32,8 @@ namespace nsp {
 ///   wherever mu_t > 0; the variance grows without bound as mu_bar falls below mu_t.
 /// - `Clamp` (b): biased, bounded variance. Each lookup's coefficients are scaled (albedo kept)
 ///   so that mu_t <= mu_bar in every channel: the estimate is exact for the clamped medium.
-/// - `Reject` (c): a collision with mu_t > mu_bar (1 + kBoundSlack) in any channel asserts in a
-///   debug build (NSP_DEBUG, or NDEBUG undefined) and, in release, ends the flight with
-///   SegmentEnd::Rejected: the path contributes 0 and reports Status::Rejected.
+/// - `Reject` (c): a collision with mu_t > mu_bar (1 + kBoundSlack) in any channel ends the flight
+///   with SegmentEnd::Rejected: the path contributes 0 and reports Status::Rejected.
 namespace bound {
 struct Guaranteed {
     static constexpr const char* name = "bounding";
