@@ -1,6 +1,7 @@
 // nsp/nsp.hpp: the umbrella header, everything nsp offers.
 #pragma once
 
+#include "bsdf.hpp"
 #include "channel_tracking.hpp"
 #include "color.hpp"
 #include "core/counter.hpp"
@@ -24,3 +25,4 @@
 #include "scene.hpp"
 #include "spectrum.hpp"
 #include "tracking.hpp"
+#include "vertex.hpp"

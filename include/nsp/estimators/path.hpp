@@ -35,40 +35,11 @@
 #include "../pdf.hpp"
 #include "../scene.hpp"
 #include "../tracking.hpp"
+#include "../vertex.hpp"
 #include "common.hpp"
 
 namespace nsp {
 
-/// The unidirectional strategy's pdf of a light path segment relative to the shared prefix:
-/// q p_w, times prod_j P_n(n_j) when the strategy uses null-scattering pdfs (THEORY 5.1, 5.6).
-/// Both weights below use it, so the two sides of one path cannot disagree.
-template <PathStrategy St>
-float unidirectional_pdf(float survival, float phase_pdf, float null_pdf_product) noexcept {
-    if constexpr (St::null_pdfs) return survival * phase_pdf * null_pdf_product;
-    else return survival * phase_pdf;
-}
-
-/// MIS weight of the unidirectional technique for a path whose last segment, tracked from a real
-/// vertex with roulette survival `survival` and phase pdf `phase_pdf`, hit a light that NEE
-/// samples with solid-angle pdf `light_pdf`. `null_pdf_product` is prod_j P_n(n_j) of the
-/// segment's nulls (used by NullScatteringMis only). THEORY 5.1, 5.2, 5.6.
-template <PathStrategy St, mis::CombiningHeuristic H>
-float unidirectional_weight(const H& h, float survival, float phase_pdf, float null_pdf_product,
-                            float light_pdf) noexcept {
-    // Both weights through weight_among with the same two pdfs, not h.weight of a ratio and of its
-    // inverse: a ratio beyond float range (a denormal p_uni) made the two not sum to 1 under
-    // Power with a small exponent (found by the fuzzer, tests/fuzz).
-    return mis::weight_among(h, unidirectional_pdf<St>(survival, phase_pdf, null_pdf_product), light_pdf);
-}
-
-/// MIS weight of NEE for the same kind of path, sampled by the light (pdf `light_pdf` > 0) with
-/// ratio tracking, whose nulls have delta-tracking product `null_pdf_product`. For one path,
-/// unidirectional_weight + next_event_weight = 1.
-template <PathStrategy St, mis::CombiningHeuristic H>
-float next_event_weight(const H& h, float survival, float phase_pdf, float null_pdf_product,
-                        float light_pdf) noexcept {
-    return mis::weight_among(h, light_pdf, unidirectional_pdf<St>(survival, phase_pdf, null_pdf_product));
-}
 /// The three techniques that can produce a path's last real vertex x and its light vertex y
 /// when equiangular sampling is on (THEORY 5.4).
 enum class VertexTechnique : std::uint8_t {
@@ -178,11 +149,10 @@ public:
     using Absorption = A;
 
     /// Throws InvalidArgument on max_depth < 0, rr_start_depth < 1 or rr_max_survival outside (0, 1].
-    explicit PathEstimator(EstimatorOptions opts = {}, H heuristic = H{}) : opts_(opts), heuristic_(heuristic) {
-        validate(opts);
-    }
+    explicit PathEstimator(EstimatorOptions opts = {}, H heuristic = H{})
+        : kernels_(opts, heuristic) {}
 
-    const EstimatorOptions& options() const noexcept { return opts_; }
+    const EstimatorOptions& options() const noexcept { return kernels_.options(); }
 
     /// An estimate of the radiance arriving at `ray.o` from direction -ray.d. Never throws.
     template <class Sc, UniformRng R, LookupCounter C>
@@ -214,8 +184,8 @@ public:
                 if (target) {
                     const Interval in = scene.medium.bounds().clip(ray, 0.f, hit.t);
                     eq = EquiangularSampler(ray, *target, in.t0, in.t1);
-                    eq_select = equiangular_selection<St>(opts_, scene, ray, eq, lambda);
-                    if (depth < opts_.max_depth && (eq_select >= 1.f || rng.uniform() < eq_select)) {
+                    eq_select = equiangular_selection<St>(kernels_.options(), scene, ray, eq, lambda);
+                    if (depth < kernels_.options().max_depth && (eq_select >= 1.f || rng.uniform() < eq_select)) {
                         const Status es =
                             equiangular_vertex(scene, ray, eq, eq_select, depth + 1, beta, lambda, rng, counter, L);
                         if (es != Status::Ok) status = es;
@@ -228,7 +198,7 @@ public:
                 // grid along it (W: its normaliser; 0 where it does not run).
                 float along = 0.f;
                 if constexpr (St::combines) {
-                    if (opts_.emission_along_segments) {
+                    if (kernels_.options().emission_along_segments) {
                         along = scene.medium.emission_along(ray, 0.f, hit.t);
                         if (along > 0.f) {
                             const Status es = emission_segment(scene, ray, hit.t, along, !from_camera, prev_survival,
@@ -240,7 +210,7 @@ public:
                 if (from_camera || St::hits_lights) {
                     // The NEE alternative of emission exists from real vertices only (THEORY 5.7).
                     seg = track_delta_visiting<A>(scene.medium, scene.majorant, ray, hit.t, lambda, rng, counter,
-                                                  EmissionCollector<Sc>{scene, ray, lambda, beta, L, heuristic_,
+                                                  EmissionCollector<Sc>{scene, ray, lambda, beta, L, kernels_.heuristic(),
                                                                         !from_camera, prev_survival, prev_phase_pdf,
                                                                         along});
                 } else {
@@ -265,10 +235,10 @@ public:
                                 const float s = unidirectional_pdf<St>(prev_survival, prev_phase_pdf,
                                                                        seg.null_pdf_product) /
                                                 scene.lights.pdf(prev_x, hit);
-                                w = equiangular_mis_weight(heuristic_, VertexTechnique::TrackHit, 1.f, s, prev_eq_ratio);
+                                w = equiangular_mis_weight(kernels_.heuristic(), VertexTechnique::TrackHit, 1.f, s, prev_eq_ratio);
                             } else {
-                                w = unidirectional_weight<St>(heuristic_, prev_survival, prev_phase_pdf,
-                                                              seg.null_pdf_product, scene.lights.pdf(prev_x, hit));
+                                w = kernels_.hit_weight(VertexPdf::scattered(prev_survival, prev_phase_pdf),
+                                                        seg.null_pdf_product, scene.lights.pdf(prev_x, hit));
                             }
                         }
                     }
@@ -278,7 +248,7 @@ public:
                 break;
             }
             if (seg.end != SegmentEnd::Scattered) break;  // absorbed
-            if (++depth > opts_.max_depth) break;
+            if (++depth > kernels_.options().max_depth) break;
 
             const Vec3 x = ray.at(seg.t);
             // p_eq / p_track of this vertex: the nulls' P_n and mu_bar P_s against the equiangular
@@ -288,9 +258,7 @@ public:
                 if (target)
                     eq_ratio = equiangular_over_tracking(eq_select * eq.pdf(seg.t), seg.null_pdf_product, seg.event_density);
             // Roulette survival is fixed before NEE: the continuing unidirectional path carries it.
-            float q = 1.f;
-            if (opts_.russian_roulette && depth >= opts_.rr_start_depth)
-                q = std::min(opts_.rr_max_survival, beta.abs().maxCoeff());
+            const float q = kernels_.survival(depth, beta);
             if constexpr (St::samples_lights) {
                 // Equiangular + NEE alone leaves the lights to its own vertices when it has a target.
                 if (St::combines || !St::equiangular || !target) {
@@ -336,10 +304,9 @@ private:
         if (!(ls.pdf > 0.f)) return Status::Ok;
         const Ray shadow{x, ls.wi};
         if (ls.occludable_by_sphere && scene.lights.sphere_blocks(shadow, ls.distance)) return Status::Ok;
-        const auto tr = track_ratio<A, St::null_pdfs>(scene.medium, scene.majorant, shadow,
-                                                      ls.distance, lambda, rng, counter);
-        if (tr.end == SegmentEnd::Aborted || tr.end == SegmentEnd::Rejected) return flight_status(tr.end);
-        if (tr.end == SegmentEnd::Terminated) return Status::Ok;
+        const auto tr = kernels_.shadow(scene.medium, scene.majorant, shadow, ls.distance, lambda, rng, counter);
+        if (tr.status != Status::Ok) return tr.status;
+        if (!(tr.transmittance != 0.f).any()) return Status::Ok;
         float w = 1.f;
         if constexpr (St::combines) {
             if constexpr (St::equiangular) {
@@ -348,12 +315,11 @@ private:
                 const float s = ls.delta ? 0.f
                                          : unidirectional_pdf<St>(survival, scene.phase.pdf(wo, ls.wi),
                                                                   tr.null_pdf_product) / ls.pdf;
-                w = equiangular_mis_weight(heuristic_,
+                w = equiangular_mis_weight(kernels_.heuristic(),
                                            equiangular_drawn ? VertexTechnique::EquiangularNee : VertexTechnique::TrackNee,
                                            track_ratio_, track_ratio_ * s, eq_ratio);
-            } else if (!ls.delta) {  // a point light cannot be hit: NEE keeps weight 1
-                w = next_event_weight<St>(heuristic_, survival, scene.phase.pdf(wo, ls.wi),
-                                          tr.null_pdf_product, ls.pdf);
+            } else {  // a point light cannot be hit: NEE keeps weight 1
+                w = kernels_.light_weight(survival, scene.phase.pdf(wo, ls.wi), tr.null_pdf_product, ls.pdf, ls.delta);
             }
         }
         NSP_DEBUG_ASSERT(!(w < 0.f) && !(w > 1.f), "an MIS weight left [0, 1]");
@@ -386,12 +352,9 @@ private:
         float track = 0.f, q = 1.f;  // p_track / p_eq of x; the roulette survival tracking would use at x
         if constexpr (St::combines) {
             track = tracking_over_equiangular<A>(ds.pdf, tr.null_pdf_product, c, mu_bar);
-            if (track > 0.f && opts_.russian_roulette && depth >= opts_.rr_start_depth) {
-                // Roulette survival is a function of the path: the throughput tracking would carry
-                // at x (null weights mu_n / (mu_bar P_n), real weight mu_s / (mu_bar P_s)), that is
-                // beta_eq p_eq / p_track.
-                q = std::min(opts_.rr_max_survival, (beta_eq / track).abs().maxCoeff());
-            }
+            // Roulette survival is a function of the path: the throughput tracking would carry at x
+            // (null weights mu_n / (mu_bar P_n), real weight mu_s / (mu_bar P_s)), beta_eq p_eq / p_track.
+            if (track > 0.f) q = kernels_.survival(depth, beta_eq / track);
         }
         return next_event(scene, x, ray.d, q, lambda, rng, counter, beta_eq, L, track, 1.f, true);
     }
@@ -444,9 +407,9 @@ private:
                             const typename Sc::Spectrum& beta, typename Sc::Spectrum& L) const {
         const DistanceSample ds = scene.medium.sample_emission_along(ray, 0.f, tmax, along, rng.uniform());
         if (!(ds.pdf > 0.f)) return Status::Ok;
-        const auto tr = track_ratio<A, St::null_pdfs>(scene.medium, scene.majorant, ray, ds.t, lambda, rng, counter);
-        if (tr.end == SegmentEnd::Aborted || tr.end == SegmentEnd::Rejected) return flight_status(tr.end);
-        if (tr.end == SegmentEnd::Terminated) return Status::Ok;
+        const auto tr = kernels_.shadow(scene.medium, scene.majorant, ray, ds.t, lambda, rng, counter);
+        if (tr.status != Status::Ok) return tr.status;
+        if (!(tr.transmittance != 0.f).any()) return Status::Ok;
         const auto v = lookup_untracked(scene.medium, scene.majorant, ray, ds.t, lambda, counter);
         if (!v) return Status::Rejected;
         if (!(v->k.sigma_a > 0.f).any()) return Status::Ok;
@@ -457,7 +420,7 @@ private:
         const EmissionPdfs p = from_vertex ? emission_pdfs<St>(survival, phase_pdf, tr.null_pdf_product, v->mu,
                                                                p_v / along, ds.t * ds.t, p_v)
                                            : emission_pdfs<St>(1.f, 1.f, tr.null_pdf_product, v->mu, p_v / along, 0.f, 0.f);
-        const float w = emission_weight(heuristic_, EmissionTechnique::Segment, p);
+        const float w = emission_weight(kernels_.heuristic(), EmissionTechnique::Segment, p);
         L += beta * tr.transmittance * v->k.sigma_a * le * (w / ds.pdf);
         return Status::Ok;
     }
@@ -471,24 +434,25 @@ private:
                           const typename Sc::Spectrum& beta, typename Sc::Spectrum& L) const {
         const auto e = sample_emission_from(scene.medium, scene.lights, x, rng);
         if (!e) return Status::Ok;
-        const auto tr = track_ratio<A, St::null_pdfs>(scene.medium, scene.majorant, e->shadow, e->dist, lambda, rng, counter);
-        if (tr.end == SegmentEnd::Aborted || tr.end == SegmentEnd::Rejected) return flight_status(tr.end);
-        if (tr.end == SegmentEnd::Terminated) return Status::Ok;
+        const auto tr = kernels_.shadow(scene.medium, scene.majorant, e->shadow, e->dist, lambda, rng, counter);
+        if (tr.status != Status::Ok) return tr.status;
+        if (!(tr.transmittance != 0.f).any()) return Status::Ok;
         const auto v = lookup_untracked(scene.medium, scene.majorant, e->shadow, e->dist, lambda, counter);
         if (!v) return Status::Rejected;
         const typename Sc::Spectrum le = scene.medium.emission(e->y.p, lambda);
         const Vec3& wi = e->shadow.d;
         float w = 1.f;
         if constexpr (St::combines)
-            w = emission_weight(heuristic_, EmissionTechnique::Nee,
+            w = emission_weight(kernels_.heuristic(), EmissionTechnique::Nee,
                                 emission_pdfs<St>(survival, scene.phase.pdf(wo, wi), tr.null_pdf_product, v->mu,
-                                                  emission_segment_pdf(opts_, scene, *e), e->dist2, e->y.pdf));
+                                                  emission_segment_pdf(kernels_.options(), scene, *e), e->dist2, e->y.pdf));
         L += beta * tr.transmittance * v->k.sigma_a * le * (w * scene.phase.eval(wo, wi) / (e->dist2 * e->y.pdf));
         return Status::Ok;
     }
 
-    EstimatorOptions opts_;
-    [[no_unique_address]] H heuristic_;
+    /// The path-vertex kernels a host's own loop calls too (vertex.hpp), with the options and
+    /// the heuristic.
+    VertexKernels<St, H, A> kernels_;
 };
 
 }  // namespace nsp

@@ -1,0 +1,136 @@
+// nsp/bsdf.hpp: surface scattering for path vertices on a host's surfaces (THEORY 5.8): the
+// concept a host's BSDF models, and three models: Lambertian reflection, a perfect mirror (a
+// delta lobe) and a null interface (the index-matched boundary of a medium, which a path crosses
+// without a real vertex).
+//
+// Directions follow propagation, as for phase functions (phase.hpp): `wo` is the direction the
+// path travelled to reach the surface (the ray's direction), `wi` the direction it leaves in. `n`
+// is the shading normal, of either orientation: a one-sided model decides the side from `wo`.
+// A BSDF's `value` is f_s(wo, wi) |n . wi|, the cosine of the outgoing direction included, so
+// that a path's throughput is multiplied by value / pdf at a surface vertex exactly as by
+// f_p / pdf at a medium vertex, and NEE adds value / light_pdf at either.
+#pragma once
+
+#include <cmath>
+#include <concepts>
+
+#include "core/error.hpp"
+#include "core/math.hpp"
+#include "media/validate.hpp"
+#include "spectrum.hpp"
+
+namespace nsp {
+
+/// A direction drawn from a BSDF: the throughput factor value = f_s |n . wi| and its pdf. For a
+/// delta lobe `pdf` is the discrete probability of the lobe (1 for a single lobe), value / pdf
+/// the lobe's weight, and no other technique can produce wi (`delta`).
+template <SpectralMode S>
+struct BsdfSample {
+    Vec3 wi{0.f, 0.f, 1.f};
+    float pdf = 0.f;                        ///< solid-angle density of wi (0: no sample)
+    typename S::Spectrum value = S::Spectrum::Zero();  ///< f_s(wo, wi) |n . wi|
+    bool delta = false;                     ///< a delta lobe: light sampling cannot produce wi
+};
+
+/// A BSDF provides `sample(wo, n, u1, u2, lambda)`, `eval(wo, wi, n, lambda)` (f_s |n . wi|; 0
+/// for the directions of a delta lobe, which no other technique reaches) and `pdf(wo, wi, n)` of
+/// its own sampling (0 for delta lobes). `passes_through` is true for a null interface: the path
+/// crosses it as it would cross empty space, with no real vertex (its MIS state carries on).
+template <class B, class S>
+concept Bsdf = SpectralMode<S> && requires(const B& b, const Vec3& w, float u, const typename S::Wavelengths& l) {
+    { b.sample(w, w, u, u, l) } -> std::same_as<BsdfSample<S>>;
+    { b.eval(w, w, w, l) } -> std::same_as<typename S::Spectrum>;
+    { b.pdf(w, w, w) } -> std::same_as<float>;
+    { B::passes_through } -> std::convertible_to<bool>;
+};
+
+namespace detail {
+/// The unit normal on the side of the surface the path arrived from (opposite to wo).
+inline Vec3 facing(const Vec3& wo, const Vec3& n) noexcept { return glm::dot(wo, n) > 0.f ? -n : n; }
+}  // namespace detail
+
+/// Lambertian reflection f_s = albedo / pi on the side the path arrived from, sampled by the
+/// cosine: pdf = |n . wi| / pi. Transmits nothing.
+template <SpectralMode S>
+class LambertianBsdf {
+public:
+    static constexpr bool passes_through = false;
+
+    /// Throws InvalidArgument unless every channel of `albedo` is finite and in [0, 1].
+    explicit LambertianBsdf(typename S::Coefficient albedo) : albedo_(albedo) {
+        detail::require_coefficient(albedo_, "LambertianBsdf albedo");
+        if (const float m = max_value(albedo_); !(m <= 1.f))
+            detail::fail("LambertianBsdf albedo = ", m, " (its largest channel) is not allowed: every channel must lie in [0, 1]");
+    }
+
+    BsdfSample<S> sample(const Vec3& wo, const Vec3& n, float u1, float u2,
+                         const typename S::Wavelengths& lambda = {}) const noexcept {
+        const Vec3 up = detail::facing(wo, n);
+        const float cos_theta = std::sqrt(std::max(0.f, 1.f - u1));  // p(cos) = 2 cos: cosine-weighted
+        BsdfSample<S> s;
+        s.wi = direction_around(up, cos_theta, 2.f * kPi * u2);
+        s.pdf = cos_theta / kPi;
+        if (!(s.pdf > 0.f)) return BsdfSample<S>{};
+        s.value = S::sample(albedo_, lambda) * (cos_theta / kPi);
+        return s;
+    }
+    typename S::Spectrum eval(const Vec3& wo, const Vec3& wi, const Vec3& n,
+                              const typename S::Wavelengths& lambda = {}) const noexcept {
+        const float c = glm::dot(wi, detail::facing(wo, n));
+        return c > 0.f ? typename S::Spectrum(S::sample(albedo_, lambda) * (c / kPi)) : typename S::Spectrum(S::Spectrum::Zero());
+    }
+    float pdf(const Vec3& wo, const Vec3& wi, const Vec3& n) const noexcept {
+        const float c = glm::dot(wi, detail::facing(wo, n));
+        return c > 0.f ? c / kPi : 0.f;
+    }
+
+private:
+    typename S::Coefficient albedo_;
+};
+
+/// A perfect mirror with per-channel reflectance: one delta lobe, wi = wo reflected about n.
+template <SpectralMode S>
+class MirrorBsdf {
+public:
+    static constexpr bool passes_through = false;
+
+    /// Throws InvalidArgument unless every channel of `reflectance` is finite and >= 0.
+    explicit MirrorBsdf(typename S::Coefficient reflectance) : reflectance_(reflectance) {
+        detail::require_coefficient(reflectance_, "MirrorBsdf reflectance");
+    }
+
+    BsdfSample<S> sample(const Vec3& wo, const Vec3& n, float, float,
+                         const typename S::Wavelengths& lambda = {}) const noexcept {
+        BsdfSample<S> s;
+        s.wi = wo - 2.f * glm::dot(wo, n) * n;
+        s.pdf = 1.f;
+        s.value = S::sample(reflectance_, lambda);
+        s.delta = true;
+        return s;
+    }
+    typename S::Spectrum eval(const Vec3&, const Vec3&, const Vec3&, const typename S::Wavelengths& = {}) const noexcept {
+        return S::Spectrum::Zero();
+    }
+    float pdf(const Vec3&, const Vec3&, const Vec3&) const noexcept { return 0.f; }
+
+private:
+    typename S::Coefficient reflectance_;
+};
+
+/// The boundary of a medium between index-matched sides: the path goes straight on (wi = wo,
+/// weight 1). A host crosses it without a real vertex: it changes the current medium and keeps
+/// tracking, and the null-pdf products of the segments on both sides multiply (THEORY 5.8).
+template <SpectralMode S>
+struct NullInterface {
+    static constexpr bool passes_through = true;
+
+    BsdfSample<S> sample(const Vec3& wo, const Vec3&, float, float, const typename S::Wavelengths& = {}) const noexcept {
+        return {wo, 1.f, S::Spectrum::Ones(), true};
+    }
+    typename S::Spectrum eval(const Vec3&, const Vec3&, const Vec3&, const typename S::Wavelengths& = {}) const noexcept {
+        return S::Spectrum::Zero();
+    }
+    float pdf(const Vec3&, const Vec3&, const Vec3&) const noexcept { return 0.f; }
+};
+
+}  // namespace nsp

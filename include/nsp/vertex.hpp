@@ -1,0 +1,210 @@
+// nsp/vertex.hpp: path-vertex kernels, for a host renderer's own path loop and for nsp's
+// estimators alike (THEORY 5.1, 5.6, 5.8). The host owns the geometry, the lights and the loop;
+// these kernels own what null-scattering MIS needs from the media: the tracked segment and its
+// null-pdf product, the shadow ray's transmittance with the pdf unidirectional tracking would have
+// had for it, the roulette survival, and the MIS weights at an emitter hit and at a light sample,
+// for a vertex on a surface (BSDF pdf) or in a medium (phase pdf).
+//
+// One path of a host's loop, grey (one pdf for every channel), with a VertexKernels `k`:
+//
+//     VertexPdf from = VertexPdf::from_camera();   // the last real vertex, for MIS
+//     float nulls = 1;                              // prod P_n of the segments since then
+//     for (int depth = 0;;) {
+//         hit = host.intersect(ray);                // the surface the ray reaches (t = inf: none)
+//         seg = k.track(medium, majorant, ray, hit.t, lambda, rng, counter);
+//         if (seg.end is not Passed/Scattered) break;   // absorbed, or a failed flight (status)
+//         beta *= seg.weight; nulls *= seg.null_pdf_product;
+//         if (seg.end == Passed) {                  // the surface (or nothing) at hit.t
+//             if (emitter && k.counts_hit(from)) L += beta * Le * k.hit_weight(from, nulls, light_pdf);
+//             if (null interface) { switch media; ray = continue past it; continue; }   // no vertex
+//             vertex = surface;                     // else a real surface vertex
+//         }                                         // else a real medium vertex at seg.t
+//         q = k.survival(++depth, beta);            // before NEE: both continuations share it
+//         if (not a delta lobe) { light = host.sample_light(x); sh = k.shadow(medium, majorant, shadow_ray, light.dist, ...);
+//         L += beta * sh.transmittance * light.Le * f(wo, light.wi) *
+//              k.light_weight(q, pdf(wo, light.wi), sh.null_pdf_product, light.pdf, light.delta) / light.pdf; }
+//         roulette with q; sample wi from the BSDF or phase function; beta *= value / pdf;
+//         from = VertexPdf::scattered(q, pdf, delta); nulls = 1; ray = {x, wi};
+//     }
+//
+// A shadow ray that crosses media boundaries is one `shadow` per medium, their transmittances and
+// null-pdf products multiplied; a path segment that crosses them multiplies its segments' products
+// likewise. Per-channel path pdfs (SpectralPathEstimator's channel policies) are the business of
+// track_channels_delta / track_channels_ratio and ChannelPathState (channel_tracking.hpp).
+#pragma once
+
+#include <algorithm>
+
+#include "estimators/common.hpp"
+#include "mis.hpp"
+#include "tracking.hpp"
+
+namespace nsp {
+
+/// The unidirectional strategy's pdf of a light path segment relative to the shared prefix:
+/// q p_w, times prod_j P_n(n_j) when the strategy uses null-scattering pdfs (THEORY 5.1, 5.6).
+/// Both weights below use it, so the two sides of one path cannot disagree.
+template <PathStrategy St>
+float unidirectional_pdf(float survival, float direction_pdf, float null_pdf_product) noexcept {
+    if constexpr (St::null_pdfs) return survival * direction_pdf * null_pdf_product;
+    else return survival * direction_pdf;
+}
+
+/// MIS weight of the unidirectional technique for a path whose last segment, tracked from a real
+/// vertex with roulette survival `survival` and direction pdf `direction_pdf` (phase or BSDF),
+/// hit a light that NEE samples with solid-angle pdf `light_pdf`. `null_pdf_product` is
+/// prod_j P_n(n_j) of the segment's nulls (used by NullScatteringMis only). THEORY 5.1, 5.2, 5.6.
+template <PathStrategy St, mis::CombiningHeuristic H>
+float unidirectional_weight(const H& h, float survival, float direction_pdf, float null_pdf_product,
+                            float light_pdf) noexcept {
+    // Both weights through weight_among with the same two pdfs, not h.weight of a ratio and of its
+    // inverse: a ratio beyond float range (a denormal p_uni) made the two not sum to 1 under
+    // Power with a small exponent (found by the fuzzer, tests/fuzz).
+    return mis::weight_among(h, unidirectional_pdf<St>(survival, direction_pdf, null_pdf_product), light_pdf);
+}
+
+/// MIS weight of NEE for the same kind of path, sampled by the light (pdf `light_pdf` > 0) with
+/// ratio tracking, whose nulls have delta-tracking product `null_pdf_product`. For one path,
+/// unidirectional_weight + next_event_weight = 1.
+template <PathStrategy St, mis::CombiningHeuristic H>
+float next_event_weight(const H& h, float survival, float direction_pdf, float null_pdf_product,
+                        float light_pdf) noexcept {
+    return mis::weight_among(h, light_pdf, unidirectional_pdf<St>(survival, direction_pdf, null_pdf_product));
+}
+
+/// The last real vertex of a path, as the MIS weight of whatever its next segments reach needs it.
+struct VertexPdf {
+    float survival = 1.f;       ///< the roulette survival probability the path passed there
+    float direction_pdf = 0.f;  ///< solid-angle pdf of the direction drawn there (phase or BSDF)
+    bool delta = false;         ///< drawn from a delta lobe: light sampling cannot produce it
+    bool camera = true;         ///< no real vertex yet: the camera ray (no NEE alternative)
+
+    /// The camera: what its ray reaches is weighted 1.
+    static constexpr VertexPdf from_camera() noexcept { return {}; }
+    /// A real vertex that drew its outgoing direction with `direction_pdf` after roulette survival.
+    static constexpr VertexPdf scattered(float survival, float direction_pdf, bool delta = false) noexcept {
+        return {survival, direction_pdf, delta, false};
+    }
+};
+
+/// A shadow ray's transmittance through one medium, with the pdf ratio that NEE's MIS weight needs.
+template <SpectralMode S>
+struct ShadowTransmittance {
+    typename S::Spectrum transmittance = S::Spectrum::Zero();  ///< unbiased per-channel estimate (ratio tracking)
+    float null_pdf_product = 1.f;  ///< prod_j P_n(n_j) that delta tracking would have had at its nulls
+    Status status = Status::Ok;    ///< Aborted or Rejected: the flight failed and contributes 0
+};
+
+/// The path-vertex kernels of strategy St (which techniques a path combines and whether their
+/// pdfs include the nulls), MIS heuristic H (mis::None exactly for single strategies) and
+/// absorption policy A of the tracked segments. One object ties the three together, so that a
+/// shadow ray's null-pdf product is the one of the same delta tracking the path segments use, and
+/// both weights of one path use the same pdfs: for every path, hit_weight + light_weight = 1.
+/// Small and trivially copyable; every kernel is const, noexcept and allocates nothing.
+template <PathStrategy St, mis::Heuristic H = mis::None, AbsorptionPolicy A = absorption::Weight>
+class VertexKernels {
+public:
+    using Strategy = St;
+    using Heuristic = H;
+    using Absorption = A;
+
+    /// Throws InvalidArgument on invalid roulette settings (see EstimatorOptions).
+    explicit VertexKernels(EstimatorOptions opts = {}, H heuristic = H{}) : opts_(opts), heuristic_(heuristic) {
+        validate(opts);
+    }
+
+    const EstimatorOptions& options() const noexcept { return opts_; }
+    const H& heuristic() const noexcept { return heuristic_; }
+
+    /// Delta-tracks `ray` through `medium` up to `t_max` (the host's surface distance, kInf for
+    /// none): Scattered at a real vertex seg.t, Passed at t_max, Absorbed (absorption::Event), or
+    /// a failed flight (flight_status(seg.end) says which). seg.weight multiplies the throughput;
+    /// seg.null_pdf_product multiplies the path's product since its last real vertex.
+    template <Medium M, MajorantPolicy<M> Maj, UniformRng R, LookupCounter C>
+    DeltaTrack<typename M::Spectral> track(const M& medium, const Maj& majorant, const Ray& ray, float t_max,
+                                           const typename M::Spectral::Wavelengths& lambda, R& rng, C& counter) const {
+        return track_delta<A>(medium, majorant, ray, t_max, lambda, rng, counter);
+    }
+
+    /// The transmittance of a shadow ray through `medium` up to `distance` (ratio tracking), and
+    /// the product of the null probabilities delta tracking with policy A would have had at its
+    /// nulls (only where St weighs by null-scattering pdfs; 1 otherwise). Never throws.
+    template <Medium M, MajorantPolicy<M> Maj, UniformRng R, LookupCounter C>
+    ShadowTransmittance<typename M::Spectral> shadow(const M& medium, const Maj& majorant, const Ray& ray,
+                                                     float distance, const typename M::Spectral::Wavelengths& lambda,
+                                                     R& rng, C& counter) const {
+        const auto tr = track_ratio<A, St::null_pdfs>(medium, majorant, ray, distance, lambda, rng, counter);
+        ShadowTransmittance<typename M::Spectral> s;
+        if (tr.end == SegmentEnd::Aborted || tr.end == SegmentEnd::Rejected) {
+            s.status = flight_status(tr.end);
+            return s;
+        }
+        if (tr.end == SegmentEnd::Terminated) return s;  // every channel below float's range: 0
+        s.transmittance = tr.transmittance;
+        s.null_pdf_product = tr.null_pdf_product;
+        return s;
+    }
+
+    /// The roulette survival probability at the path's `depth`-th real vertex (1-based) with
+    /// throughput `beta`: 1 before EstimatorOptions::rr_start_depth, else min(rr_max_survival,
+    /// max_c |beta_c|) (THEORY 5.6). Decide it before NEE: the unidirectional continuation carries
+    /// it, so NEE's weight needs it.
+    template <class Spectrum>
+    float survival(int depth, const Spectrum& beta) const noexcept {
+        if (!opts_.russian_roulette || depth < opts_.rr_start_depth) return 1.f;
+        return std::min(opts_.rr_max_survival, float(beta.abs().maxCoeff()));
+    }
+
+    /// The MIS weight of an emitter that the path's segments from `from` reached, with the null
+    /// products of those segments multiplied into `null_pdf_product`, and `light_pdf` the
+    /// solid-angle pdf with which light sampling from `from` picks that point (light selection
+    /// included). 1 from the camera, after a delta lobe, or where light sampling cannot reach it
+    /// (light_pdf 0); 1 for single strategies (the host adds a hit only if St::hits_lights).
+    /// A NaN or negative pdf or product (bad host input) gives 0: the contribution is dropped,
+    /// never turned into a NaN.
+    float hit_weight(const VertexPdf& from, float null_pdf_product, float light_pdf) const noexcept {
+        if constexpr (!St::combines) {
+            (void)from, (void)null_pdf_product, (void)light_pdf;
+            return 1.f;
+        } else {
+            if (from.camera || from.delta) return 1.f;
+            if (!valid(from.survival, from.direction_pdf, null_pdf_product, light_pdf)) return 0.f;
+            if (!(light_pdf > 0.f)) return 1.f;
+            return unidirectional_weight<St>(heuristic_, from.survival, from.direction_pdf, null_pdf_product, light_pdf);
+        }
+    }
+
+    /// The MIS weight of a light sample drawn with solid-angle pdf `light_pdf` (selection
+    /// included) from a real vertex with roulette survival `survival`, whose BSDF or phase
+    /// function would draw that direction with `direction_pdf`; `null_pdf_product` from the shadow
+    /// rays. 1 for a delta light (nothing else reaches it) and for single strategies; 0 for a NaN
+    /// or negative pdf or product, as hit_weight.
+    float light_weight(float survival, float direction_pdf, float null_pdf_product, float light_pdf,
+                       bool delta_light) const noexcept {
+        if constexpr (!St::combines) {
+            (void)survival, (void)direction_pdf, (void)null_pdf_product, (void)light_pdf, (void)delta_light;
+            return 1.f;
+        } else {
+            if (delta_light) return 1.f;
+            if (!valid(survival, direction_pdf, null_pdf_product, light_pdf)) return 0.f;
+            return next_event_weight<St>(heuristic_, survival, direction_pdf, null_pdf_product, light_pdf);
+        }
+    }
+
+    /// Whether the host adds an emitter that the segments from `from` reach: always under a
+    /// strategy that counts hits, and otherwise from the camera and after a delta lobe, the paths
+    /// light sampling cannot produce.
+    static constexpr bool counts_hit(const VertexPdf& from) noexcept {
+        return St::hits_lights || from.camera || from.delta;
+    }
+
+private:
+    static bool valid(float survival, float direction_pdf, float null_pdf_product, float light_pdf) noexcept {
+        return survival >= 0.f && direction_pdf >= 0.f && null_pdf_product >= 0.f && light_pdf >= 0.f;
+    }
+
+    EstimatorOptions opts_;
+    [[no_unique_address]] H heuristic_;
+};
+
+}  // namespace nsp
