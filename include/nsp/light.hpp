@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cmath>
+#include <concepts>
 #include <limits>
 #include <optional>
 
@@ -14,27 +15,6 @@
 
 namespace nsp {
 
-/// An isotropic point light with radiant intensity `intensity` (W/sr). Reachable by NEE only.
-template <SpectralMode S>
-struct PointLight {
-    Vec3 position;
-    typename S::Coefficient intensity;
-};
-
-/// A sphere emitting radiance `radiance` from its surface, outward. Opaque: it blocks light.
-template <SpectralMode S>
-struct SphereLight {
-    Vec3 center;
-    float radius;
-    typename S::Coefficient radiance;
-};
-
-/// Constant radiance arriving from every direction at infinity.
-template <SpectralMode S>
-struct EnvironmentLight {
-    typename S::Coefficient radiance;
-};
-
 /// What a ray meets first among the lights.
 struct LightHit {
     float t = kInf;       ///< distance to the sphere light, or kInf (the environment)
@@ -44,13 +24,186 @@ struct LightHit {
 /// A light sample for next-event estimation from a point x.
 template <SpectralMode S>
 struct LightSample {
-    Vec3 wi;                          ///< unit direction from x toward the light
+    Vec3 wi{0.f, 0.f, 1.f};           ///< unit direction from x toward the light
     float distance = kInf;            ///< distance to the light's vertex (kInf: environment)
-    typename S::Spectrum radiance;    ///< incident radiance (point light: intensity / d^2)
-    float pdf = 0.f;                  ///< solid-angle pdf including light selection (delta: selection only)
+    typename S::Spectrum radiance = S::Spectrum::Zero();  ///< incident radiance (point light: intensity / d^2)
+    float pdf = 0.f;                  ///< solid-angle pdf including light selection (delta: selection only); 0: no sample
     bool delta = false;               ///< a point light: no other strategy can sample it
-    bool occludable_by_sphere = false;///< the sphere light may block this sample
+    bool occludable_by_sphere = false;///< Lights<S>: the sphere light may block this sample
 };
+
+/// A light a host's loop samples for NEE and may hit (THEORY 5.8). `sample(x, u1, u2, lambda,
+/// selection)` draws a direction from x toward it with its solid-angle pdf times `selection` (the
+/// probability with which the caller picked this light); `pdf(x, w, selection)` is that density
+/// for direction w (0 for a delta light, or where w misses it); `emitted(w, lambda)` what a ray
+/// travelling along w receives when it reaches the light; `power(scene_radius)` a grey measure of
+/// its emitted power for light selection by power. Models: PointLight, SphereLight, QuadLight,
+/// EnvironmentLight; LightSampler chooses among any number of them.
+template <class L, class S>
+concept Light = SpectralMode<S> && requires(const L& l, const Vec3& v, float u, const typename S::Wavelengths& lambda) {
+    { l.sample(v, u, u, lambda, u) } -> std::same_as<LightSample<S>>;
+    { l.pdf(v, v, u) } -> std::same_as<float>;
+    { l.emitted(v, lambda) } -> std::same_as<typename S::Spectrum>;
+    { l.power(u) } -> std::same_as<float>;
+    { L::is_delta } -> std::convertible_to<bool>;
+};
+
+/// An isotropic point light with radiant intensity `intensity` (W/sr). Reachable by NEE only.
+template <SpectralMode S>
+struct PointLight {
+    static constexpr bool is_delta = true;
+    Vec3 position;
+    typename S::Coefficient intensity;
+
+    LightSample<S> sample(const Vec3& x, float, float, const typename S::Wavelengths& l = {},
+                          float selection = 1.f) const noexcept {
+        LightSample<S> s;
+        const Vec3 d = position - x;
+        const float d2 = glm::dot(d, d);
+        if (!(d2 > 0.f)) return s;
+        s.distance = std::sqrt(d2);
+        s.wi = d / s.distance;
+        s.radiance = S::sample(intensity, l) / d2;
+        s.pdf = selection;
+        s.delta = true;
+        return s;
+    }
+    float pdf(const Vec3&, const Vec3&, float = 1.f) const noexcept { return 0.f; }
+    typename S::Spectrum emitted(const Vec3&, const typename S::Wavelengths& = {}) const noexcept {
+        return S::Spectrum::Zero();  // a point is never hit
+    }
+    float power(float = 1.f) const noexcept { return 4.f * kPi * max_value(intensity); }
+};
+
+/// A sphere emitting radiance `radiance` from its surface, outward. Opaque: it blocks light.
+template <SpectralMode S>
+struct SphereLight {
+    static constexpr bool is_delta = false;
+    Vec3 center;
+    float radius;
+    typename S::Coefficient radiance;
+
+    /// Uniform in the cone the sphere subtends from x (nothing from inside it).
+    LightSample<S> sample(const Vec3& x, float u1, float u2, const typename S::Wavelengths& l = {},
+                          float selection = 1.f) const noexcept {
+        LightSample<S> s;
+        const Vec3 dc = center - x;
+        const float d = glm::length(dc);
+        const float r = radius;
+        if (!(d > r)) return s;  // x inside the light: it cannot be sampled from here
+        const float sin2 = (r * r) / (d * d);
+        const float cos_max = std::sqrt(std::max(0.f, 1.f - sin2));
+        const float one_minus_cos = sin2 / (1.f + cos_max);  // stable for small lights
+        const float cos_theta = 1.f - u1 * one_minus_cos;
+        s.wi = direction_around(dc / d, cos_theta, 2.f * kPi * u2);
+        float t = intersect_sphere(Ray{x, s.wi}, center, r);
+        if (!(t < kInf))  // grazing: the tangent distance
+            t = d * cos_theta - std::sqrt(std::max(0.f, r * r - d * d * (1.f - cos_theta * cos_theta)));
+        s.distance = t;
+        s.radiance = S::sample(radiance, l);
+        s.pdf = selection / (2.f * kPi * one_minus_cos);
+        return s;
+    }
+    /// The solid-angle density of `sample` at x for any direction into the cone (0 from inside).
+    float cone_pdf(const Vec3& x) const noexcept {
+        const Vec3 dc = center - x;
+        const float d2 = glm::dot(dc, dc), r2 = radius * radius;
+        if (!(d2 > r2)) return 0.f;
+        const float sin2 = r2 / d2;
+        const float one_minus_cos = sin2 / (1.f + std::sqrt(std::max(0.f, 1.f - sin2)));
+        return 1.f / (2.f * kPi * one_minus_cos);
+    }
+    float pdf(const Vec3& x, const Vec3& w, float selection = 1.f) const noexcept {
+        return intersect(Ray{x, w}) < kInf ? selection * cone_pdf(x) : 0.f;
+    }
+    float intersect(const Ray& r) const noexcept { return intersect_sphere(r, center, radius); }
+    typename S::Spectrum emitted(const Vec3&, const typename S::Wavelengths& l = {}) const noexcept {
+        return S::sample(radiance, l);
+    }
+    /// pi L x area: what a Lambertian emitter of radiance L sends out.
+    float power(float = 1.f) const noexcept { return kPi * max_value(radiance) * 4.f * kPi * radius * radius; }
+};
+
+/// A one-sided rectangle at `corner` spanned by `edge_u` and `edge_v`, emitting `radiance` toward
+/// the side of cross(edge_u, edge_v). Sampled uniformly by area. A host's geometry holds it (it
+/// blocks light where the host says so); `intersect` is there for hosts that have none.
+template <SpectralMode S>
+struct QuadLight {
+    static constexpr bool is_delta = false;
+    Vec3 corner, edge_u, edge_v;
+    typename S::Coefficient radiance;
+
+    Vec3 normal() const noexcept { return glm::normalize(glm::cross(edge_u, edge_v)); }
+    float area() const noexcept { return glm::length(glm::cross(edge_u, edge_v)); }
+
+    LightSample<S> sample(const Vec3& x, float u1, float u2, const typename S::Wavelengths& l = {},
+                          float selection = 1.f) const noexcept {
+        LightSample<S> s;
+        const Vec3 y = corner + u1 * edge_u + u2 * edge_v;
+        const Vec3 d = y - x;
+        const float d2 = glm::dot(d, d);
+        if (!(d2 > 0.f)) return s;
+        const float dist = std::sqrt(d2);
+        const Vec3 wi = d / dist;
+        const float cos_y = -glm::dot(normal(), wi);  // > 0: x on the emitting side
+        if (!(cos_y > 0.f)) return s;
+        s.wi = wi;
+        s.distance = dist;
+        s.radiance = S::sample(radiance, l);
+        s.pdf = selection * d2 / (cos_y * area());
+        return s;
+    }
+    /// Distance along r to the rectangle (either side), or kInf.
+    float intersect(const Ray& r) const noexcept {
+        const Vec3 n = glm::cross(edge_u, edge_v);
+        const float denom = glm::dot(n, r.d);
+        if (denom == 0.f) return kInf;
+        const float t = glm::dot(n, corner - r.o) / denom;
+        if (!(t > 0.f)) return kInf;
+        const Vec3 p = r.at(t) - corner;
+        const float a = glm::dot(p, edge_u) / glm::dot(edge_u, edge_u), b = glm::dot(p, edge_v) / glm::dot(edge_v, edge_v);
+        return a >= 0.f && a <= 1.f && b >= 0.f && b <= 1.f ? t : kInf;
+    }
+    float pdf(const Vec3& x, const Vec3& w, float selection = 1.f) const noexcept {
+        const float t = intersect(Ray{x, w});
+        const float cos_y = -glm::dot(normal(), w);
+        if (!(t < kInf) || !(cos_y > 0.f)) return 0.f;
+        return selection * t * t / (cos_y * area());
+    }
+    /// Its radiance for a ray travelling along w that reaches its emitting side, else 0.
+    typename S::Spectrum emitted(const Vec3& w, const typename S::Wavelengths& l = {}) const noexcept {
+        return glm::dot(normal(), w) < 0.f ? typename S::Spectrum(S::sample(radiance, l))
+                                           : typename S::Spectrum(S::Spectrum::Zero());
+    }
+    float power(float = 1.f) const noexcept { return kPi * max_value(radiance) * area(); }
+};
+
+/// Constant radiance arriving from every direction at infinity, sampled uniformly.
+template <SpectralMode S>
+struct EnvironmentLight {
+    static constexpr bool is_delta = false;
+    typename S::Coefficient radiance;
+
+    LightSample<S> sample(const Vec3&, float u1, float u2, const typename S::Wavelengths& l = {},
+                          float selection = 1.f) const noexcept {
+        LightSample<S> s;
+        s.wi = uniform_sphere(u1, u2);
+        s.radiance = S::sample(radiance, l);
+        s.pdf = selection * kInv4Pi;
+        return s;
+    }
+    float pdf(const Vec3&, const Vec3&, float selection = 1.f) const noexcept { return selection * kInv4Pi; }
+    typename S::Spectrum emitted(const Vec3&, const typename S::Wavelengths& l = {}) const noexcept {
+        return S::sample(radiance, l);
+    }
+    /// What it sends into a sphere of radius `scene_radius` around the scene: pi L x 4 pi R^2.
+    float power(float scene_radius = 1.f) const noexcept {
+        return kPi * max_value(radiance) * 4.f * kPi * scene_radius * scene_radius;
+    }
+};
+
+static_assert(Light<PointLight<Rgb>, Rgb> && Light<SphereLight<Rgb>, Rgb> && Light<QuadLight<Rgb>, Rgb> &&
+              Light<EnvironmentLight<Hero<4>>, Hero<4>>);
 
 /// The lights of a scene: at most one of each kind, selected uniformly for NEE.
 template <SpectralMode S>
@@ -118,7 +271,7 @@ public:
     float pdf(const Vec3& x, const LightHit& hit) const noexcept {
         const int n = count();
         if (n == 0) return 0.f;
-        if (hit.sphere) return cone_pdf(x) / float(n);
+        if (hit.sphere) return sphere_->cone_pdf(x) / float(n);
         return env_ ? kInv4Pi / float(n) : 0.f;
     }
 
@@ -133,38 +286,12 @@ public:
         int pick = std::min(int(u0 * float(n)), n - 1);
         const float sel = 1.f / float(n);
         if (point_ && pick-- == 0) {
-            const Vec3 d = point_->position - x;
-            const float d2 = glm::dot(d, d);
-            if (!(d2 > 0.f)) return s;
-            s.distance = std::sqrt(d2);
-            s.wi = d / s.distance;
-            s.radiance = S::sample(point_->intensity, l) / d2;
-            s.pdf = sel;
-            s.delta = true;
-            s.occludable_by_sphere = sphere_.has_value();
+            s = point_->sample(x, u1, u2, l, sel);
+            if (s.pdf > 0.f) s.occludable_by_sphere = sphere_.has_value();
             return s;
         }
-        if (sphere_ && pick-- == 0) {
-            const Vec3 dc = sphere_->center - x;
-            const float d = glm::length(dc);
-            const float r = sphere_->radius;
-            if (!(d > r)) return s;  // x inside the light: it cannot be sampled from here
-            const float sin2 = (r * r) / (d * d);
-            const float cos_max = std::sqrt(std::max(0.f, 1.f - sin2));
-            const float one_minus_cos = sin2 / (1.f + cos_max);  // stable for small lights
-            const float cos_theta = 1.f - u1 * one_minus_cos;
-            s.wi = direction_around(dc / d, cos_theta, 2.f * kPi * u2);
-            float t = intersect_sphere(Ray{x, s.wi}, sphere_->center, r);
-            if (!(t < kInf))  // grazing: the tangent distance
-                t = d * cos_theta - std::sqrt(std::max(0.f, r * r - d * d * (1.f - cos_theta * cos_theta)));
-            s.distance = t;
-            s.radiance = S::sample(sphere_->radiance, l);
-            s.pdf = sel / (2.f * kPi * one_minus_cos);
-            return s;
-        }
-        s.wi = uniform_sphere(u1, u2);
-        s.radiance = S::sample(env_->radiance, l);
-        s.pdf = sel * kInv4Pi;
+        if (sphere_ && pick-- == 0) return sphere_->sample(x, u1, u2, l, sel);
+        s = env_->sample(x, u1, u2, l, sel);
         s.occludable_by_sphere = sphere_.has_value();
         return s;
     }
@@ -175,15 +302,6 @@ public:
     }
 
 private:
-    float cone_pdf(const Vec3& x) const noexcept {
-        const Vec3 dc = sphere_->center - x;
-        const float d2 = glm::dot(dc, dc), r2 = sphere_->radius * sphere_->radius;
-        if (!(d2 > r2)) return 0.f;
-        const float sin2 = r2 / d2;
-        const float one_minus_cos = sin2 / (1.f + std::sqrt(std::max(0.f, 1.f - sin2)));
-        return 1.f / (2.f * kPi * one_minus_cos);
-    }
-
     std::optional<PointLight<S>> point_;
     std::optional<SphereLight<S>> sphere_;
     std::optional<EnvironmentLight<S>> env_;

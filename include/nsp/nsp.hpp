@@ -11,6 +11,7 @@
 #include "equiangular.hpp"
 #include "estimator.hpp"
 #include "light.hpp"
+#include "light_sampler.hpp"
 #include "majorant.hpp"
 #include "majorants/grid.hpp"
 #include "media/emissive.hpp"

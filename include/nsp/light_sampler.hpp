@@ -1,0 +1,164 @@
+// nsp/light_sampler.hpp: next-event estimation over any number of lights of any models of
+// nsp::Light (light.hpp), for a host's own loop (THEORY 5.8): one light chosen uniformly or in
+// proportion to its power, then a direction toward it, with the solid-angle pdf of both; the pdf
+// of a direction toward a given light, for the MIS weight of a path that hit it.
+//
+// The lights live in one vector per model type (no virtual calls): `LightSampler<S, QuadLight<S>,
+// SphereLight<S>>`. A light is named by its index in the order the constructor got them, vector
+// by vector. Everything is built and checked in the constructor; sample / pdf allocate nothing.
+#pragma once
+
+#include <algorithm>
+#include <cstdint>
+#include <tuple>
+#include <utility>
+#include <vector>
+
+#include "core/error.hpp"
+#include "light.hpp"
+#include "media/validate.hpp"
+
+namespace nsp {
+
+/// How LightSampler chooses a light.
+enum class LightSelection : std::uint8_t {
+    Uniform,  ///< every light with probability 1 / count
+    Power,    ///< in proportion to Light::power(scene_radius)
+};
+
+/// A light sample and the light it came from.
+template <SpectralMode S>
+struct SampledLight {
+    LightSample<S> sample;  ///< pdf includes the selection probability; 0: no sample
+    int light = -1;         ///< the light's index, or -1
+};
+
+template <SpectralMode S, class... Ls>
+    requires(Light<Ls, S> && ...)
+class LightSampler {
+public:
+    /// Throws InvalidArgument on a light with a non-finite position, a radius or area that is not
+    /// finite and > 0, a bad radiance, or (Power) when no light has positive power. No lights is
+    /// allowed: sample() then returns pdf 0.
+    explicit LightSampler(LightSelection selection, float scene_radius, std::vector<Ls>... lights)
+        : lights_(std::move(lights)...) {
+        if (!(scene_radius > 0.f) || !std::isfinite(scene_radius))
+            detail::fail("LightSampler scene_radius = ", scene_radius, " is not allowed: it must be finite and > 0");
+        double total = 0.0;
+        for_each_light([&](const auto& l, int kind, int index) {
+            validate(l);
+            const double w = selection == LightSelection::Power ? double(l.power(scene_radius)) : 1.0;
+            entries_.push_back({std::uint8_t(kind), std::uint32_t(index), float(w), 0.f});
+            total += w;
+        });
+        if (!entries_.empty() && !(total > 0.0))
+            detail::fail("LightSampler: selection by power needs a light whose power is > 0; all ", entries_.size(),
+                         " have power 0");
+        double cdf = 0.0;
+        for (Entry& e : entries_) {
+            cdf += double(e.pmf);
+            e.pmf = float(double(e.pmf) / total);
+            e.cdf = float(cdf / total);
+        }
+        if (!entries_.empty()) entries_.back().cdf = 1.f;
+    }
+
+    int count() const noexcept { return int(entries_.size()); }
+
+    /// The probability with which sample() chooses light `light`.
+    float selection_pdf(int light) const noexcept {
+        return light >= 0 && light < count() ? entries_[std::size_t(light)].pmf : 0.f;
+    }
+
+    /// Chooses a light with u0 and a direction toward it from x with (u1, u2).
+    SampledLight<S> sample(const Vec3& x, float u0, float u1, float u2, const typename S::Wavelengths& lambda = {}) const
+        noexcept {
+        if (entries_.empty()) return {};
+        const auto it = std::upper_bound(entries_.begin(), entries_.end(), u0,
+                                         [](float u, const Entry& e) { return u < e.cdf; });
+        const std::size_t i = std::min(std::size_t(it - entries_.begin()), entries_.size() - 1);
+        SampledLight<S> out{{}, int(i)};
+        const Entry& e = entries_[i];
+        visit(e, [&](const auto& l) { out.sample = l.sample(x, u1, u2, lambda, e.pmf); });
+        return out;
+    }
+
+    /// The solid-angle pdf with which sample() from x produces direction w toward light `light`
+    /// (selection included): what the MIS weight of a path that hit that light needs.
+    float pdf(int light, const Vec3& x, const Vec3& w) const noexcept {
+        if (light < 0 || light >= count()) return 0.f;
+        const Entry& e = entries_[std::size_t(light)];
+        float p = 0.f;
+        visit(e, [&](const auto& l) { p = l.pdf(x, w, e.pmf); });
+        return p;
+    }
+
+    /// What a ray travelling along w receives when it reaches light `light`.
+    typename S::Spectrum emitted(int light, const Vec3& w, const typename S::Wavelengths& lambda = {}) const noexcept {
+        typename S::Spectrum v = S::Spectrum::Zero();
+        if (light >= 0 && light < count()) visit(entries_[std::size_t(light)], [&](const auto& l) { v = l.emitted(w, lambda); });
+        return v;
+    }
+
+    /// The lights of model type L, in the order given.
+    template <class L>
+    const std::vector<L>& lights() const noexcept {
+        return std::get<std::vector<L>>(lights_);
+    }
+
+private:
+    struct Entry {
+        std::uint8_t kind;
+        std::uint32_t index;
+        float pmf, cdf;
+    };
+
+    template <class F>
+    void for_each_light(F&& f) const {
+        [&]<std::size_t... K>(std::index_sequence<K...>) {
+            (([&] {
+                 const auto& v = std::get<K>(lights_);
+                 for (std::size_t i = 0; i < v.size(); ++i) f(v[i], int(K), int(i));
+             }()),
+             ...);
+        }(std::index_sequence_for<Ls...>{});
+    }
+
+    template <class F>
+    void visit(const Entry& e, F&& f) const noexcept {
+        [&]<std::size_t... K>(std::index_sequence<K...>) {
+            ((e.kind == K ? (f(std::get<K>(lights_)[e.index]), 0) : 0), ...);
+        }(std::index_sequence_for<Ls...>{});
+    }
+
+    static void require_point(const Vec3& p, const char* what) {
+        for (int a = 0; a < 3; ++a) detail::require_finite(p[a], what);
+    }
+    static void validate(const PointLight<S>& l) {
+        require_point(l.position, "PointLight position");
+        detail::require_coefficient(l.intensity, "PointLight intensity");
+    }
+    static void validate(const SphereLight<S>& l) {
+        require_point(l.center, "SphereLight center");
+        if (!std::isfinite(l.radius * l.radius) || !(l.radius > 0.f))
+            detail::fail("SphereLight radius = ", l.radius, " is not allowed: it must be finite and > 0");
+        detail::require_coefficient(l.radiance, "SphereLight radiance");
+    }
+    static void validate(const QuadLight<S>& l) {
+        require_point(l.corner, "QuadLight corner");
+        require_point(l.edge_u, "QuadLight edge_u");
+        require_point(l.edge_v, "QuadLight edge_v");
+        if (const float a = l.area(); !(a > 0.f) || !std::isfinite(a))
+            detail::fail("QuadLight area = ", a, " is not allowed: edge_u and edge_v must span a finite area > 0");
+        detail::require_coefficient(l.radiance, "QuadLight radiance");
+    }
+    static void validate(const EnvironmentLight<S>& l) { detail::require_coefficient(l.radiance, "EnvironmentLight radiance"); }
+    /// A host's own light model: it checks itself.
+    template <class L>
+    static void validate(const L&) {}
+
+    std::tuple<std::vector<Ls>...> lights_;
+    std::vector<Entry> entries_;
+};
+
+}  // namespace nsp

@@ -1,0 +1,154 @@
+// tests/test_lights.cpp: the light models of the Light concept (light.hpp) and LightSampler
+// (light_sampler.hpp): each sample's pdf equals an independent evaluation of pdf() for its
+// direction; NEE estimates of irradiance from a sphere and from rectangles match their closed
+// forms; selection by power follows the powers; bad lights are rejected by name.
+#include <array>
+#include <cmath>
+#include <vector>
+
+#include "common.hpp"
+
+namespace {
+
+using namespace nsp_test;
+using S = Rgb;
+
+// k = 5 standard errors, estimated from the samples, with fixed seeds: deterministic.
+constexpr double kSigmas = 5.0;
+
+/// Irradiance at x (normal n) from a rectangle of radiance 1 with corners c[0..3], in closed form
+/// (Lambert's formula for polygons): E = 1/2 sum_i theta_i n . normalize(v_i x v_{i+1}), v_i the
+/// unit vectors toward the corners, theta_i the angle between consecutive ones.
+double polygon_irradiance(const Vec3& x, const Vec3& n, const std::array<Vec3, 4>& c) {
+    double e = 0.0;
+    for (int i = 0; i < 4; ++i) {
+        const glm::dvec3 a = glm::normalize(glm::dvec3(c[std::size_t(i)] - x));
+        const glm::dvec3 b = glm::normalize(glm::dvec3(c[std::size_t((i + 1) % 4)] - x));
+        const double theta = std::acos(std::clamp(glm::dot(a, b), -1.0, 1.0));
+        e += theta * glm::dot(glm::dvec3(n), glm::normalize(glm::cross(a, b)));
+    }
+    return std::abs(0.5 * e);
+}
+
+/// NEE's estimate of the irradiance at x (normal n) from `sampler`'s lights, channel 0.
+template <class Sampler>
+Stat irradiance(const Sampler& sampler, const Vec3& x, const Vec3& n, std::uint64_t seed) {
+    Pcg32 rng(seed, 5);
+    Stat s;
+    for (int i = 0; i < 40000; ++i) {
+        const auto l = sampler.sample(x, rng.uniform(), rng.uniform(), rng.uniform());
+        const float c = glm::dot(n, l.sample.wi);
+        s.add(l.sample.pdf > 0.f && c > 0.f ? double(l.sample.radiance[0]) * c / l.sample.pdf : 0.0);
+    }
+    return s;
+}
+
+TEST_CASE("lights: every model's sample pdf equals its pdf() for the sampled direction") {
+    const SphereLight<S> sphere{Vec3(0.f, 2.f, 0.f), 0.5f, S::Spectrum(1.f, 2.f, 3.f)};
+    const QuadLight<S> quad{Vec3(-1.f, 3.f, -1.f), Vec3(2.f, 0.f, 0.f), Vec3(0.f, 0.f, 2.f), S::Spectrum::Ones()};
+    const EnvironmentLight<S> env{S::Spectrum::Constant(0.5f)};
+    const PointLight<S> point{Vec3(1.f, 1.f, 1.f), S::Spectrum::Constant(4.f)};
+    CHECK(quad.normal().y == doctest::Approx(-1.f));  // emits downward, toward the origin
+    Pcg32 rng(1, 1);
+    for (int i = 0; i < 2000; ++i) {
+        const Vec3 x(2.f * rng.uniform() - 1.f, 2.f * rng.uniform() - 1.f, 2.f * rng.uniform() - 1.f);
+        const float u1 = rng.uniform(), u2 = rng.uniform(), sel = 0.25f + 0.75f * rng.uniform();
+        const auto ls = sphere.sample(x, u1, u2, {}, sel);
+        REQUIRE(ls.pdf > 0.f);  // x lies outside the sphere
+        CHECK(sphere.pdf(x, ls.wi, sel) == doctest::Approx(ls.pdf).epsilon(1e-4));
+        CHECK(ls.distance == doctest::Approx(sphere.intersect(Ray{x, ls.wi})).epsilon(1e-3));
+        const auto lq = quad.sample(x, u1, u2, {}, sel);
+        REQUIRE(lq.pdf > 0.f);  // x lies below the quad, on its emitting side
+        CHECK(quad.pdf(x, lq.wi, sel) == doctest::Approx(lq.pdf).epsilon(1e-3));
+        CHECK(lq.distance == doctest::Approx(quad.intersect(Ray{x, lq.wi})).epsilon(1e-4));
+        CHECK(quad.emitted(lq.wi, {})[0] == 1.f);
+        CHECK(quad.emitted(-lq.wi, {})[0] == 0.f);  // one-sided
+        const auto le = env.sample(x, u1, u2, {}, sel);
+        CHECK(env.pdf(x, le.wi, sel) == doctest::Approx(le.pdf));
+        const auto lp = point.sample(x, u1, u2, {}, sel);
+        CHECK(lp.delta);
+        CHECK(point.pdf(x, lp.wi, sel) == 0.f);  // no direction reaches a point by chance
+        CHECK(lp.radiance[0] == doctest::Approx(4.f / (lp.distance * lp.distance)));
+    }
+    // Behind the quad nothing is emitted toward x: no sample, pdf 0.
+    CHECK(quad.sample(Vec3(0.f, 4.f, 0.f), 0.5f, 0.5f).pdf == 0.f);
+    CHECK(quad.pdf(Vec3(0.f, 4.f, 0.f), Vec3(0.f, -1.f, 0.f)) == 0.f);
+}
+
+TEST_CASE("lights: NEE irradiance from a sphere and from rectangles matches the closed forms") {
+    const Vec3 x(0.f), n(0.f, 1.f, 0.f);
+    // A sphere of radiance 1 and radius r at distance d above x: E = pi (r / d)^2.
+    const LightSampler<S, SphereLight<S>> one_sphere(LightSelection::Uniform, 10.f,
+                                                     {{Vec3(0.f, 3.f, 0.f), 0.5f, S::Spectrum::Ones()}});
+    const Stat es = irradiance(one_sphere, x, n, 1);
+    CAPTURE(es.mean);
+    CHECK(std::abs(es.mean - kPi * (0.5 / 3.0) * (0.5 / 3.0)) <= kSigmas * es.se());
+    // Two rectangles, one tilted, chosen uniformly or by power (radiances 1 and 3): the sum of
+    // their closed forms either way (radiance scales the formula).
+    const QuadLight<S> a{Vec3(-1.f, 2.f, -1.f), Vec3(2.f, 0.f, 0.f), Vec3(0.f, 0.f, 2.f), S::Spectrum::Ones()};
+    const QuadLight<S> b{Vec3(1.f, 1.f, -0.5f), Vec3(0.f, 0.f, 1.f), Vec3(0.5f, 0.8f, 0.f), S::Spectrum::Constant(3.f)};
+    REQUIRE(glm::dot(b.normal(), x - b.corner) > 0.f);  // b faces x
+    const double exact = polygon_irradiance(x, n, {a.corner, a.corner + a.edge_u, a.corner + a.edge_u + a.edge_v, a.corner + a.edge_v}) +
+                         3.0 * polygon_irradiance(x, n, {b.corner, b.corner + b.edge_u, b.corner + b.edge_u + b.edge_v, b.corner + b.edge_v});
+    for (const LightSelection sel : {LightSelection::Uniform, LightSelection::Power}) {
+        const LightSampler<S, QuadLight<S>> quads(sel, 10.f, {a, b});
+        const Stat eq = irradiance(quads, x, n, 2 + std::uint64_t(sel));
+        CAPTURE(int(sel));
+        CAPTURE(eq.mean);
+        CAPTURE(exact);
+        CHECK(std::abs(eq.mean - exact) <= kSigmas * eq.se());
+    }
+}
+
+TEST_CASE("lights: LightSampler selects by power, and its pdf matches its samples") {
+    const std::vector<QuadLight<S>> quads{{Vec3(-1.f, 2.f, -1.f), Vec3(2.f, 0.f, 0.f), Vec3(0.f, 0.f, 2.f), S::Spectrum::Ones()}};
+    const std::vector<SphereLight<S>> spheres{{Vec3(0.f, 3.f, 0.f), 0.5f, S::Spectrum::Constant(2.f)},
+                                              {Vec3(3.f, 0.f, 0.f), 0.25f, S::Spectrum::Constant(1.f)}};
+    const std::vector<PointLight<S>> points{{Vec3(0.f, -2.f, 0.f), S::Spectrum::Constant(1.f)}};
+    const LightSampler<S, QuadLight<S>, SphereLight<S>, PointLight<S>> power(LightSelection::Power, 1.f, quads, spheres, points);
+    const LightSampler<S, QuadLight<S>, SphereLight<S>, PointLight<S>> uniform(LightSelection::Uniform, 1.f, quads, spheres, points);
+    REQUIRE(power.count() == 4);
+    const double p[4] = {kPi * 4.0, kPi * 2.0 * 4.0 * kPi * 0.25, kPi * 4.0 * kPi * 0.0625, 4.0 * kPi};
+    const double total = p[0] + p[1] + p[2] + p[3];
+    for (int i = 0; i < 4; ++i) {
+        CHECK(power.selection_pdf(i) == doctest::Approx(p[i] / total).epsilon(1e-5));
+        CHECK(uniform.selection_pdf(i) == doctest::Approx(0.25));
+    }
+    // How often each light is chosen: Binomial(n, pmf), within 5 standard deviations.
+    Pcg32 rng(4, 4);
+    const int n = 40000;
+    std::array<int, 4> counts{};
+    const Vec3 x(0.1f, 0.2f, -0.3f);
+    for (int k = 0; k < n; ++k) {
+        const auto l = power.sample(x, rng.uniform(), rng.uniform(), rng.uniform());
+        REQUIRE(l.light >= 0);
+        ++counts[std::size_t(l.light)];
+        if (l.sample.pdf > 0.f && !l.sample.delta)
+            CHECK(power.pdf(l.light, x, l.sample.wi) == doctest::Approx(l.sample.pdf).epsilon(1e-3));
+    }
+    for (int i = 0; i < 4; ++i) {
+        const double q = power.selection_pdf(i);
+        CHECK(std::abs(counts[std::size_t(i)] - n * q) <= 5.0 * std::sqrt(n * q * (1.0 - q)));
+    }
+    CHECK(power.emitted(1, Vec3(0.f, 1.f, 0.f))[0] == 2.f);
+    // No lights: a valid sampler whose samples have pdf 0.
+    const LightSampler<S, QuadLight<S>> none(LightSelection::Power, 1.f, {});
+    CHECK(none.count() == 0);
+    CHECK(none.sample(x, 0.5f, 0.5f, 0.5f).sample.pdf == 0.f);
+    CHECK(none.pdf(0, x, Vec3(0.f, 1.f, 0.f)) == 0.f);
+}
+
+TEST_CASE("lights: LightSampler rejects bad lights with their value") {
+    using QS = LightSampler<S, QuadLight<S>>;
+    CHECK_THROWS_WITH_AS(QS(LightSelection::Uniform, 1.f, {{Vec3(0.f), Vec3(1.f, 0.f, 0.f), Vec3(2.f, 0.f, 0.f), S::Spectrum::Ones()}}),
+                         doctest::Contains("QuadLight area = 0"), InvalidArgument);
+    CHECK_THROWS_WITH_AS(QS(LightSelection::Uniform, 1.f, {{Vec3(0.f), Vec3(1.f, 0.f, 0.f), Vec3(0.f, 1.f, 0.f), S::Spectrum(1.f, -1.f, 1.f)}}),
+                         doctest::Contains("QuadLight radiance"), InvalidArgument);
+    CHECK_THROWS_WITH_AS(QS(LightSelection::Power, 1.f, {{Vec3(0.f), Vec3(1.f, 0.f, 0.f), Vec3(0.f, 1.f, 0.f), S::Spectrum::Zero()}}),
+                         doctest::Contains("power is > 0"), InvalidArgument);
+    CHECK_THROWS_WITH_AS((LightSampler<S, SphereLight<S>>(LightSelection::Uniform, 1.f, {{Vec3(0.f), 0.f, S::Spectrum::Ones()}})),
+                         doctest::Contains("SphereLight radius = 0"), InvalidArgument);
+    CHECK_THROWS_WITH_AS(QS(LightSelection::Uniform, -1.f, {}), doctest::Contains("scene_radius = -1"), InvalidArgument);
+}
+
+}  // namespace
