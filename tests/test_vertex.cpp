@@ -7,6 +7,7 @@
 #include <array>
 #include <limits>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "common.hpp"
@@ -328,9 +329,30 @@ TEST_CASE("vertex kernels: the weights of one path sum to 1; delta vertices and 
     CHECK(VertexKernels<strategy::Unidirectional>::counts_hit(VertexPdf::scattered(1.f, 1.f, false)));
 }
 
-TEST_CASE("vertex kernels: bad host input gives weight 0, never NaN") {
+TEST_CASE("vertex kernels: bad host input gives weight 0 and a status, never NaN") {
     const VertexKernels<strategy::NullScatteringMis, mis::Balance> k;
     const float nan = std::numeric_limits<float>::quiet_NaN();
+    using M = HomogeneousMedium<S>;
+    const M medium(Box{Vec3(-1.f), Vec3(1.f)}, Spectrum::Constant(0.5f), Spectrum::Constant(0.5f));
+    const GlobalMajorant<M> majorant(medium, 2.f);
+    Pcg32 rng(1, 1);
+    NoLookupCount counter;
+    const Ray good{Vec3(0.f, 0.f, -3.f), Vec3(0.f, 0.f, 1.f)};
+    // A NaN or negative distance, a NaN or zero direction, an infinite origin: nothing tracked.
+    for (const auto& [ray, t] : {std::pair{good, nan}, std::pair{good, -1.f}, std::pair{Ray{good.o, Vec3(nan, 0.f, 1.f)}, 5.f},
+                                 std::pair{Ray{good.o, Vec3(0.f)}, 5.f}, std::pair{Ray{Vec3(kInf, 0.f, 0.f), good.d}, 5.f}}) {
+        const auto seg = k.track(medium, majorant, ray, t, {}, rng, counter);
+        CHECK(seg.end == SegmentEnd::InvalidInput);
+        CHECK(flight_status(seg.end) == Status::NonFinite);
+        CHECK(seg.weight[0] == 0.f);
+        const auto sh = k.shadow(medium, majorant, ray, t, {}, rng, counter);
+        CHECK(sh.status == Status::NonFinite);
+        CHECK(sh.transmittance[0] == 0.f);
+    }
+    CHECK(k.track(medium, majorant, good, kInf, {}, rng, counter).end != SegmentEnd::InvalidInput);  // no surface: fine
+    // A BSDF given a NaN normal draws nothing.
+    CHECK(LambertianBsdf<S>(Spectrum::Constant(0.5f)).sample(good.d, Vec3(nan, 0.f, 1.f), 0.3f, 0.3f).pdf == 0.f);
+    CHECK(MirrorBsdf<S>(Spectrum::Constant(0.5f)).sample(good.d, Vec3(nan, 0.f, 1.f), 0.3f, 0.3f).pdf == 0.f);
     CHECK(k.hit_weight(VertexPdf::scattered(1.f, nan), 1.f, 1.f) == 0.f);
     CHECK(k.hit_weight(VertexPdf::scattered(1.f, -1.f), 1.f, 1.f) == 0.f);
     CHECK(k.hit_weight(VertexPdf::scattered(1.f, 1.f), 1.f, nan) == 0.f);

@@ -5,7 +5,8 @@
 //
 // Directions follow propagation, as for phase functions (phase.hpp): `wo` is the direction the
 // path travelled to reach the surface (the ray's direction), `wi` the direction it leaves in. `n`
-// is the shading normal, of either orientation: a one-sided model decides the side from `wo`.
+// is the unit shading normal, of either orientation: a one-sided model decides the side from `wo`
+// (a normal that is NaN or not of unit length gives no sample: pdf 0).
 // A BSDF's `value` is f_s(wo, wi) |n . wi|, the cosine of the outgoing direction included, so
 // that a path's throughput is multiplied by value / pdf at a surface vertex exactly as by
 // f_p / pdf at a medium vertex, and NEE adds value / light_pdf at either.
@@ -66,6 +67,7 @@ public:
     BsdfSample<S> sample(const Vec3& wo, const Vec3& n, float u1, float u2,
                          const typename S::Wavelengths& lambda = {}) const noexcept {
         const Vec3 up = detail::facing(wo, n);
+        if (!(std::abs(glm::dot(up, up) - 1.f) < 1e-3f)) return BsdfSample<S>{};  // a NaN or non-unit normal: no sample
         const float cos_theta = std::sqrt(std::max(0.f, 1.f - u1));  // p(cos) = 2 cos: cosine-weighted
         BsdfSample<S> s;
         s.wi = direction_around(up, cos_theta, 2.f * kPi * u2);
@@ -102,6 +104,7 @@ public:
     BsdfSample<S> sample(const Vec3& wo, const Vec3& n, float, float,
                          const typename S::Wavelengths& lambda = {}) const noexcept {
         BsdfSample<S> s;
+        if (!(std::abs(glm::dot(n, n) - 1.f) < 1e-3f)) return s;  // a NaN or non-unit normal: no sample
         s.wi = wo - 2.f * glm::dot(wo, n) * n;
         s.pdf = 1.f;
         s.value = S::sample(reflectance_, lambda);

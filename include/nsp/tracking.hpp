@@ -290,6 +290,7 @@ enum class SegmentEnd : std::uint8_t {
     Aborted,     ///< the collision limit was reached; the estimate is discarded (weight 0)
     Rejected,    ///< bound::Reject met mu_t > mu_bar; the estimate is discarded (weight 0)
     Overflowed,  ///< per-channel tracking: a contribution or pdf left float's range; the estimate is discarded (weight 0)
+    InvalidInput,  ///< VertexKernels: the host's ray or distance was NaN, infinite or negative; nothing was tracked (weight 0)
 };
 
 /// How an aborted flight ends a segment: Rejected (bound::Reject) or Aborted (collision limit).

@@ -34,6 +34,7 @@
 #pragma once
 
 #include <algorithm>
+#include <cmath>
 
 #include "estimators/common.hpp"
 #include "mis.hpp"
@@ -119,20 +120,26 @@ public:
     /// Delta-tracks `ray` through `medium` up to `t_max` (the host's surface distance, kInf for
     /// none): Scattered at a real vertex seg.t, Passed at t_max, Absorbed (absorption::Event), or
     /// a failed flight (flight_status(seg.end) says which). seg.weight multiplies the throughput;
-    /// seg.null_pdf_product multiplies the path's product since its last real vertex.
+    /// seg.null_pdf_product multiplies the path's product since its last real vertex. A ray with a
+    /// non-finite origin or direction, a zero direction, or a NaN or negative t_max ends
+    /// SegmentEnd::InvalidInput (flight_status: NonFinite) with weight 0: bad host input is never
+    /// tracked as if it were a ray.
     template <Medium M, MajorantPolicy<M> Maj, UniformRng R, LookupCounter C>
     DeltaTrack<typename M::Spectral> track(const M& medium, const Maj& majorant, const Ray& ray, float t_max,
                                            const typename M::Spectral::Wavelengths& lambda, R& rng, C& counter) const {
+        if (!valid_ray(ray, t_max)) return {SegmentEnd::InvalidInput, 0.f, M::Spectral::Spectrum::Zero(), 1.f};
         return track_delta<A>(medium, majorant, ray, t_max, lambda, rng, counter);
     }
 
     /// The transmittance of a shadow ray through `medium` up to `distance` (ratio tracking), and
     /// the product of the null probabilities delta tracking with policy A would have had at its
-    /// nulls (only where St weighs by null-scattering pdfs; 1 otherwise). Never throws.
+    /// nulls (only where St weighs by null-scattering pdfs; 1 otherwise). Never throws; bad input
+    /// as for track() gives transmittance 0 and Status::NonFinite.
     template <Medium M, MajorantPolicy<M> Maj, UniformRng R, LookupCounter C>
     ShadowTransmittance<typename M::Spectral> shadow(const M& medium, const Maj& majorant, const Ray& ray,
                                                      float distance, const typename M::Spectral::Wavelengths& lambda,
                                                      R& rng, C& counter) const {
+        if (!valid_ray(ray, distance)) return {M::Spectral::Spectrum::Zero(), 1.f, Status::NonFinite};
         const auto tr = track_ratio<A, St::null_pdfs>(medium, majorant, ray, distance, lambda, rng, counter);
         ShadowTransmittance<typename M::Spectral> s;
         if (tr.end == SegmentEnd::Aborted || tr.end == SegmentEnd::Rejected) {
@@ -199,6 +206,11 @@ public:
     }
 
 private:
+    static bool valid_ray(const Ray& r, float t_max) noexcept {
+        const bool finite = std::isfinite(r.o.x) && std::isfinite(r.o.y) && std::isfinite(r.o.z) &&
+                            std::isfinite(r.d.x) && std::isfinite(r.d.y) && std::isfinite(r.d.z);
+        return finite && t_max >= 0.f && glm::dot(r.d, r.d) > 0.f;  // a NaN t_max fails the comparison
+    }
     static bool valid(float survival, float direction_pdf, float null_pdf_product, float light_pdf) noexcept {
         return survival >= 0.f && direction_pdf >= 0.f && null_pdf_product >= 0.f && light_pdf >= 0.f;
     }

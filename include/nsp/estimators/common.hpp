@@ -100,13 +100,14 @@ enum class Status : std::uint8_t {
     Rejected,   ///< bound::Reject met mu_t > mu_bar on a flight; that flight contributed 0 (biased)
 };
 
-/// The status of a path one of whose flights ended with `end` (Ok unless Aborted, Rejected or
-/// Overflowed, which is reported as NonFinite).
+/// The status of a path one of whose flights ended with `end` (Ok unless Aborted, Rejected,
+/// Overflowed or InvalidInput, the last two reported as NonFinite).
 inline Status flight_status(SegmentEnd end) noexcept {
     switch (end) {
         case SegmentEnd::Aborted: return Status::Aborted;
         case SegmentEnd::Rejected: return Status::Rejected;
-        case SegmentEnd::Overflowed: return Status::NonFinite;
+        case SegmentEnd::Overflowed:
+        case SegmentEnd::InvalidInput: return Status::NonFinite;
         default: return Status::Ok;
     }
 }
