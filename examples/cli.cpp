@@ -165,10 +165,11 @@ std::vector<std::string> checked_arguments(int argc, char** argv, const std::vec
 }
 
 constexpr const char* kDescription =
-    "nsp_render: renders the example scenes with nsp's estimators and prints an efficiency table per light\n"
-    "set-up and spectral mode (LTUV = density lookups per sample x variance per sample; cpu-s*var = CPU\n"
-    "seconds per sample x variance per sample; lower is better). Writes an EXR per row, a PNG contact sheet\n"
-    "per table and a larger PNG picture per scene. Every flag is explained in docs/renderer.md.";
+    "nsp_render: renders the example scenes with nsp's estimators and prints an efficiency table per\n"
+    "light set-up and spectral mode (LTUV = density lookups per sample x variance per sample;\n"
+    "cpu-s*var = CPU seconds per sample x variance per sample; lower is better). Writes an EXR per\n"
+    "row, a PNG contact sheet per table and a PNG picture per scene. docs/renderer.md explains\n"
+    "every flag at length.";
 
 constexpr const char* kFooter =
     "Examples: nsp_render --scene cloud --setup A --estimators uni-nee-mis_balance\n"
@@ -185,7 +186,7 @@ Options parse_command_line(int argc, char** argv) {
 
     CLI::App app(kDescription, "nsp_render");
     app.option_defaults()->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
-    app.get_formatter()->column_width(30);
+    app.get_formatter()->column_width(28);
     app.footer(kFooter);
     app.set_help_flag("-h,--help", "this text");
     // One value: `parse` turns it into the option's field or throws BadValue.
@@ -200,9 +201,9 @@ Options parse_command_line(int argc, char** argv) {
         app.add_flag_callback(name, set, help)->disable_flag_override();
     };
     // What is rendered
-    value("--scene", "LIST", "scenes: cloud, chromatic, sparse, fog, plume, both (= cloud,chromatic), all",
+    value("--scene", "LIST", "cloud, chromatic, sparse, fog, plume, both (cloud,chromatic), all",
           [&](std::string_view v) { parse_scenes(o, v); });
-    value("--setup", "LIST", "set-ups: A, B, C1, C2, SA, SB, F1, F2, F3, P1, all (default: all but SB)",
+    value("--setup", "LIST", "A, B, C1, C2, SA, SB, F1, F2, F3, P1, all (default: all but SB)",
           [&](std::string_view v) { parse_setups(o, v); });
     value("--spectral", "LIST", "spectral modes: mono, rgb, hero, both (= mono,rgb), all",
           [&](std::string_view v) { parse_modes(o, v); });
@@ -240,15 +241,15 @@ Options parse_command_line(int argc, char** argv) {
           [&](std::string_view v) { o.height = parse_number<int>("--height", v, 1, 16384); });
     value("--runs", "K", "render each row K times (seeds seed..seed+K-1), report medians",
           [&](std::string_view v) { o.runs = parse_number<int>("--runs", v, 1, 1000); });
-    value("--reference-spp", "N", "effective variance against an N-spp reference image (chromatic, fog, plume)",
+    value("--reference-spp", "N", "effective variance against an N-spp reference (chromatic, fog, plume)",
           [&](std::string_view v) { o.reference_spp = parse_number<int>("--reference-spp", v, 2, 1 << 24); });
-    value("--threads", "N", "worker threads (default: hardware concurrency; images do not depend on it)",
+    value("--threads", "N", "worker threads (default: all cores; images do not depend on it)",
           [&](std::string_view v) { o.threads = parse_number<int>("--threads", v, 1, 1024); });
     value("--seed", "N", "random seed, unsigned 64-bit (default 1)", [&](std::string_view v) {
         o.seed = parse_number<std::uint64_t>("--seed", v, 0, std::numeric_limits<std::uint64_t>::max());
     });
     // The estimators' options
-    value("--max-depth", "N", "most real scattering vertices per path (default 1000; 0: direct light only)",
+    value("--max-depth", "N", "real scattering vertices per path (default 1000; 0: direct light)",
           [&](std::string_view v) { o.estimator.max_depth = parse_number<int>("--max-depth", v, 0, 1 << 20); });
     flag("--equiangular-every-segment", "uni-nee-eq-mis: an equiangular vertex on every segment",
          [&] { o.estimator.adaptive_equiangular = false; });
