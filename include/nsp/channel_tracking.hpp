@@ -371,11 +371,14 @@ struct ChannelRatioCollision {
         }
     }
 
-    /// The segment's result (rounded to float after long flights).
-    ChannelShadow<S> finish() const noexcept {
+    /// The segment's result (rounded to float after long flights: a value past FLT_MAX there is
+    /// handled as in `normalize`).
+    ChannelShadow<S> finish() noexcept {
         if (nulls <= detail::kFloatNulls) return out;
-        return {out.end, Spec(f_d.template cast<float>()), Spec(nee_d.template cast<float>()),
-                Spec(uni_d.template cast<float>())};
+        ChannelShadow<S> r{out.end, Spec(f_d.template cast<float>()), Spec(nee_d.template cast<float>()),
+                           Spec(uni_d.template cast<float>())};
+        if (!guard(r.f, r.nee, r.uni)) r.end = out.end;
+        return r;
     }
 
 private:
@@ -431,12 +434,33 @@ private:
         nee /= k;
         uni /= k;
         // In float: f / k past FLT_MAX (in double the products have the range to recover).
-        if constexpr (std::is_same_v<T, float>)
-            if (!(CP::mis_over_channels ? f.allFinite() : std::isfinite(f[c]))) [[unlikely]] {
+        if constexpr (std::is_same_v<T, float>) return guard(f, nee, uni);
+        return true;
+    }
+
+    /// Values past FLT_MAX cannot be represented. Where every channel is estimated (or channel c's
+    /// value overflowed) the segment is Overflowed and zeroed; under independent tracking the other
+    /// channels are never estimated and are zeroed where they overflow (as ChannelPathState does).
+    /// `uni` counts only with uni_alternative (without it nothing reads it, fuzzer finding 8).
+    template <class Arr>
+    bool guard(Arr& f, Arr& nee, Arr& uni) {
+        const bool uni_ok = !uni_alternative || uni.allFinite();
+        if (f.allFinite() && nee.allFinite() && uni_ok) [[likely]] return true;
+        if constexpr (CP::mis_over_channels) {
+            zero(f, nee, uni, SegmentEnd::Overflowed);
+            return false;
+        } else {
+            auto ok = (f.isFinite() && nee.isFinite()).eval();
+            if (uni_alternative) ok = ok && uni.isFinite();
+            if (!ok[c]) {
                 zero(f, nee, uni, SegmentEnd::Overflowed);
                 return false;
             }
-        return true;
+            f = ok.select(f, 0.f);
+            nee = ok.select(nee, 0.f);
+            uni = ok.select(uni, 0.f);
+            return true;
+        }
     }
 
     template <class Arr>
