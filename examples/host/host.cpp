@@ -1,7 +1,8 @@
 // examples/host/host.cpp: a host renderer with its own geometry, lights and path loop, which takes
 // from nsp only what a renderer would: a medium, its majorant, the path-vertex kernels
-// (nsp/vertex.hpp), a BSDF, a phase function and the light sampler. The scene: a cloud over a
-// diffuse floor under a rectangular light and a dim sky.
+// (nsp/vertex.hpp), a BSDF, a phase function, the light sampler and the SurfaceHit record its
+// geometry (shapes.hpp, an nsp::Geometry) reports. The scene: a cloud over a diffuse floor under a
+// rectangular light and a dim sky.
 //
 //   nsp_host [--res N] [--spp N] [--out FILE.png]   renders the scene, prints its image mean
 //   nsp_host --compare                              renders the cloud under a sphere light (no
@@ -26,6 +27,8 @@
 
 #include <nsp/nsp.hpp>
 
+#include "shapes.hpp"
+
 namespace {
 
 using S = nsp::Mono;
@@ -49,37 +52,16 @@ Medium make_cloud() {
                   Spectrum::Constant(8.f));
 }
 
-/// The host's world: its geometry is a floor rectangle and the lights' own shapes.
+/// The host's world: its shapes (examples/host/shapes.hpp; the floor and the lights' own
+/// surfaces), one medium, one BSDF and the light sampler whose indices the shapes' light handles are.
 struct World {
     Medium cloud = make_cloud();
     nsp::GlobalMajorant<Medium> majorant{cloud};
     nsp::HenyeyGreensteinPhase phase{0.6f};
-    nsp::LambertianBsdf<S> floor_bsdf{Spectrum::Constant(0.6f)};
-    bool has_floor = true;
-    float floor_y = -1.05f, floor_half = 3.f;
+    nsp::LambertianBsdf<S> floor_bsdf{Spectrum::Constant(0.6f)};  ///< material 0
+    nsp_host::Shapes shapes;
     Lights lights{nsp::LightSelection::Uniform, 1.f, {}, {}, {}};
     int sky = -1;  ///< the light index of the environment, or -1
-
-    struct Hit {
-        float t = nsp::kInf;
-        int light = -1;  ///< the light whose surface the ray reached, or -1 (the floor, or nothing)
-    };
-    Hit intersect(const nsp::Ray& r) const {
-        Hit h;
-        if (has_floor && r.d.y != 0.f) {
-            const float t = (floor_y - r.o.y) / r.d.y;
-            const nsp::Vec3 p = r.at(t);
-            if (t > 1e-4f && std::abs(p.x) <= floor_half && std::abs(p.z) <= floor_half) h.t = t;
-        }
-        int id = 0;
-        for (const auto& q : lights.lights<nsp::QuadLight<S>>())
-            if (const float t = q.intersect(r); t > 1e-4f && t < h.t) h = {t, id++};
-            else ++id;
-        for (const auto& s : lights.lights<nsp::SphereLight<S>>())
-            if (const float t = s.intersect(r); t > 1e-4f && t < h.t) h = {t, id++};
-            else ++id;
-        return h;
-    }
 };
 
 /// One path of the host's loop: delta tracking to the next surface, NEE at every real vertex
@@ -90,10 +72,9 @@ float radiance(const Kernels& k, const World& w, nsp::Ray ray, nsp::Pcg32& rng) 
     Spectrum beta = Spectrum::Ones();
     nsp::VertexPdf from = nsp::VertexPdf::from_camera();
     float nulls = 1.f;
-    nsp::Vec3 prev = ray.o;
-    const nsp::Vec3 up(0.f, 1.f, 0.f);
+    nsp::Vec3 prev = ray.o, n(0.f, 1.f, 0.f);
     for (int depth = 0;;) {
-        const World::Hit hit = w.intersect(ray);
+        const nsp::SurfaceHit hit = w.shapes.intersect(ray, nsp::kInf);
         const auto seg = k.track(w.cloud, w.majorant, ray, hit.t, {}, rng, counter);
         if (nsp::flight_status(seg.end) != nsp::Status::Ok) return 0.f;  // a failed flight: no estimate
         beta *= seg.weight;
@@ -101,14 +82,15 @@ float radiance(const Kernels& k, const World& w, nsp::Ray ray, nsp::Pcg32& rng) 
         bool on_floor = false;
         nsp::Vec3 x;
         if (seg.end == nsp::SegmentEnd::Passed) {
-            const int light = hit.t < nsp::kInf ? hit.light : w.sky;
-            if (light >= 0 || hit.t == nsp::kInf) {  // an emitter's surface, the sky, or nothing
+            const int light = hit.found() ? hit.light : w.sky;
+            if (light >= 0 || !hit.found()) {  // an emitter's surface, the sky, or nothing
                 if (light >= 0 && k.counts_hit(from))
                     L += beta[0] * w.lights.emitted(light, ray.d)[0] * k.hit_weight(from, nulls, w.lights.pdf(light, prev, ray.d));
                 break;
             }
-            x = ray.at(hit.t);
-            on_floor = true;
+            x = hit.p;
+            n = hit.ns;
+            on_floor = true;  // the scene's only material
         } else if (seg.end == nsp::SegmentEnd::Scattered) {
             x = ray.at(seg.t);
         } else {
@@ -120,12 +102,9 @@ float radiance(const Kernels& k, const World& w, nsp::Ray ray, nsp::Pcg32& rng) 
         const nsp::SampledLight<S> ls = w.lights.sample(x, u0, u1, u2);
         if (ls.sample.pdf > 0.f) {
             const nsp::Vec3 wi = ls.sample.wi;
-            const World::Hit blocker = w.intersect(nsp::Ray{x, wi});  // the host's visibility test
-            const bool visible = ls.sample.distance == nsp::kInf ? blocker.t == nsp::kInf
-                                                                 : blocker.t >= ls.sample.distance * (1.f - 1e-4f);
-            if (visible) {
-                const float f = on_floor ? w.floor_bsdf.eval(ray.d, wi, up)[0] : w.phase.eval(ray.d, wi);
-                const float p = on_floor ? w.floor_bsdf.pdf(ray.d, wi, up) : w.phase.pdf(ray.d, wi);
+            if (!w.shapes.occluded(nsp::Ray{x, wi}, ls.sample.distance * (1.f - 1e-4f))) {
+                const float f = on_floor ? w.floor_bsdf.eval(ray.d, wi, n)[0] : w.phase.eval(ray.d, wi);
+                const float p = on_floor ? w.floor_bsdf.pdf(ray.d, wi, n) : w.phase.pdf(ray.d, wi);
                 const auto sh = k.shadow(w.cloud, w.majorant, nsp::Ray{x, wi}, ls.sample.distance, {}, rng, counter);
                 if (sh.status != nsp::Status::Ok) return 0.f;
                 L += beta[0] * sh.transmittance[0] * ls.sample.radiance[0] * f *
@@ -140,7 +119,7 @@ float radiance(const Kernels& k, const World& w, nsp::Ray ray, nsp::Pcg32& rng) 
         nsp::Vec3 wi;
         float pdf;
         if (on_floor) {
-            const nsp::BsdfSample<S> b = w.floor_bsdf.sample(ray.d, up, v1, v2);
+            const nsp::BsdfSample<S> b = w.floor_bsdf.sample(ray.d, n, v1, v2);
             if (!(b.pdf > 0.f)) break;
             beta *= b.value / b.pdf;
             wi = b.wi;
@@ -213,8 +192,8 @@ int main(int argc, char** argv) {
         // The cloud under a sphere light, no floor: a scene nsp::PathEstimator renders too.
         const nsp::SphereLight<S> sun{nsp::Vec3(0.f, 2.5f, -0.5f), 0.3f, Spectrum::Constant(30.f)};
         World w;
-        w.has_floor = false;
         w.lights = Lights(nsp::LightSelection::Uniform, 4.f, {}, {sun}, {});
+        w.shapes.spheres.push_back({sun.center, sun.radius, {-1, 0, -1, -1}});  // light 0
         nsp::Lights<S> lights;
         lights.set(sun);
         const auto scene = nsp::make_scene(make_cloud(), nsp::HenyeyGreensteinPhase(0.6f), lights);
@@ -235,6 +214,10 @@ int main(int argc, char** argv) {
                                          Spectrum::Constant(12.f)}},
                       {}, {nsp::EnvironmentLight<S>{Spectrum::Constant(0.05f)}});
     w.sky = 1;
+    const auto& lamp = w.lights.lights<nsp::QuadLight<S>>()[0];
+    w.shapes.quads.push_back({lamp.corner, lamp.edge_u, lamp.edge_v, {-1, 0, -1, -1}});  // light 0
+    w.shapes.quads.push_back({nsp::Vec3(-3.f, -1.05f, 3.f), nsp::Vec3(6.f, 0.f, 0.f), nsp::Vec3(0.f, 0.f, -6.f),
+                              {0, -1, -1, -1}});  // the floor, material 0, normal up
     const Image img = render(res, spp, 1, [&](const nsp::Ray& r, nsp::Pcg32& rng) { return radiance(kernels, w, r, rng); });
     std::printf("nsp_host: %dx%d, %d spp, image mean %.5f +- %.5f\n", res, res, spp, img.mean, img.se);
     if (!out.empty()) {

@@ -10,6 +10,7 @@
 #include "core/rng.hpp"
 #include "equiangular.hpp"
 #include "estimator.hpp"
+#include "geometry.hpp"
 #include "light.hpp"
 #include "light_sampler.hpp"
 #include "majorant.hpp"

@@ -1,0 +1,98 @@
+// tests/test_geometry.cpp: the SurfaceHit record and the Geometry concept (geometry.hpp) with the
+// example host's shapes (examples/host/shapes.hpp): distances and outward normals of spheres,
+// boxes, quads and triangles; the media on either side of a boundary as a ray leaves and
+// re-enters media, through nested media and from a camera inside one; shadow rays that pass
+// media boundaries and stop at opaque surfaces.
+#include <vector>
+
+#include "common.hpp"
+#include "host/shapes.hpp"
+
+namespace {
+
+using namespace nsp_test;
+using nsp_host::Box;
+using nsp_host::Handles;
+using nsp_host::Quad;
+using nsp_host::Shapes;
+using nsp_host::Sphere;
+using nsp_host::Triangle;
+
+TEST_CASE("geometry: distances and outward normals of the example shapes") {
+    Shapes s;
+    s.spheres.push_back({Vec3(0.f, 0.f, 5.f), 1.f, {3, -1, 7, -1}});
+    const Ray ray{Vec3(0.f), Vec3(0.f, 0.f, 1.f)};
+    SurfaceHit h = s.intersect(ray, kInf);
+    REQUIRE(h.found());
+    CHECK(h.t == doctest::Approx(4.f));
+    CHECK(h.ng.z == doctest::Approx(-1.f));  // outward, toward the ray's origin
+    CHECK(h.material == 3);
+    CHECK(h.medium_entered(ray.d) == 7);  // into the sphere's inside
+    CHECK(h.medium_left(ray.d) == -1);
+    CHECK(!s.intersect(ray, 3.9f).found());  // beyond t_max
+    // From inside the sphere: the far side, leaving medium 7.
+    h = s.intersect(Ray{Vec3(0.f, 0.f, 5.f), Vec3(1.f, 0.f, 0.f)}, kInf);
+    CHECK(h.t == doctest::Approx(1.f));
+    CHECK(h.medium_left(Vec3(1.f, 0.f, 0.f)) == 7);
+    CHECK(h.medium_entered(Vec3(1.f, 0.f, 0.f)) == -1);
+
+    Shapes b;
+    b.boxes.push_back({Vec3(1.f, -1.f, -1.f), Vec3(3.f, 1.f, 1.f), {}});
+    h = b.intersect(Ray{Vec3(0.f), Vec3(1.f, 0.f, 0.f)}, kInf);
+    CHECK(h.t == doctest::Approx(1.f));
+    CHECK(h.ng.x == doctest::Approx(-1.f));
+    CHECK(h.p.x == doctest::Approx(1.f));
+
+    Shapes q;
+    q.quads.push_back({Vec3(-1.f, 2.f, -1.f), Vec3(0.f, 0.f, 2.f), Vec3(2.f, 0.f, 0.f), {}});
+    h = q.intersect(Ray{Vec3(0.2f, 0.f, 0.3f), Vec3(0.f, 1.f, 0.f)}, kInf);
+    CHECK(h.t == doctest::Approx(2.f));
+    CHECK(h.ng.y == doctest::Approx(1.f));  // cross(edge_u, edge_v)
+    CHECK(!q.intersect(Ray{Vec3(1.5f, 0.f, 0.f), Vec3(0.f, 1.f, 0.f)}, kInf).found());  // beside it
+
+    Shapes t;
+    t.triangles.push_back({Vec3(0.f, 0.f, 2.f), Vec3(1.f, 0.f, 2.f), Vec3(0.f, 1.f, 2.f), {}});
+    h = t.intersect(Ray{Vec3(0.2f, 0.2f, 0.f), Vec3(0.f, 0.f, 1.f)}, kInf);
+    CHECK(h.t == doctest::Approx(2.f));
+    CHECK(h.ng.z == doctest::Approx(1.f));
+    CHECK(!t.intersect(Ray{Vec3(0.8f, 0.8f, 0.f), Vec3(0.f, 0.f, 1.f)}, kInf).found());  // outside the edge
+
+    CHECK(!NoSurfaces{}.intersect(ray, kInf).found());
+    CHECK(!NoSurfaces{}.occluded(ray, kInf));
+}
+
+/// The media a ray passes through, boundary by boundary, starting in `start`.
+std::vector<int> media_along(const Shapes& s, Ray r, int start) {
+    std::vector<int> media{start};
+    for (int i = 0; i < 16; ++i) {
+        const SurfaceHit h = s.intersect(r, kInf);
+        if (!h.found()) break;
+        CHECK(h.medium_left(r.d) == media.back());  // the boundaries agree on the medium between them
+        media.push_back(h.medium_entered(r.d));
+        r.o = h.p;
+    }
+    return media;
+}
+
+TEST_CASE("geometry: media across boundaries: leaving and re-entering, nested media, a camera inside") {
+    Shapes s;
+    // Two boxes of media 0 and 1 along x with vacuum between them, and inside box 0 a nested box
+    // of medium 2; every boundary an index-matched interface (no material, no light).
+    s.boxes.push_back({Vec3(0.f, -1.f, -1.f), Vec3(4.f, 1.f, 1.f), {-1, -1, 0, -1}});
+    s.boxes.push_back({Vec3(1.f, -0.5f, -0.5f), Vec3(2.f, 0.5f, 0.5f), {-1, -1, 2, 0}});
+    s.boxes.push_back({Vec3(5.f, -1.f, -1.f), Vec3(6.f, 1.f, 1.f), {-1, -1, 1, -1}});
+    const Vec3 x(1.f, 0.f, 0.f);
+    CHECK(media_along(s, Ray{Vec3(-1.f, 0.f, 0.f), x}, -1) == std::vector<int>{-1, 0, 2, 0, -1, 1, -1});
+    // A camera inside the nested box: the first boundary says which medium it is in.
+    const SurfaceHit first = s.intersect(Ray{Vec3(1.5f, 0.f, 0.f), x}, kInf);
+    CHECK(first.medium_left(x) == 2);
+    CHECK(media_along(s, Ray{Vec3(1.5f, 0.f, 0.f), x}, 2) == std::vector<int>{2, 0, -1, 1, -1});
+    // A shadow ray passes all these boundaries, and stops at an opaque quad beyond them.
+    CHECK(!s.occluded(Ray{Vec3(-1.f, 0.f, 0.f), x}, 10.f));
+    s.quads.push_back({Vec3(7.f, -1.f, -1.f), Vec3(0.f, 2.f, 0.f), Vec3(0.f, 0.f, 2.f), {0, -1, -1, -1}});
+    CHECK(s.occluded(Ray{Vec3(-1.f, 0.f, 0.f), x}, 10.f));
+    CHECK(!s.occluded(Ray{Vec3(-1.f, 0.f, 0.f), x}, 7.5f));  // the quad at distance 8 is beyond
+    static_assert(Geometry<Shapes> && Geometry<NoSurfaces>);
+}
+
+}  // namespace
