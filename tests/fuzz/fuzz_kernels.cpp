@@ -465,6 +465,25 @@ bool vertex_on_segment_end(const Maj& maj, const Ray& ray, const Lambda& lambda,
     return false;
 }
 
+/// True when a null lies where mu_bar - mu_t is at float rounding level in some channel: P_n is
+/// formed there from a difference of nearly equal floats, the sampler's float P_n and the
+/// re-evaluation's can differ by a factor of 2 (finding 12: mu_n one ulp of mu_bar = 16 against
+/// half an ulp), and the pdf comparison is ill-conditioned. It is skipped there, as at segment
+/// ends (finding 4); such a null is drawn with probability ~1e-7 and changes no estimate.
+template <class M, class Maj, class Lambda>
+bool null_at_rounding_level(const M& medium, const Maj& maj, const Ray& ray, const Lambda& lambda,
+                            const std::vector<float>& nulls) {
+    using Spec = typename M::Spectral::Spectrum;
+    for (const float t : nulls) {
+        const auto mu_v = majorant_value_at<M>(maj, ray, t, lambda);
+        if (!mu_v) continue;
+        const Spec mu = detail::broadcast_majorant<Spec>(*mu_v);
+        const Spec mu_t = tracked_coefficients(medium, maj, ray, t, lambda).sigma_t();
+        if (((mu - mu_t).abs() <= 16.f * 0x1p-23f * mu.abs()).any()) return true;
+    }
+    return false;
+}
+
 /// Prints what a pdf comparison found before NSP_FUZZ_CHECK aborts on it.
 inline bool report_pdf(bool ok, double lp, double recorded, std::size_t vertices, float tmax) {
     if (!ok)
@@ -560,7 +579,7 @@ void drive_grey(FuzzRng& rng, const M& medium, const Maj& maj, const Ray& ray, f
             const double lp = delta_segment_log_pdf<A>(medium, maj, ray, tmax, lambda, nulls, d.end, d.t);
             const float t_far = rec.t.empty() ? 0.f : std::abs(rec.t.back()) + std::abs(ray.o.x) + std::abs(ray.o.y) +
                                                           std::abs(ray.o.z);
-            if (!vertex_on_segment_end<M>(maj, ray, lambda, rec.t))
+            if (!vertex_on_segment_end<M>(maj, ray, lambda, rec.t) && !null_at_rounding_level(medium, maj, ray, lambda, nulls))
                 NSP_FUZZ_CHECK(report_pdf(std::abs(lp - rec.log_pdf) <= log_pdf_tolerance(rec.log_pdf, rec.t.size(), t_far, maj_max),
                                           lp, rec.log_pdf, rec.t.size(), tmax));
         }
@@ -645,7 +664,8 @@ void drive_channels(Input& in, FuzzRng& rng, const M& medium, const Maj& maj, co
                     channel_delta_segment_log_pdf<A>(medium, maj, ray, tmax, lambda, c, nulls, tr.end, tr.t);
                 const float t_far = (rec.t.empty() ? 0.f : std::abs(rec.t.back())) + std::abs(ray.o.x) +
                                     std::abs(ray.o.y) + std::abs(ray.o.z);
-                if (!vertex_on_segment_end<M>(maj, ray, lambda, rec.t))
+                if (!vertex_on_segment_end<M>(maj, ray, lambda, rec.t) &&
+                    !null_at_rounding_level(medium, maj, ray, lambda, nulls))
                     NSP_FUZZ_CHECK(report_pdf(std::abs(lp - rec.log_pdf) <=
                                                   log_pdf_tolerance(rec.log_pdf, rec.t.size(), t_far, maj_max),
                                               lp, rec.log_pdf, rec.t.size(), tmax));
