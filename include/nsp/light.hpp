@@ -205,6 +205,40 @@ struct EnvironmentLight {
 static_assert(Light<PointLight<Rgb>, Rgb> && Light<SphereLight<Rgb>, Rgb> && Light<QuadLight<Rgb>, Rgb> &&
               Light<EnvironmentLight<Hero<4>>, Hero<4>>);
 
+/// Checks a light model's values; throws InvalidArgument naming the bad one: a non-finite
+/// position or edge, a radius that is not finite and > 0 (or whose square overflows), a
+/// rectangle without a finite area > 0, a negative or non-finite radiance or intensity.
+template <SpectralMode S>
+void validate_light(const PointLight<S>& l) {
+    for (int a = 0; a < 3; ++a) detail::require_finite(l.position[a], "PointLight position");
+    detail::require_coefficient(l.intensity, "PointLight intensity");
+}
+template <SpectralMode S>
+void validate_light(const SphereLight<S>& l) {
+    for (int a = 0; a < 3; ++a) detail::require_finite(l.center[a], "SphereLight center");
+    if (!std::isfinite(l.radius) || !(l.radius > 0.f))
+        detail::fail("SphereLight radius = ", l.radius, " is not allowed: it must be finite and > 0");
+    if (!std::isfinite(l.radius * l.radius))
+        detail::fail("SphereLight radius = ", l.radius, " is not allowed: radius^2 must be finite (radius <= ",
+                     std::sqrt(std::numeric_limits<float>::max()), ")");
+    detail::require_coefficient(l.radiance, "SphereLight radiance");
+}
+template <SpectralMode S>
+void validate_light(const QuadLight<S>& l) {
+    for (int a = 0; a < 3; ++a) {
+        detail::require_finite(l.corner[a], "QuadLight corner");
+        detail::require_finite(l.edge_u[a], "QuadLight edge_u");
+        detail::require_finite(l.edge_v[a], "QuadLight edge_v");
+    }
+    if (const float area = l.area(); !(area > 0.f) || !std::isfinite(area))
+        detail::fail("QuadLight area = ", area, " is not allowed: edge_u and edge_v must span a finite area > 0");
+    detail::require_coefficient(l.radiance, "QuadLight radiance");
+}
+template <SpectralMode S>
+void validate_light(const EnvironmentLight<S>& l) {
+    detail::require_coefficient(l.radiance, "EnvironmentLight radiance");
+}
+
 /// The lights of a scene: at most one of each kind, selected uniformly for NEE.
 template <SpectralMode S>
 class Lights {
@@ -213,27 +247,20 @@ public:
 
     /// Sets the point light; throws InvalidArgument on a non-finite position or bad intensity.
     Lights& set(const PointLight<S>& l) {
-        for (int a = 0; a < 3; ++a) detail::require_finite(l.position[a], "PointLight position");
-        detail::require_coefficient(l.intensity, "PointLight intensity");
+        validate_light(l);
         point_ = l;
         return *this;
     }
     /// Sets the sphere light; throws InvalidArgument on a non-finite centre, a radius that is not
     /// finite and > 0 (or whose square overflows), or a bad radiance.
     Lights& set(const SphereLight<S>& l) {
-        for (int a = 0; a < 3; ++a) detail::require_finite(l.center[a], "SphereLight center");
-        if (!std::isfinite(l.radius) || !(l.radius > 0.f))
-            detail::fail("SphereLight radius = ", l.radius, " is not allowed: it must be finite and > 0");
-        if (!std::isfinite(l.radius * l.radius))
-            detail::fail("SphereLight radius = ", l.radius, " is not allowed: radius^2 must be finite (radius <= ",
-                         std::sqrt(std::numeric_limits<float>::max()), ")");
-        detail::require_coefficient(l.radiance, "SphereLight radiance");
+        validate_light(l);
         sphere_ = l;
         return *this;
     }
     /// Sets the environment; throws InvalidArgument on a bad radiance.
     Lights& set(const EnvironmentLight<S>& l) {
-        detail::require_coefficient(l.radiance, "EnvironmentLight radiance");
+        validate_light(l);
         env_ = l;
         return *this;
     }

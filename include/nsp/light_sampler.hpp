@@ -131,31 +131,11 @@ private:
         }(std::index_sequence_for<Ls...>{});
     }
 
-    static void require_point(const Vec3& p, const char* what) {
-        for (int a = 0; a < 3; ++a) detail::require_finite(p[a], what);
-    }
-    static void validate(const PointLight<S>& l) {
-        require_point(l.position, "PointLight position");
-        detail::require_coefficient(l.intensity, "PointLight intensity");
-    }
-    static void validate(const SphereLight<S>& l) {
-        require_point(l.center, "SphereLight center");
-        if (!std::isfinite(l.radius * l.radius) || !(l.radius > 0.f))
-            detail::fail("SphereLight radius = ", l.radius, " is not allowed: it must be finite and > 0");
-        detail::require_coefficient(l.radiance, "SphereLight radiance");
-    }
-    static void validate(const QuadLight<S>& l) {
-        require_point(l.corner, "QuadLight corner");
-        require_point(l.edge_u, "QuadLight edge_u");
-        require_point(l.edge_v, "QuadLight edge_v");
-        if (const float a = l.area(); !(a > 0.f) || !std::isfinite(a))
-            detail::fail("QuadLight area = ", a, " is not allowed: edge_u and edge_v must span a finite area > 0");
-        detail::require_coefficient(l.radiance, "QuadLight radiance");
-    }
-    static void validate(const EnvironmentLight<S>& l) { detail::require_coefficient(l.radiance, "EnvironmentLight radiance"); }
-    /// A host's own light model: it checks itself.
+    /// nsp's light models check their values (validate_light); a host's own model checks itself.
     template <class L>
-    static void validate(const L&) {}
+    static void validate(const L& l) {
+        if constexpr (requires { validate_light(l); }) validate_light(l);
+    }
 
     std::tuple<std::vector<Ls>...> lights_;
     std::vector<Entry> entries_;
