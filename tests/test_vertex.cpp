@@ -232,7 +232,10 @@ void check_furnace(const K& k, const char* name) {
 
 TEST_CASE("vertex kernels: a host's loop with surfaces renders the furnace of emitting walls (L = 2)") {
     check_furnace(VertexKernels<strategy::Unidirectional>{}, "unidirectional");
-    check_furnace(VertexKernels<strategy::NextEvent>{}, "ratio-nee");
+    // NEE alone is left out: the quads are sampled by area, and in a closed box the second moment
+    // of that estimate diverges (logarithmically) at vertices near an edge or a wall, so its
+    // standard error means nothing there. tests/test_surface_estimators.cpp checks NEE alone
+    // on the same kernels in a white furnace under a uniform sky, where its variance is finite.
     check_furnace(VertexKernels<strategy::NullScatteringMis, mis::Balance>{}, "uni-nee-mis balance");
     check_furnace(VertexKernels<strategy::NullScatteringMis, mis::Power, absorption::Event>{}, "uni-nee-mis power event");
     check_furnace(VertexKernels<strategy::DirectionalMis, mis::Balance>{}, "directional-mis");

@@ -37,6 +37,8 @@ struct BsdfSample {
 /// for the directions of a delta lobe, which no other technique reaches) and `pdf(wo, wi, n)` of
 /// its own sampling (0 for delta lobes). `passes_through` is true for a null interface: the path
 /// crosses it as it would cross empty space, with no real vertex (its MIS state carries on).
+/// Optional: `static constexpr bool is_delta = true` on a model all of whose lobes are delta
+/// lobes (MirrorBsdf), so that an estimator skips light sampling there.
 template <class B, class S>
 concept Bsdf = SpectralMode<S> && requires(const B& b, const Vec3& w, float u, const typename S::Wavelengths& l) {
     { b.sample(w, w, u, u, l) } -> std::same_as<BsdfSample<S>>;
@@ -95,6 +97,7 @@ template <SpectralMode S>
 class MirrorBsdf {
 public:
     static constexpr bool passes_through = false;
+    static constexpr bool is_delta = true;  ///< its only lobe is a delta: NEE is skipped there
 
     /// Throws InvalidArgument unless every channel of `reflectance` is finite and >= 0.
     explicit MirrorBsdf(typename S::Coefficient reflectance) : reflectance_(reflectance) {

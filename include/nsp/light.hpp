@@ -182,6 +182,7 @@ struct QuadLight {
 template <SpectralMode S>
 struct EnvironmentLight {
     static constexpr bool is_delta = false;
+    static constexpr bool is_infinite = true;  ///< reached by every ray that leaves the scene
     typename S::Coefficient radiance;
 
     LightSample<S> sample(const Vec3&, float u1, float u2, const typename S::Wavelengths& l = {},

@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <tuple>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -48,6 +49,7 @@ public:
         for_each_light([&](const auto& l, int kind, int index) {
             validate(l);
             const double w = selection == LightSelection::Power ? double(l.power(scene_radius)) : 1.0;
+            if (is_infinite<std::decay_t<decltype(l)>>()) infinite_.push_back(int(entries_.size()));
             entries_.push_back({std::uint8_t(kind), std::uint32_t(index), float(w), 0.f});
             total += w;
         });
@@ -64,6 +66,10 @@ public:
     }
 
     int count() const noexcept { return int(entries_.size()); }
+
+    /// The indices of the lights at infinity (models with `is_infinite`, e.g. EnvironmentLight):
+    /// what a ray that leaves the scene reaches.
+    const std::vector<int>& infinite() const noexcept { return infinite_; }
 
     /// The probability with which sample() chooses light `light`.
     float selection_pdf(int light) const noexcept {
@@ -137,8 +143,15 @@ private:
         if constexpr (requires { validate_light(l); }) validate_light(l);
     }
 
+    template <class L>
+    static constexpr bool is_infinite() noexcept {
+        if constexpr (requires { L::is_infinite; }) return bool(L::is_infinite);
+        else return false;
+    }
+
     std::tuple<std::vector<Ls>...> lights_;
     std::vector<Entry> entries_;
+    std::vector<int> infinite_;
 };
 
 }  // namespace nsp

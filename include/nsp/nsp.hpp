@@ -26,5 +26,6 @@
 #include "phase.hpp"
 #include "scene.hpp"
 #include "spectrum.hpp"
+#include "surface_scene.hpp"
 #include "tracking.hpp"
 #include "vertex.hpp"

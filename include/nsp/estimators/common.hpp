@@ -98,6 +98,8 @@ enum class Status : std::uint8_t {
     Aborted,    ///< a flight hit the collision limit; that flight contributed 0 (rare, biased)
     NonFinite,  ///< the estimate was NaN or Inf and has been replaced by 0
     Rejected,   ///< bound::Reject met mu_t > mu_bar on a flight; that flight contributed 0 (biased)
+    InvalidInput,  ///< the host's geometry reported a hit nsp cannot use (a NaN or negative distance, a
+                   ///< non-unit normal, a handle outside its tables); the path stopped there
 };
 
 /// The status of a path one of whose flights ended with `end` (Ok unless Aborted, Rejected,

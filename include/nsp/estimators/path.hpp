@@ -35,8 +35,10 @@
 #include "../pdf.hpp"
 #include "../scene.hpp"
 #include "../tracking.hpp"
+#include "../surface_scene.hpp"
 #include "../vertex.hpp"
 #include "common.hpp"
+#include "surface_path.hpp"
 
 namespace nsp {
 
@@ -154,7 +156,9 @@ public:
 
     const EstimatorOptions& options() const noexcept { return kernels_.options(); }
 
-    /// An estimate of the radiance arriving at `ray.o` from direction -ray.d. Never throws.
+    /// An estimate of the radiance arriving at `ray.o` from direction -ray.d, in a Scene (media
+    /// in empty space) or a SurfaceScene (the host's surfaces, media and lights; the loop of
+    /// estimators/surface_path.hpp). Never throws.
     template <class Sc, UniformRng R, LookupCounter C>
     RadianceSample<typename Sc::Spectral> radiance(const Sc& scene, const Ray& camera_ray,
                                                    const typename Sc::Spectral::Wavelengths& lambda,
@@ -162,6 +166,16 @@ public:
         static_assert(!is_per_channel_majorant_v<typename Sc::MajorantType, typename Sc::MediumType>,
                       "nsp::PathEstimator drives every channel with one pdf and needs a grey majorant "
                       "(GlobalMajorant or GridMajorant); per-channel majorants go with nsp::SpectralPathEstimator");
+        if constexpr (is_surface_scene_v<Sc>) return detail::surface_radiance(kernels_, scene, camera_ray, lambda, rng, counter);
+        else return media_radiance(scene, camera_ray, lambda, rng, counter);
+    }
+
+private:
+    /// One path through a Scene: media in empty space, the three fixed lights.
+    template <class Sc, UniformRng R, LookupCounter C>
+    RadianceSample<typename Sc::Spectral> media_radiance(const Sc& scene, const Ray& camera_ray,
+                                                         const typename Sc::Spectral::Wavelengths& lambda,
+                                                         R& rng, C& counter) const {
         using Spectrum = typename Sc::Spectrum;
         constexpr bool kEmissive = EmissiveMedium<typename Sc::MediumType>;
         Spectrum L = Spectrum::Zero(), beta = Spectrum::Ones();
@@ -289,7 +303,6 @@ public:
         return {L, status};
     }
 
-private:
     /// Adds NEE's weighted contribution at real vertex x (arrived along wo, throughput beta) to L;
     /// returns Aborted or Rejected if its shadow flight was, else Ok. For the equiangular
     /// strategies, `track_ratio_` and `eq_ratio` are the tracking and equiangular pdfs of x over

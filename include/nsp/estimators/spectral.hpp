@@ -30,6 +30,7 @@
 #include "../path_pdf.hpp"
 #include "../pdf.hpp"
 #include "../scene.hpp"
+#include "../surface_scene.hpp"
 #include "common.hpp"
 
 namespace nsp {
@@ -79,6 +80,9 @@ public:
                                                    const typename Sc::Spectral::Wavelengths& lambda,
                                                    const ChannelSelection<typename Sc::Spectral>& selection, R& rng,
                                                    C& counter) const {
+        static_assert(!is_surface_scene_v<Sc>,
+                      "nsp::SpectralPathEstimator renders nsp::Scene (media in empty space) only so far; a "
+                      "SurfaceScene renders with nsp::PathEstimator, or in a host's loop on the vertex kernels");
         using M = typename Sc::MediumType;
         using Maj = typename Sc::MajorantType;
         static_assert(CP::own_pdfs || !is_per_channel_majorant_v<Maj, M>,

@@ -1,0 +1,146 @@
+// nsp/surface_scene.hpp: what the path estimators render when a scene has surfaces (THEORY 3,
+// 5.8): the host's geometry (an nsp::Geometry), a table of media with their majorants and phase
+// functions, a table of BSDFs and a LightSampler over any number of lights. A SurfaceHit's
+// handles index these tables: `material` the BSDFs, `light` the light sampler, `medium_front` /
+// `medium_back` the media (-1 everywhere: none, vacuum).
+//
+//     using Mats = nsp::Materials<S, nsp::LambertianBsdf<S>, nsp::MirrorBsdf<S>>;
+//     using Ls = nsp::LightSampler<S, nsp::QuadLight<S>, nsp::EnvironmentLight<S>>;
+//     nsp::SurfaceScene<MyGeometry, M, nsp::GlobalMajorant<M>, nsp::HenyeyGreensteinPhase, Mats, Ls>
+//         scene{geometry, {{medium, majorant, phase}}, Mats({floor}, {mirror}), lights, camera_medium};
+//     estimator.radiance(scene, camera_ray, lambda, rng, counter);
+//
+// A medium's density is confined by the surfaces around it: a path is tracked through medium i
+// only between the boundaries whose handles say it is inside i. The estimators start every ray
+// at the previous hit point, unoffset: the host's intersect must not report the surface a ray
+// starts on (an epsilon, or its primitive id), as every renderer's does.
+#pragma once
+
+#include <cstdint>
+#include <tuple>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
+#include "bsdf.hpp"
+#include "core/error.hpp"
+#include "geometry.hpp"
+#include "light_sampler.hpp"
+#include "majorant.hpp"
+#include "medium.hpp"
+#include "phase.hpp"
+
+namespace nsp {
+
+namespace detail {
+template <class B>
+constexpr bool bsdf_is_delta() noexcept {
+    if constexpr (requires { B::is_delta; }) return bool(B::is_delta);
+    else return false;
+}
+}  // namespace detail
+
+/// A table of BSDFs of the model types Bs..., one vector per type (no virtual calls). A
+/// material is named by its index in the order the constructor got them, vector by vector.
+template <SpectralMode S, class... Bs>
+    requires(Bsdf<Bs, S> && ...)
+class Materials {
+public:
+    using Spectral = S;
+
+    explicit Materials(std::vector<Bs>... bsdfs) : bsdfs_(std::move(bsdfs)...) {
+        [&]<std::size_t... K>(std::index_sequence<K...>) {
+            (([&] {
+                 const auto& v = std::get<K>(bsdfs_);
+                 for (std::size_t i = 0; i < v.size(); ++i) entries_.push_back({std::uint8_t(K), std::uint32_t(i)});
+             }()),
+             ...);
+        }(std::index_sequence_for<Bs...>{});
+    }
+
+    int count() const noexcept { return int(entries_.size()); }
+    bool contains(int material) const noexcept { return material >= 0 && material < count(); }
+
+    /// Calls f(bsdf) with material `material` (which must be contained).
+    template <class F>
+    void visit(int material, F&& f) const noexcept {
+        const Entry& e = entries_[std::size_t(material)];
+        [&]<std::size_t... K>(std::index_sequence<K...>) {
+            ((e.kind == K ? (f(std::get<K>(bsdfs_)[e.index]), 0) : 0), ...);
+        }(std::index_sequence_for<Bs...>{});
+    }
+
+    /// Whether the material is a boundary a path crosses without a vertex (a null interface).
+    bool passes_through(int material) const noexcept {
+        bool p = false;
+        visit(material, [&](const auto& b) { p = std::decay_t<decltype(b)>::passes_through; });
+        return p;
+    }
+    /// Whether every lobe of the material is a delta lobe (light sampling cannot reach its paths).
+    bool is_delta(int material) const noexcept {
+        bool d = false;
+        visit(material, [&](const auto& b) { d = detail::bsdf_is_delta<std::decay_t<decltype(b)>>(); });
+        return d;
+    }
+
+private:
+    struct Entry {
+        std::uint8_t kind;
+        std::uint32_t index;
+    };
+    std::tuple<std::vector<Bs>...> bsdfs_;
+    std::vector<Entry> entries_;
+};
+
+/// One medium of a SurfaceScene: its density, majorant and phase function.
+template <Medium M, MajorantPolicy<M> Maj, PhaseFunction P>
+struct SceneMedium {
+    M medium;
+    Maj majorant;
+    P phase;
+};
+
+/// A scene with surfaces: geometry G (the host's), media of type M with majorants Maj and phase
+/// functions P, the BSDF table Mats (a Materials) and the light sampler Ls (a LightSampler).
+/// `camera_medium` is the medium camera rays start in (-1: vacuum).
+template <Geometry G, Medium M, MajorantPolicy<M> Maj, PhaseFunction P, class Mats, class Ls>
+struct SurfaceScene {
+    using GeometryType = G;
+    using MediumType = M;
+    using MajorantType = Maj;
+    using PhaseType = P;
+    using Spectral = typename M::Spectral;
+    using Spectrum = typename Spectral::Spectrum;
+    static_assert(std::is_same_v<typename Mats::Spectral, Spectral>,
+                  "nsp::SurfaceScene: the materials' spectral mode must be the media's");
+
+    G geometry;
+    std::vector<SceneMedium<M, Maj, P>> media;
+    Mats materials;
+    Ls lights;
+    int camera_medium = -1;
+
+    /// Throws InvalidArgument if `camera_medium` is not -1 or an index into `media`, or if a
+    /// medium's single-valued majorant (GlobalMajorant) has a value its bound policy forbids.
+    SurfaceScene(G g, std::vector<SceneMedium<M, Maj, P>> m, Mats mats, Ls l, int camera = -1)
+        : geometry(std::move(g)), media(std::move(m)), materials(std::move(mats)), lights(std::move(l)),
+          camera_medium(camera) {
+        if (camera_medium < -1 || camera_medium >= int(media.size()))
+            detail::fail("SurfaceScene camera_medium = ", camera_medium, " is not allowed: it must be -1 (vacuum) or "
+                         "an index into the ", media.size(), " media");
+        for (const auto& s : media)
+            if constexpr (requires(const Maj& j) { { j.value() } -> std::convertible_to<float>; })
+                detail::require_majorant_value<bound_policy_t<Maj>>(s.majorant.value(), s.medium.max_extinction(),
+                                                                    "SurfaceScene: a medium's majorant value",
+                                                                    " of that medium");
+    }
+
+    bool has_medium(int i) const noexcept { return i >= 0 && i < int(media.size()); }
+};
+
+template <class Sc>
+inline constexpr bool is_surface_scene_v = false;
+template <class G, class M, class Maj, class P, class Mats, class Ls>
+inline constexpr bool is_surface_scene_v<SurfaceScene<G, M, Maj, P, Mats, Ls>> = true;
+
+}  // namespace nsp
