@@ -12,6 +12,9 @@
 #     EXR per row, a PNG contact sheet per table (SETUP[_mode]_sheet.png, the rows in table order)
 #     and a larger PNG picture of each scene (cloud.png, chromatic.png, sparse.png, fog.png,
 #     plume.png; --picture-res, 256 by default). docs/renderer.md explains every flag;
+#  1b. nsp_room: the cloud over a diffuse floor in an open room under a quad light and a dim sky
+#     (the scene with surfaces), every strategy PathEstimator renders surfaces with, its table
+#     and out/room_sheet.png, out/room.png;
 # With --with-references it then also runs (about 90 s more, which would take the default run past
 # five minutes on 2 cores with the renderer's build; README's heavy-tail tables come from it):
 #  2. the heavy-tail comparison: the grey-majorant baseline against spectral MIS + NEE (per-channel
@@ -32,7 +35,7 @@
 # With other arguments, runs nsp_render once with them instead (see build/examples/nsp_render --help).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-scripts/setup.sh nsp_render
+scripts/setup.sh nsp_render nsp_room
 
 references=0
 if [ "${1:-}" = --with-references ]; then
@@ -45,6 +48,8 @@ fi
 
 start=$SECONDS
 build/examples/nsp_render --out out
+# The scene with surfaces: the cloud over a floor in an open room (about 40 s).
+build/examples/nsp_room --out out
 if [ "$references" = 0 ]; then
     echo
     echo "main job: $((SECONDS - start)) s of rendering (scripts/run-main.sh --with-references adds the"

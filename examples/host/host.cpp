@@ -5,10 +5,10 @@
 // rectangular light and a dim sky.
 //
 //   nsp_host [--res N] [--spp N] [--out FILE.png]   renders the scene, prints its image mean
-//   nsp_host --compare                              renders the cloud under a sphere light (no
-//       floor) with this loop and with nsp::PathEstimator and checks that the image means agree
-//       within 5 standard errors (exit 1 if not): the host's loop and the library's are the same
-//       estimator.
+//   nsp_host --compare                              renders the scene with this loop and with
+//       nsp::PathEstimator over an nsp::SurfaceScene of the same shapes, medium and lights, and
+//       checks that the image means agree within 5 standard errors (exit 1 if not; independent
+//       seeds): the host's loop and the library's are the same estimator.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -188,15 +188,25 @@ int main(int argc, char** argv) {
     }
     if (res < 1 || spp < 2) return std::fprintf(stderr, "nsp_host: --res must be >= 1 and --spp >= 2\n"), 2;
     const Kernels kernels;
+    World w;
+    w.lights = Lights(nsp::LightSelection::Power, 4.f,
+                      {nsp::QuadLight<S>{nsp::Vec3(-0.6f, 2.6f, -0.6f), nsp::Vec3(1.2f, 0.f, 0.f), nsp::Vec3(0.f, 0.f, 1.2f),
+                                         Spectrum::Constant(12.f)}},
+                      {}, {nsp::EnvironmentLight<S>{Spectrum::Constant(0.05f)}});
+    w.sky = 1;
+    const auto& lamp = w.lights.lights<nsp::QuadLight<S>>()[0];
+    w.shapes.quads.push_back({lamp.corner, lamp.edge_u, lamp.edge_v, {-1, 0, -1, -1}});  // light 0
+    w.shapes.quads.push_back({nsp::Vec3(-3.f, -1.05f, 3.f), nsp::Vec3(6.f, 0.f, 0.f), nsp::Vec3(0.f, 0.f, -6.f),
+                              {0, -1, -1, -1}});  // the floor, material 0, normal up
     if (compare) {
-        // The cloud under a sphere light, no floor: a scene nsp::PathEstimator renders too.
-        const nsp::SphereLight<S> sun{nsp::Vec3(0.f, 2.5f, -0.5f), 0.3f, Spectrum::Constant(30.f)};
-        World w;
-        w.lights = Lights(nsp::LightSelection::Uniform, 4.f, {}, {sun}, {});
-        w.shapes.spheres.push_back({sun.center, sun.radius, {-1, 0, -1, -1}});  // light 0
-        nsp::Lights<S> lights;
-        lights.set(sun);
-        const auto scene = nsp::make_scene(make_cloud(), nsp::HenyeyGreensteinPhase(0.6f), lights);
+        // The same scene as an nsp::SurfaceScene for nsp::PathEstimator: the host tracks its one
+        // medium everywhere, so every shape there has medium 0 on both sides and so does the camera.
+        nsp_host::Shapes shapes = w.shapes;
+        for (auto& q : shapes.quads) q.h.inside = q.h.outside = 0;
+        using Scene = nsp::SurfaceScene<nsp_host::Shapes, Medium, nsp::GlobalMajorant<Medium>, nsp::HenyeyGreensteinPhase,
+                                        nsp::Materials<S, nsp::LambertianBsdf<S>>, Lights>;
+        const Scene scene(shapes, {{w.cloud, w.majorant, w.phase}}, nsp::Materials<S, nsp::LambertianBsdf<S>>({w.floor_bsdf}),
+                          w.lights, 0);
         const nsp::PathEstimator<nsp::strategy::NullScatteringMis, nsp::mis::Balance> estimator;
         const Image host = render(32, 128, 1, [&](const nsp::Ray& r, nsp::Pcg32& rng) { return radiance(kernels, w, r, rng); });
         const Image lib = render(32, 128, 2, [&](const nsp::Ray& r, nsp::Pcg32& rng) {
@@ -208,16 +218,6 @@ int main(int argc, char** argv) {
                     "(allowed: 5)\n", host.mean, host.se, lib.mean, lib.se, z);
         return z <= 5.0 ? 0 : 1;
     }
-    World w;
-    w.lights = Lights(nsp::LightSelection::Power, 4.f,
-                      {nsp::QuadLight<S>{nsp::Vec3(-0.6f, 2.6f, -0.6f), nsp::Vec3(1.2f, 0.f, 0.f), nsp::Vec3(0.f, 0.f, 1.2f),
-                                         Spectrum::Constant(12.f)}},
-                      {}, {nsp::EnvironmentLight<S>{Spectrum::Constant(0.05f)}});
-    w.sky = 1;
-    const auto& lamp = w.lights.lights<nsp::QuadLight<S>>()[0];
-    w.shapes.quads.push_back({lamp.corner, lamp.edge_u, lamp.edge_v, {-1, 0, -1, -1}});  // light 0
-    w.shapes.quads.push_back({nsp::Vec3(-3.f, -1.05f, 3.f), nsp::Vec3(6.f, 0.f, 0.f), nsp::Vec3(0.f, 0.f, -6.f),
-                              {0, -1, -1, -1}});  // the floor, material 0, normal up
     const Image img = render(res, spp, 1, [&](const nsp::Ray& r, nsp::Pcg32& rng) { return radiance(kernels, w, r, rng); });
     std::printf("nsp_host: %dx%d, %d spp, image mean %.5f +- %.5f\n", res, res, spp, img.mean, img.se);
     if (!out.empty()) {

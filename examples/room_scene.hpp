@@ -1,0 +1,63 @@
+// examples/room_scene.hpp: the surface-and-smoke scene of the main job (nsp_room) and its tests:
+// the default cloud (default_scene.hpp) resting over a diffuse floor in an open room (a floor, a
+// back wall and a left wall), lit by a small rectangular light above and to the right of it and a
+// dim sky, as an nsp::SurfaceScene over the example shapes (host/shapes.hpp).
+#pragma once
+
+#include <cmath>
+
+#include <nsp/nsp.hpp>
+
+#include "default_scene.hpp"
+#include "host/shapes.hpp"
+
+namespace nsp_examples {
+
+using RoomMedium = nsp::DenseGridMedium<nsp::Mono>;
+using RoomMaterials = nsp::Materials<nsp::Mono, nsp::LambertianBsdf<nsp::Mono>>;
+using RoomLights = nsp::LightSampler<nsp::Mono, nsp::QuadLight<nsp::Mono>, nsp::EnvironmentLight<nsp::Mono>>;
+using RoomScene = nsp::SurfaceScene<nsp_host::Shapes, RoomMedium, nsp::GlobalMajorant<RoomMedium>,
+                                    nsp::HenyeyGreensteinPhase, RoomMaterials, RoomLights>;
+
+/// The lamp: 0.7 x 0.7 at height 2.2 above (1.1, 0.3), facing down, radiance 40.
+inline nsp::QuadLight<nsp::Mono> room_lamp() {
+    return {nsp::Vec3(0.75f, 2.2f, -0.05f), nsp::Vec3(0.7f, 0.f, 0.f), nsp::Vec3(0.f, 0.f, 0.7f),
+            nsp::Mono::Spectrum::Constant(40.f)};
+}
+inline constexpr float kRoomSky = 0.08f;  ///< the environment's radiance
+inline constexpr float kRoomFloorY = -1.05f;
+
+/// The room: the cloud in [-1, 1]^3 behind null interfaces (medium 0), the floor (material 0,
+/// albedo 0.7), the back and left walls (material 1, albedo 0.5), the lamp (light 0) and the sky
+/// (light 1), light selection by power.
+inline RoomScene make_room_scene() {
+    using S = nsp::Mono;
+    nsp_host::Shapes shapes;
+    shapes.boxes.push_back({nsp::Vec3(-1.f), nsp::Vec3(1.f), {-1, -1, 0, -1}});
+    const float y0 = kRoomFloorY, y1 = 2.95f;
+    shapes.quads.push_back({nsp::Vec3(-3.f, y0, 3.f), nsp::Vec3(6.f, 0.f, 0.f), nsp::Vec3(0.f, 0.f, -6.f), {0, -1, -1, -1}});
+    shapes.quads.push_back({nsp::Vec3(-3.f, y0, 3.f), nsp::Vec3(0.f, y1 - y0, 0.f), nsp::Vec3(6.f, 0.f, 0.f), {1, -1, -1, -1}});
+    shapes.quads.push_back({nsp::Vec3(-3.f, y0, -3.f), nsp::Vec3(0.f, 0.f, 6.f), nsp::Vec3(0.f, y1 - y0, 0.f), {1, -1, -1, -1}});
+    const nsp::QuadLight<S> lamp = room_lamp();
+    shapes.quads.push_back({lamp.corner, lamp.edge_u, lamp.edge_v, {-1, 0, -1, -1}});
+    RoomMedium cloud = make_default_medium<S>();
+    nsp::GlobalMajorant<RoomMedium> majorant(cloud);
+    return RoomScene(std::move(shapes), {{std::move(cloud), majorant, nsp::HenyeyGreensteinPhase(kPhaseG)}},
+                     RoomMaterials({nsp::LambertianBsdf<S>(S::Spectrum::Constant(0.7f)),
+                                    nsp::LambertianBsdf<S>(S::Spectrum::Constant(0.5f))}),
+                     RoomLights(nsp::LightSelection::Power, 4.f, {lamp}, {nsp::EnvironmentLight<S>{S::Spectrum::Constant(kRoomSky)}}),
+                     -1);
+}
+
+/// The room's camera: from (0, 0.6, -5.6) toward (0, -0.15, 0), 42 degrees vertical field of
+/// view; (u, v) in [0, 1)^2 with v = 0 at the bottom.
+inline nsp::Ray room_camera_ray(float u, float v, float aspect) {
+    const nsp::Vec3 eye(0.f, 0.6f, -5.6f), target(0.f, -0.15f, 0.f);
+    const nsp::Vec3 f = glm::normalize(target - eye);
+    const nsp::Vec3 r = glm::normalize(glm::cross(nsp::Vec3(0.f, 1.f, 0.f), f));
+    const nsp::Vec3 up = glm::cross(f, r);
+    const float tan_half = std::tan(0.5f * 42.f * nsp::kPi / 180.f);
+    return {eye, glm::normalize(f + (2.f * u - 1.f) * tan_half * aspect * r + (2.f * v - 1.f) * tan_half * up)};
+}
+
+}  // namespace nsp_examples
