@@ -32,7 +32,8 @@
 # Step 1 renders in about 160 s on 2 cores (its pictures about 17 s of it), all three in about
 # 270 s, with the build up to date; the renderer's build takes about 2.5 minutes more on a fresh
 # machine.
-# With other arguments, runs nsp_render once with them instead (see build/examples/nsp_render --help).
+# With other arguments, runs nsp_render once with them instead (see build/examples/nsp_render --help);
+# with --room first, nsp_room with the rest (build/examples/nsp_room --help).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh nsp_render nsp_room
@@ -41,6 +42,10 @@ references=0
 if [ "${1:-}" = --with-references ]; then
     references=1
     shift
+fi
+if [ "${1:-}" = --room ]; then
+    shift
+    exec build/examples/nsp_room --out out "$@"
 fi
 if [ $# -gt 0 ]; then
     exec build/examples/nsp_render --out out "$@"
