@@ -32,6 +32,7 @@
 #include "../scene.hpp"
 #include "../surface_scene.hpp"
 #include "common.hpp"
+#include "spectral_surface_path.hpp"
 
 namespace nsp {
 
@@ -80,14 +81,25 @@ public:
                                                    const typename Sc::Spectral::Wavelengths& lambda,
                                                    const ChannelSelection<typename Sc::Spectral>& selection, R& rng,
                                                    C& counter) const {
-        static_assert(!is_surface_scene_v<Sc>,
-                      "nsp::SpectralPathEstimator renders nsp::Scene (media in empty space) only so far; a "
-                      "SurfaceScene renders with nsp::PathEstimator, or in a host's loop on the vertex kernels");
         using M = typename Sc::MediumType;
         using Maj = typename Sc::MajorantType;
         static_assert(CP::own_pdfs || !is_per_channel_majorant_v<Maj, M>,
                       "nsp::SpectralPathEstimator: spectral tracking shares one pdf over channels and needs a "
                       "grey majorant bounding every channel (GlobalMajorant)");
+        if constexpr (is_surface_scene_v<Sc>)
+            return detail::spectral_surface_radiance<CP, St, A>(opts_, scene, camera_ray, lambda, selection, rng, counter);
+        else
+            return media_radiance(scene, camera_ray, lambda, selection, rng, counter);
+    }
+
+private:
+    /// One path through a Scene: media in empty space, the three fixed lights.
+    template <class Sc, UniformRng R, LookupCounter C>
+    RadianceSample<typename Sc::Spectral> media_radiance(const Sc& scene, const Ray& camera_ray,
+                                                         const typename Sc::Spectral::Wavelengths& lambda,
+                                                         const ChannelSelection<typename Sc::Spectral>& selection, R& rng,
+                                                         C& counter) const {
+        using M = typename Sc::MediumType;
         using Spectrum = typename Sc::Spectrum;
         const Spectrum& q = selection.probabilities();
         const int c = selection.sample(rng.uniform());
@@ -222,7 +234,6 @@ public:
         return {L, status};
     }
 
-private:
     /// Adds NEE's contribution at real vertex x (arrived along wo, roulette survival rr) to L:
     /// `f` is every channel's contribution of the path up to x, `p_track` its tracking pdf and
     /// `p_eq` its equiangular pdf (0 without equiangular sampling), all relative to one
