@@ -149,6 +149,24 @@ TEST_CASE("lights: LightSampler rejects bad lights with their value") {
     CHECK_THROWS_WITH_AS((LightSampler<S, SphereLight<S>>(LightSelection::Uniform, 1.f, {{Vec3(0.f), 0.f, S::Spectrum::Ones()}})),
                          doctest::Contains("SphereLight radius = 0"), InvalidArgument);
     CHECK_THROWS_WITH_AS(QS(LightSelection::Uniform, -1.f, {}), doctest::Contains("scene_radius = -1"), InvalidArgument);
+    using DS = LightSampler<S, DirectionalLight<S>>;
+    CHECK_THROWS_WITH_AS(DS(LightSelection::Uniform, 1.f, {{Vec3(0.f), S::Spectrum::Ones()}}),
+                         doctest::Contains("DirectionalLight direction (0, 0, 0)"), InvalidArgument);
+    CHECK_THROWS_WITH_AS(DS(LightSelection::Uniform, 1.f, {{Vec3(0.f, 0.f, -1.f), S::Spectrum::Constant(kInf)}}),
+                         doctest::Contains("DirectionalLight irradiance"), InvalidArgument);
+}
+
+TEST_CASE("lights: a directional light is a delta light from one direction, never hit") {
+    const DirectionalLight<S> sun{Vec3(0.f, 0.f, -2.f), S::Spectrum::Constant(3.f)};  // travelling down
+    const auto ls = sun.sample(Vec3(1.f, 2.f, 3.f), 0.3f, 0.7f, {}, 0.25f);
+    CHECK(ls.wi == Vec3(0.f, 0.f, 1.f));  // toward the light: up
+    CHECK(ls.distance == kInf);
+    CHECK(ls.delta);
+    CHECK(ls.pdf == 0.25f);  // the selection probability alone
+    CHECK(ls.radiance[0] == 3.f);
+    CHECK(sun.pdf(Vec3(0.f), Vec3(0.f, 0.f, 1.f)) == 0.f);
+    CHECK(sun.emitted(Vec3(0.f, 0.f, -1.f))[0] == 0.f);
+    CHECK(sun.power(2.f) == doctest::Approx(kPi * 4.f * 3.f));
 }
 
 }  // namespace

@@ -40,8 +40,8 @@ SceneMedium<M, GlobalMajorant<M>, HenyeyGreensteinPhase> medium(Box box, float s
     return {m, GlobalMajorant<M>(m, 2.f * (sigma_a + sigma_s) + 0.5f), HenyeyGreensteinPhase(g)};
 }
 
-template <class E, class Make>
-Stat estimate(const E& est, const Sc& sc, int n, std::uint64_t seed, Make make_ray) {
+template <class E, class Scene, class Make>
+Stat estimate(const E& est, const Scene& sc, int n, std::uint64_t seed, Make make_ray) {
     Pcg32 rng(seed, 5);
     LookupCount counter;
     Stat s;
@@ -210,6 +210,44 @@ TEST_CASE("surface estimators: every strategy agrees on a scattering cube over a
         CAPTURE(s.se());
         CHECK(std::abs(s.mean - ref.mean) <= kSigmas * std::hypot(s.se(), ref.se()));
     });
+}
+
+TEST_CASE("surface estimators: single scattering in a slab over a Lambertian plane under the sun (closed form)") {
+    // A homogeneous slab z in [0.2, 1.2] (sigma_s 0.6, sigma_a 0.3, HG g = 0.3) behind null
+    // interfaces over a Lambertian plane z = 0 (albedo 0.6), lit by a distant light of irradiance
+    // E = 2 from the direction w_s; max_depth 1: exactly one real vertex per path, in the slab or
+    // on the plane. Viewed from above along v (mu_v = |v_z|, mu_s = w_s.z, slab thickness d = 1):
+    //   L = sigma_s f_p(v . w_s) E (1 - exp(-sigma_t (d / mu_v) (1 + mu_v / mu_s))) / (sigma_t (1 + mu_v / mu_s))
+    //     + exp(-sigma_t d / mu_v) (0.6 / pi) E mu_s exp(-sigma_t d / mu_s),
+    // the single scattering along the camera ray and the plane's reflection, each attenuated on the
+    // way in and out; every shadow ray to the plane crosses the slab's two faces.
+    const float sigma_s = 0.6f, sigma_a = 0.3f, sigma_t = sigma_s + sigma_a, e = 2.f, albedo = 0.6f, g = 0.3f;
+    const Vec3 ws = glm::normalize(Vec3(0.5f, 0.2f, 1.f)), v = glm::normalize(Vec3(0.3f, 0.f, -1.f));
+    using Ds = LightSampler<S, DirectionalLight<S>>;
+    using DSc = SurfaceScene<Shapes, M, GlobalMajorant<M>, HenyeyGreensteinPhase, Mats, Ds>;
+    Shapes shapes;
+    const Box slab{Vec3(-60.f, -60.f, 0.2f), Vec3(60.f, 60.f, 1.2f)};
+    shapes.boxes.push_back({slab.lo, slab.hi, {-1, -1, 0, -1}});
+    shapes.quads.push_back({Vec3(-60.f, -60.f, 0.f), Vec3(120.f, 0.f, 0.f), Vec3(0.f, 120.f, 0.f), {0, -1, -1, -1}});
+    const DSc sc(shapes, {medium(slab, sigma_a, sigma_s, g)}, materials(albedo),
+                 Ds(LightSelection::Uniform, 100.f, {DirectionalLight<S>{-ws, Spectrum::Constant(e)}}), -1);
+    const double mu_v = -v.z, mu_s = ws.z, k = 1.0 + mu_v / mu_s;
+    const double fp = HenyeyGreensteinPhase(g).eval(v, ws);
+    const double expected = sigma_s * fp * e * (1.0 - std::exp(-sigma_t * (1.0 / mu_v) * k)) / (sigma_t * k) +
+                            std::exp(-sigma_t / mu_v) * (albedo / kPi) * e * mu_s * std::exp(-sigma_t / mu_s);
+    EstimatorOptions opts;
+    opts.max_depth = 1;
+    auto check = [&](const auto& est, const char* name) {
+        CAPTURE(std::string(name));
+        const Stat s = estimate(est, sc, 40000, 17, [&](Pcg32&) { return Ray{Vec3(0.f, 0.f, 3.f), v}; });
+        CAPTURE(s.mean);
+        CAPTURE(expected);
+        CHECK(std::abs(s.mean - expected) <= kSigmas * s.se());
+    };
+    check(PathEstimator<strategy::NextEvent>(opts), "ratio-nee");
+    check(PathEstimator<strategy::DirectionalMis, mis::Balance>(opts), "directional-mis");
+    check(PathEstimator<strategy::NullScatteringMis, mis::Balance>(opts), "uni-nee-mis balance");
+    check(PathEstimator<strategy::NullScatteringMis, mis::Power, absorption::Event>(opts), "uni-nee-mis power event");
 }
 
 /// A geometry that reports one fixed hit for every ray.

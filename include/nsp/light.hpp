@@ -1,6 +1,7 @@
-// nsp/light.hpp: the lights estimators know: a point light, a spherical area light and a
-// constant environment, with light sampling for next-event estimation and the pdf of hitting
-// them by unidirectional sampling (both in solid angle at the shading point).
+// nsp/light.hpp: the lights estimators know: a point light, a spherical area light, a one-sided
+// rectangle, a distant (directional) light and a constant environment, with light sampling for
+// next-event estimation and the pdf of hitting them by unidirectional sampling (both in solid
+// angle at the shading point).
 #pragma once
 
 #include <cmath>
@@ -203,8 +204,36 @@ struct EnvironmentLight {
     }
 };
 
+/// A distant light (the sun): parallel light travelling along `direction` (need not be unit),
+/// with irradiance `irradiance` (W/m^2) on a plane perpendicular to it. A delta light, reached
+/// by NEE only, from infinitely far away: its shadow rays run to the end of the scene.
+template <SpectralMode S>
+struct DirectionalLight {
+    static constexpr bool is_delta = true;
+    Vec3 direction;
+    typename S::Coefficient irradiance;
+
+    LightSample<S> sample(const Vec3&, float, float, const typename S::Wavelengths& l = {},
+                          float selection = 1.f) const noexcept {
+        LightSample<S> s;
+        const float len = glm::length(direction);
+        if (!(len > 0.f)) return s;
+        s.wi = -direction / len;
+        s.radiance = S::sample(irradiance, l);
+        s.pdf = selection;
+        s.delta = true;
+        return s;
+    }
+    float pdf(const Vec3&, const Vec3&, float = 1.f) const noexcept { return 0.f; }
+    typename S::Spectrum emitted(const Vec3&, const typename S::Wavelengths& = {}) const noexcept {
+        return S::Spectrum::Zero();  // a direction is never hit
+    }
+    /// What it sends through a disc of radius `scene_radius` across the scene: E pi R^2.
+    float power(float scene_radius = 1.f) const noexcept { return kPi * scene_radius * scene_radius * max_value(irradiance); }
+};
+
 static_assert(Light<PointLight<Rgb>, Rgb> && Light<SphereLight<Rgb>, Rgb> && Light<QuadLight<Rgb>, Rgb> &&
-              Light<EnvironmentLight<Hero<4>>, Hero<4>>);
+              Light<EnvironmentLight<Hero<4>>, Hero<4>> && Light<DirectionalLight<Mono>, Mono>);
 
 /// Checks a light model's values; throws InvalidArgument naming the bad one: a non-finite
 /// position or edge, a radius that is not finite and > 0 (or whose square overflows), a
@@ -238,6 +267,14 @@ void validate_light(const QuadLight<S>& l) {
 template <SpectralMode S>
 void validate_light(const EnvironmentLight<S>& l) {
     detail::require_coefficient(l.radiance, "EnvironmentLight radiance");
+}
+template <SpectralMode S>
+void validate_light(const DirectionalLight<S>& l) {
+    for (int a = 0; a < 3; ++a) detail::require_finite(l.direction[a], "DirectionalLight direction");
+    if (!(glm::dot(l.direction, l.direction) > 0.f))
+        detail::fail("DirectionalLight direction (", l.direction.x, ", ", l.direction.y, ", ", l.direction.z,
+                     ") is not allowed: it must have a length > 0");
+    detail::require_coefficient(l.irradiance, "DirectionalLight irradiance");
 }
 
 /// The lights of a scene: at most one of each kind, selected uniformly for NEE.
