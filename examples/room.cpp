@@ -1,12 +1,15 @@
 // examples/room.cpp: nsp_room, the main job's scene with surfaces (room_scene.hpp): the cloud over
-// a diffuse floor in an open room under a small rectangular light and a dim sky, rendered by
-// nsp::PathEstimator over an nsp::SurfaceScene with every strategy that renders surfaces, and the
-// efficiency table the other scenes have (docs/renderer.md reads it).
+// a diffuse floor in an open room under a small rectangular light and a dim sky, rendered over an
+// nsp::SurfaceScene with the efficiency tables the other scenes have (docs/surfaces.md reads
+// them): the grey cloud (Mono, 96x96 by default) with every strategy of nsp::PathEstimator that
+// renders surfaces, then the chromatic cloud (Rgb, half the size and spp) with the grey-majorant
+// PathEstimator against nsp::SpectralPathEstimator's per-channel pdfs.
 //
 //   nsp_room [--res N] [--spp N] [--threads N] [--out DIR] [--no-png] [--picture-res N]
 //
-// Writes DIR/room_sheet.png (every row at one exposure) and DIR/room.png (uni-nee-mis, balance,
-// 128 spp, --picture-res pixels square) unless --no-png.
+// Writes DIR/room_sheet.png and DIR/room_rgb_sheet.png (each table's rows at one exposure) and
+// DIR/room.png (the grey room, uni-nee-mis balance, 128 spp, --picture-res pixels square) unless
+// --no-png. Exits 1 if any path ended with a status other than Ok.
 #include <algorithm>
 #include <array>
 #include <atomic>
@@ -27,7 +30,6 @@
 
 namespace {
 
-using nsp_examples::RoomScene;
 
 double thread_cpu_seconds() {
     timespec ts{};
@@ -43,16 +45,18 @@ struct Row {
     nsp_examples::Image image;
 };
 
-/// Renders the room with `estimator` at res x res, spp samples per pixel, one Pcg32 stream per
-/// pixel (seeded by `seed`), rows shared among `threads` workers.
-template <class E>
-Row render(const RoomScene& scene, const E& estimator, const std::string& name, int res, int spp, int threads,
+/// Renders `scene` with `estimator` at res x res, spp samples per pixel, one Pcg32 stream per
+/// pixel (seeded by `seed`), rows shared among `threads` workers. The per-pixel statistics are of
+/// the channel mean of each sample (Mono: its value).
+template <class Sc, class E>
+Row render(const Sc& scene, const E& estimator, const std::string& name, int res, int spp, int threads,
            std::uint64_t seed) {
+    constexpr int kChannels = Sc::Spectral::channels;
     Row row;
     row.name = name;
     row.image.width = row.image.height = res;
     row.image.rgb.assign(std::size_t(res) * std::size_t(res) * 3u, 0.f);
-    std::vector<double> pixel_var(std::size_t(res) * std::size_t(res), 0.0);
+    std::vector<double> pixel_var(std::size_t(res) * std::size_t(res), 0.0), pixel_mean(pixel_var.size(), 0.0);
     std::atomic<int> next{0};
     struct Totals {
         std::uint64_t lookups = 0, failed = 0;
@@ -68,16 +72,19 @@ Row render(const RoomScene& scene, const E& estimator, const std::string& name, 
                 const std::size_t pixel = std::size_t(y) * std::size_t(res) + std::size_t(x);
                 nsp::Pcg32 rng(seed, pixel);
                 double mean = 0.0, m2 = 0.0;
+                std::array<double, 3> rgb{};
                 for (int k = 1; k <= spp; ++k) {
                     const float u = (float(x) + rng.uniform()) / float(res);
                     const float v = 1.f - (float(y) + rng.uniform()) / float(res);
                     const auto r = estimator.radiance(scene, nsp_examples::room_camera_ray(u, v, 1.f), {}, rng, counter);
                     if (r.status != nsp::Status::Ok) ++out.failed;
-                    const double L = r.value[0], d = L - mean;
+                    for (int c = 0; c < 3; ++c) rgb[std::size_t(c)] += r.value[kChannels == 3 ? c : 0];
+                    const double L = double(r.value.mean()), d = L - mean;
                     mean += d / k;
                     m2 += d * (L - mean);
                 }
-                for (int c = 0; c < 3; ++c) row.image.rgb[3 * pixel + std::size_t(c)] = float(mean);
+                for (int c = 0; c < 3; ++c) row.image.rgb[3 * pixel + std::size_t(c)] = float(rgb[std::size_t(c)] / spp);
+                pixel_mean[pixel] = mean;
                 pixel_var[pixel] = m2 / (spp - 1);
             }
         out.lookups = counter.count();
@@ -97,13 +104,43 @@ Row render(const RoomScene& scene, const E& estimator, const std::string& name, 
     double sum_var = 0.0, sum_mean = 0.0;
     for (std::size_t p = 0; p < pixel_var.size(); ++p) {
         sum_var += pixel_var[p];
-        sum_mean += row.image.rgb[3 * p];
+        sum_mean += pixel_mean[p];
     }
     row.lookups = lookups / samples;
     row.variance = sum_var / n_pixels;
     row.mean = sum_mean / n_pixels;
     row.se = std::sqrt(row.variance / samples);  // the image mean's standard error (pixels independent)
     return row;
+}
+
+/// CPU seconds x variance of row i: what cpu-s*var orders by (per sample, up to a common factor).
+double cost(const std::vector<Row>& rows, std::size_t i) { return rows[i].cpu_seconds * rows[i].variance; }
+
+/// Prints one efficiency table; `reference` is the row the z column compares with. Returns the
+/// number of paths with a failed status.
+std::uint64_t print_table(const char* title, const std::vector<Row>& rows, std::size_t reference, int res, int spp,
+                          int threads) {
+    const double samples = double(res) * res * spp;
+    double best = nsp::kInf;
+    for (const Row& r : rows) best = std::min(best, r.cpu_seconds / samples * r.variance);
+    std::printf("\n%s, %dx%d, %d spp, %d threads): the cloud over a floor, a quad light and a sky\n", title, res, res,
+                spp, threads);
+    std::printf("%-38s %8s %11s %11s %11s %11s %10s %9s %6s\n", "estimator", "seconds", "lookups/spl", "var/spl",
+                "LTUV", "cpu-s*var", "cpu/best", "mean", "z");
+    std::uint64_t failed = 0;
+    const Row& ref = rows[reference];
+    for (const Row& r : rows) {
+        const double cpu_var = r.cpu_seconds / samples * r.variance;
+        const double z = &r == &ref ? 0.0 : std::abs(r.mean - ref.mean) / std::hypot(r.se, ref.se);
+        std::printf("%-38s %8.2f %11.3g %11.3g %11.3g %11.3g %10.3g %9.4g %6.2f\n", r.name.c_str(), r.seconds,
+                    r.lookups, r.variance, r.lookups * r.variance, cpu_var, cpu_var / best, r.mean, z);
+        failed += r.failed;
+    }
+    std::printf("var/spl: per-pixel sample variance of the channel mean, averaged over pixels; cpu-s*var: thread CPU "
+                "seconds per sample x var/spl (lower is better; cpu/best against the best row). z: |mean - mean of %s| "
+                "in combined standard errors of the image means. Paths with a failed status: %llu\n",
+                ref.name.c_str(), static_cast<unsigned long long>(failed));
+    return failed;
 }
 
 }  // namespace
@@ -122,60 +159,71 @@ int main(int argc, char** argv) {
     app.add_flag("--no-png", no_png, "write no pictures");
     CLI11_PARSE(app, argc, argv);
 
-    const RoomScene scene = nsp_examples::make_room_scene();
     using namespace nsp;
-    std::vector<Row> rows;
     std::uint64_t seed = 1;
-    auto run = [&](const auto& estimator, const char* name) {
-        rows.push_back(render(scene, estimator, name, res, spp, threads, seed++));
-        std::fprintf(stderr, "  room: %-28s %6.2f s\n", name, rows.back().seconds);
+    std::vector<Row> rows;
+    int run_res = res, run_spp = spp;
+    auto run = [&](const auto& scene, const auto& estimator, const char* name) {
+        rows.push_back(render(scene, estimator, name, run_res, run_spp, threads, seed++));
+        std::fprintf(stderr, "  room: %-44s %6.2f s\n", name, rows.back().seconds);
     };
-    run(PathEstimator<strategy::Unidirectional>{}, "unidirectional");
-    run(PathEstimator<strategy::NextEvent>{}, "ratio-nee");
-    run(PathEstimator<strategy::DirectionalMis, mis::Balance>{}, "directional-mis_balance");
-    run(PathEstimator<strategy::DirectionalMis, mis::Power>{}, "directional-mis_power");
-    run(PathEstimator<strategy::NullScatteringMis, mis::Balance>{}, "uni-nee-mis_balance");
-    run(PathEstimator<strategy::NullScatteringMis, mis::Power>{}, "uni-nee-mis_power");
-    const std::size_t reference = 4;  // uni-nee-mis_balance: the z column compares every mean with it
 
-    double best = kInf;
-    for (const Row& r : rows) best = std::min(best, r.cpu_seconds / (double(res) * res * spp) * r.variance);
-    std::printf("\nRoom (mono, %dx%d, %d spp, %d threads): the cloud over a floor, a quad light and a sky\n", res, res,
-                spp, threads);
-    std::printf("%-28s %8s %11s %11s %11s %11s %10s %9s %6s\n", "estimator", "seconds", "lookups/spl", "var/spl",
-                "LTUV", "cpu-s*var", "cpu/best", "mean", "z");
-    for (const Row& r : rows) {
-        const double cpu_var = r.cpu_seconds / (double(res) * res * spp) * r.variance;
-        const Row& ref = rows[reference];
-        const double z = &r == &ref ? 0.0 : std::abs(r.mean - ref.mean) / std::hypot(r.se, ref.se);
-        std::printf("%-28s %8.2f %11.3g %11.3g %11.3g %11.3g %10.3g %9.4g %6.2f\n", r.name.c_str(), r.seconds,
-                    r.lookups, r.variance, r.lookups * r.variance, cpu_var, cpu_var / best, r.mean, z);
-    }
-    std::uint64_t failed = 0;
-    for (const Row& r : rows) failed += r.failed;
-    std::printf("var/spl: per-pixel sample variance, averaged over pixels; cpu-s*var: thread CPU seconds per sample x "
-                "var/spl (lower is better; cpu/best against the best row). z: |mean - mean of uni-nee-mis_balance| in "
-                "combined standard errors of the image means. Paths with a failed status: %llu\n",
-                static_cast<unsigned long long>(failed));
-    auto cost = [&](std::size_t i) { return rows[i].cpu_seconds * rows[i].variance; };
-    const std::size_t best_single = cost(0) <= cost(1) ? 0 : 1;
+    // Table 1: the grey cloud, Mono, one global majorant, every grey strategy.
+    const auto grey = nsp_examples::make_room_scene();
+    run(grey, PathEstimator<strategy::Unidirectional>{}, "unidirectional");
+    run(grey, PathEstimator<strategy::NextEvent>{}, "ratio-nee");
+    run(grey, PathEstimator<strategy::DirectionalMis, mis::Balance>{}, "directional-mis_balance");
+    run(grey, PathEstimator<strategy::DirectionalMis, mis::Power>{}, "directional-mis_power");
+    run(grey, PathEstimator<strategy::NullScatteringMis, mis::Balance>{}, "uni-nee-mis_balance");
+    run(grey, PathEstimator<strategy::NullScatteringMis, mis::Power>{}, "uni-nee-mis_power");
+    const std::uint64_t failed_grey = print_table("Room (mono", rows, 4, res, spp, threads);  // z against uni-nee-mis_balance
     std::printf("room: uni-nee-mis_balance / best single strategy (%s) in cpu-s*var: %.3g; unidirectional / ratio-nee: %.3g\n",
-                rows[best_single].name.c_str(), cost(reference) / cost(best_single), cost(0) / cost(1));
+                rows[cost(rows, 0) <= cost(rows, 1) ? 0 : 1].name.c_str(), cost(rows, 4) / std::min(cost(rows, 0), cost(rows, 1)),
+                cost(rows, 0) / cost(rows, 1));
+
+    // Table 2: the chromatic cloud (extinction 5, 20, 80 per unit density), Rgb: the grey-majorant
+    // PathEstimator against SpectralPathEstimator's per-channel pdfs, all uni + NEE MIS.
+    using CM = DenseGridMedium<Rgb>;
+    const CM chroma = nsp_examples::make_chromatic_medium<Rgb>();
+    const auto chroma_grey = nsp_examples::make_room_scene(chroma, GlobalMajorant<CM>(chroma));
+    const auto chroma_channel = nsp_examples::make_room_scene(chroma, ChannelMajorant<CM>(chroma));
+    const std::size_t first = rows.size();
+    run_res = std::max(1, res / 2);  // the chromatic cloud costs about 4x the lookups: half the size, half the spp
+    run_spp = std::max(2, spp / 2);
+    run(chroma_grey, PathEstimator<strategy::NullScatteringMis, mis::Balance>{}, "uni-nee-mis_grey_balance");
+    run(chroma_grey, SpectralPathEstimator<channels::SpectralTrackingAverage, strategy::NullScatteringMis, mis::Balance>{},
+        "uni-nee-mis_spectral-tracking-avg");
+    run(chroma_grey, SpectralPathEstimator<channels::SpectralMis, strategy::NullScatteringMis, mis::Balance>{},
+        "uni-nee-mis_spectral-mis_global");
+    run(chroma_channel, SpectralPathEstimator<channels::SpectralMis, strategy::NullScatteringMis, mis::Balance>{},
+        "uni-nee-mis_spectral-mis_per-channel");
+    std::vector<Row> chromatic(rows.begin() + std::ptrdiff_t(first), rows.end());
+    const std::uint64_t failed_chroma = print_table("Room, chromatic cloud (rgb", chromatic, 3, run_res, run_spp, threads);
+    std::printf("room chromatic: grey-majorant PathEstimator / spectral MIS (per-channel majorant) in cpu-s*var: %.3g "
+                "(the grey estimator's variance is practically infinite on this medium: its sample variance "
+                "understates it; docs/chromatic.md)\n",
+                cost(chromatic, 0) / cost(chromatic, 3));
+    const std::uint64_t failed = failed_grey + failed_chroma;
 
     if (!no_png) {
         std::filesystem::create_directories(out);
-        std::vector<nsp_examples::Tile> tiles;
-        std::vector<const nsp_examples::Image*> images;
-        for (std::size_t i = 0; i < rows.size(); ++i) {
-            tiles.push_back({std::to_string(i + 1) + " " + rows[i].name, &rows[i].image});
-            images.push_back(&rows[i].image);
-        }
-        const float exposure = nsp_examples::exposure_for(images);
-        nsp_examples::write_contact_sheet(out + "/room_sheet.png", tiles, exposure);
-        const Row picture = render(scene, PathEstimator<strategy::NullScatteringMis, mis::Balance>{}, "picture",
+        // One contact sheet per table, each at one exposure.
+        auto sheet = [&](const std::string& path, std::size_t from, std::size_t to) {
+            std::vector<nsp_examples::Tile> tiles;
+            std::vector<const nsp_examples::Image*> images;
+            for (std::size_t i = from; i < to; ++i) {
+                tiles.push_back({std::to_string(i - from + 1) + " " + rows[i].name, &rows[i].image});
+                images.push_back(&rows[i].image);
+            }
+            nsp_examples::write_contact_sheet(path, tiles, nsp_examples::exposure_for(images));
+        };
+        sheet(out + "/room_sheet.png", 0, first);
+        sheet(out + "/room_rgb_sheet.png", first, rows.size());
+        const Row picture = render(grey, PathEstimator<strategy::NullScatteringMis, mis::Balance>{}, "picture",
                                    picture_res, 128, threads, 99);
         nsp_examples::write_png(out + "/room.png", picture.image, nsp_examples::exposure_for({&picture.image}));
-        std::fprintf(stderr, "  room: %s/room_sheet.png, %s/room.png (%.1f s)\n", out.c_str(), out.c_str(), picture.seconds);
+        std::fprintf(stderr, "  room: %s/room_sheet.png, %s/room_rgb_sheet.png, %s/room.png (%.1f s)\n", out.c_str(),
+                     out.c_str(), out.c_str(), picture.seconds);
     }
     return failed == 0 ? 0 : 1;
 }

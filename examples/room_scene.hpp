@@ -1,7 +1,7 @@
-// examples/room_scene.hpp: the surface-and-smoke scene of the main job (nsp_room) and its tests:
-// the default cloud (default_scene.hpp) resting over a diffuse floor in an open room (a floor, a
-// back wall and a left wall), lit by a small rectangular light above and to the right of it and a
-// dim sky, as an nsp::SurfaceScene over the example shapes (host/shapes.hpp).
+// examples/room_scene.hpp: the surface-and-smoke scene of the main job (nsp_room): the default
+// cloud (default_scene.hpp), grey or chromatic, resting over a diffuse floor in an open room (a
+// floor, a back wall and a left wall), lit by a small rectangular light above and to the right of
+// it and a dim sky, as an nsp::SurfaceScene over the example shapes (host/shapes.hpp).
 #pragma once
 
 #include <cmath>
@@ -13,40 +13,51 @@
 
 namespace nsp_examples {
 
-using RoomMedium = nsp::DenseGridMedium<nsp::Mono>;
-using RoomMaterials = nsp::Materials<nsp::Mono, nsp::LambertianBsdf<nsp::Mono>>;
-using RoomLights = nsp::LightSampler<nsp::Mono, nsp::QuadLight<nsp::Mono>, nsp::EnvironmentLight<nsp::Mono>>;
-using RoomScene = nsp::SurfaceScene<nsp_host::Shapes, RoomMedium, nsp::GlobalMajorant<RoomMedium>,
-                                    nsp::HenyeyGreensteinPhase, RoomMaterials, RoomLights>;
+template <nsp::SpectralMode S>
+using RoomMaterials = nsp::Materials<S, nsp::LambertianBsdf<S>>;
+template <nsp::SpectralMode S>
+using RoomLights = nsp::LightSampler<S, nsp::QuadLight<S>, nsp::EnvironmentLight<S>>;
+/// The room with medium M under majorant Maj (the default: the grey cloud, Mono, one global majorant).
+template <nsp::Medium M = nsp::DenseGridMedium<nsp::Mono>, class Maj = nsp::GlobalMajorant<M>>
+using RoomScene = nsp::SurfaceScene<nsp_host::Shapes, M, Maj, nsp::HenyeyGreensteinPhase,
+                                    RoomMaterials<typename M::Spectral>, RoomLights<typename M::Spectral>>;
 
-/// The lamp: 0.7 x 0.7 at height 2.2 above (1.1, 0.3), facing down, radiance 40.
-inline nsp::QuadLight<nsp::Mono> room_lamp() {
+/// The lamp: 0.7 x 0.7 at height 2.2 above (1.1, 0.3), facing down, radiance 40 (white).
+template <nsp::SpectralMode S = nsp::Mono>
+nsp::QuadLight<S> room_lamp() {
     return {nsp::Vec3(0.75f, 2.2f, -0.05f), nsp::Vec3(0.7f, 0.f, 0.f), nsp::Vec3(0.f, 0.f, 0.7f),
-            nsp::Mono::Spectrum::Constant(40.f)};
+            nsp::constant_coefficient<S>(40.f)};
 }
-inline constexpr float kRoomSky = 0.08f;  ///< the environment's radiance
+inline constexpr float kRoomSky = 0.08f;  ///< the environment's radiance (white)
 inline constexpr float kRoomFloorY = -1.05f;
 
-/// The room: the cloud in [-1, 1]^3 behind null interfaces (medium 0), the floor (material 0,
-/// albedo 0.7), the back and left walls (material 1, albedo 0.5), the lamp (light 0) and the sky
-/// (light 1), light selection by power.
-inline RoomScene make_room_scene() {
-    using S = nsp::Mono;
+/// The room around `medium` (in [-1, 1]^3, behind null interfaces: medium 0) with `majorant`:
+/// the floor (material 0, albedo 0.7), the back and left walls (material 1, albedo 0.5), the lamp
+/// (light 0) and the sky (light 1), light selection by power. Grey surfaces and lights.
+template <nsp::Medium M, class Maj>
+RoomScene<M, Maj> make_room_scene(M medium, Maj majorant) {
+    using S = typename M::Spectral;
     nsp_host::Shapes shapes;
     shapes.boxes.push_back({nsp::Vec3(-1.f), nsp::Vec3(1.f), {-1, -1, 0, -1}});
     const float y0 = kRoomFloorY, y1 = 2.95f;
     shapes.quads.push_back({nsp::Vec3(-3.f, y0, 3.f), nsp::Vec3(6.f, 0.f, 0.f), nsp::Vec3(0.f, 0.f, -6.f), {0, -1, -1, -1}});
     shapes.quads.push_back({nsp::Vec3(-3.f, y0, 3.f), nsp::Vec3(0.f, y1 - y0, 0.f), nsp::Vec3(6.f, 0.f, 0.f), {1, -1, -1, -1}});
     shapes.quads.push_back({nsp::Vec3(-3.f, y0, -3.f), nsp::Vec3(0.f, 0.f, 6.f), nsp::Vec3(0.f, y1 - y0, 0.f), {1, -1, -1, -1}});
-    const nsp::QuadLight<S> lamp = room_lamp();
+    const nsp::QuadLight<S> lamp = room_lamp<S>();
     shapes.quads.push_back({lamp.corner, lamp.edge_u, lamp.edge_v, {-1, 0, -1, -1}});
-    RoomMedium cloud = make_default_medium<S>();
-    nsp::GlobalMajorant<RoomMedium> majorant(cloud);
-    return RoomScene(std::move(shapes), {{std::move(cloud), majorant, nsp::HenyeyGreensteinPhase(kPhaseG)}},
-                     RoomMaterials({nsp::LambertianBsdf<S>(S::Spectrum::Constant(0.7f)),
-                                    nsp::LambertianBsdf<S>(S::Spectrum::Constant(0.5f))}),
-                     RoomLights(nsp::LightSelection::Power, 4.f, {lamp}, {nsp::EnvironmentLight<S>{S::Spectrum::Constant(kRoomSky)}}),
-                     -1);
+    return RoomScene<M, Maj>(std::move(shapes), {{std::move(medium), std::move(majorant), nsp::HenyeyGreensteinPhase(kPhaseG)}},
+                             RoomMaterials<S>({nsp::LambertianBsdf<S>(nsp::constant_coefficient<S>(0.7f)),
+                                               nsp::LambertianBsdf<S>(nsp::constant_coefficient<S>(0.5f))}),
+                             RoomLights<S>(nsp::LightSelection::Power, 4.f, {lamp},
+                                           {nsp::EnvironmentLight<S>{nsp::constant_coefficient<S>(kRoomSky)}}),
+                             -1);
+}
+
+/// The grey room of the main job's first table: the default cloud, Mono, one global majorant.
+inline RoomScene<> make_room_scene() {
+    auto cloud = make_default_medium<nsp::Mono>();
+    nsp::GlobalMajorant<nsp::DenseGridMedium<nsp::Mono>> majorant(cloud);
+    return make_room_scene(std::move(cloud), majorant);
 }
 
 /// The room's camera: from (0, 0.6, -5.6) toward (0, -0.15, 0), 42 degrees vertical field of

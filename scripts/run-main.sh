@@ -14,7 +14,8 @@
 #     plume.png; --picture-res, 256 by default). docs/renderer.md explains every flag;
 #  1b. nsp_room: the cloud over a diffuse floor in an open room under a quad light and a dim sky
 #     (the scene with surfaces), every strategy PathEstimator renders surfaces with, its table
-#     and out/room_sheet.png, out/room.png;
+#     (and the chromatic cloud in the room with the spectral estimators), its tables and
+#     out/room_sheet.png, out/room_rgb_sheet.png, out/room.png;
 # With --with-references it then also runs (about 90 s more, which would take the default run past
 # five minutes on 2 cores with the renderer's build; README's heavy-tail tables come from it):
 #  2. the heavy-tail comparison: the grey-majorant baseline against spectral MIS + NEE (per-channel
@@ -53,7 +54,7 @@ fi
 
 start=$SECONDS
 build/examples/nsp_render --out out
-# The scene with surfaces: the cloud over a floor in an open room (about 40 s).
+# The scene with surfaces: the cloud over a floor in an open room, grey and chromatic (about 40 s).
 build/examples/nsp_room --out out
 if [ "$references" = 0 ]; then
     echo
