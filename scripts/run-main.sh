@@ -13,8 +13,8 @@
 #     and a larger PNG picture of each scene (cloud.png, chromatic.png, sparse.png, fog.png,
 #     plume.png; --picture-res, 256 by default). docs/renderer.md explains every flag;
 #  1b. nsp_room: the cloud over a diffuse floor in an open room under a quad light and a dim sky
-#     (the scene with surfaces), every strategy PathEstimator renders surfaces with, its table
-#     (and the chromatic cloud in the room with the spectral estimators), its tables and
+#     (the scene with surfaces) with every strategy PathEstimator renders surfaces with, then the
+#     chromatic cloud in the room with the spectral estimators; its two tables and
 #     out/room_sheet.png, out/room_rgb_sheet.png, out/room.png;
 # With --with-references it then also runs (about 90 s more, which would take the default run past
 # five minutes on 2 cores with the renderer's build; README's heavy-tail tables come from it):
