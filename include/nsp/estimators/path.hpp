@@ -171,7 +171,7 @@ public:
     }
 
 private:
-    /// One path through a Scene: media in empty space, the three fixed lights.
+    /// One path through a Scene: one medium in empty space under Lights<S>.
     template <class Sc, UniformRng R, LookupCounter C>
     RadianceSample<typename Sc::Spectral> media_radiance(const Sc& scene, const Ray& camera_ray,
                                                          const typename Sc::Spectral::Wavelengths& lambda,
