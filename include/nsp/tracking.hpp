@@ -183,6 +183,14 @@ void clamp_to_majorant(Coefficients<S>& k, const V& mu) noexcept {
     const Spec f = (t > m).select(m / t, Spec::Ones());
     k.sigma_a *= f;
     k.sigma_s *= f;
+    // Rounding can leave a + s above m; under a majorant of a few subnormal ulps by a whole ulp, so
+    // that a tracking weight came out 4/3 (found by the fuzzer, tests/fuzz). The excess comes off
+    // sigma_s (m - a is exact there: subnormal subtraction does not round).
+    const Spec over = (k.sigma_a + k.sigma_s) - m;
+    if ((over > 0.f).any()) [[unlikely]] {
+        k.sigma_a = k.sigma_a.min(m);
+        k.sigma_s = (over > 0.f).select((m - k.sigma_a).max(0.f), k.sigma_s);
+    }
 }
 
 /// bound::Reject: true when mu_t exceeds mu_bar by more than rounding in some channel.

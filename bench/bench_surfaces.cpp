@@ -1,0 +1,96 @@
+// bench/bench_surfaces.cpp: the path estimators over an nsp::SurfaceScene (THEORY 5.8).
+// - BM_Room/<strategy>: one radiance sample of the room (examples/room_scene.hpp: the cloud behind
+//   null interfaces over a floor with walls, a quad light and a sky), Mono, per grey strategy, on
+//   camera rays through the image (cycled).
+// - BM_CloudUnderSky/<scene>/<strategy>: what the general loop costs where there are no surfaces:
+//   the default cloud under a white sky as an nsp::Scene and as a SurfaceScene over
+//   nsp::NoSurfaces (the camera in the cloud's medium, a LightSampler of the one environment
+//   light): the same estimator, so the ratio of the two times is the price of the surface walk
+//   (its geometry queries and handle checks, the light sampler) for a host that uses it anyway.
+#include <string>
+
+#include <benchmark/benchmark.h>
+
+#include "fixtures.hpp"
+#include "room_scene.hpp"
+
+namespace {
+
+using namespace nsp_bench;
+
+/// Camera rays through the room's image, a fixed set.
+const std::vector<nsp::Ray>& room_rays() {
+    static const std::vector<nsp::Ray> rays = [] {
+        nsp::Pcg32 rng(8, 88);
+        std::vector<nsp::Ray> r;
+        r.reserve(kSetSize);
+        for (std::size_t i = 0; i < kSetSize; ++i) r.push_back(nsp_examples::room_camera_ray(rng.uniform(), rng.uniform(), 1.f));
+        return r;
+    }();
+    return rays;
+}
+
+template <class E, class Sc>
+void run(benchmark::State& state, const Sc& scene, const std::vector<nsp::Ray>& rays) {
+    const E estimator;
+    nsp::Pcg32 rng(6, 66);
+    nsp::LookupCount counter;
+    std::size_t i = 0;
+    for (auto _ : state) {
+        auto r = estimator.radiance(scene, rays[i], {}, rng, counter);
+        benchmark::DoNotOptimize(r);
+        i = (i + 1) & kSetMask;
+    }
+    report_lookups(state, counter, "lookups/sample");
+}
+
+template <class E>
+void BM_Room(benchmark::State& state) {
+    static const auto scene = nsp_examples::make_room_scene();
+    run<E>(state, scene, room_rays());
+}
+
+using Cloud = nsp::DenseGridMedium<nsp::Mono>;
+using Sky = nsp::LightSampler<nsp::Mono, nsp::EnvironmentLight<nsp::Mono>>;
+using CloudOnly = nsp::SurfaceScene<nsp::NoSurfaces, Cloud, nsp::GlobalMajorant<Cloud>, nsp::HenyeyGreensteinPhase,
+                                    nsp::Materials<nsp::Mono, nsp::LambertianBsdf<nsp::Mono>>, Sky>;
+
+template <class E>
+void BM_CloudUnderSky_Scene(benchmark::State& state) {
+    static const auto scene = [] {
+        nsp::Lights<nsp::Mono> sky;
+        sky.set(nsp::EnvironmentLight<nsp::Mono>{nsp::constant_coefficient<nsp::Mono>(1.f)});
+        return nsp::make_scene(nsp_examples::make_default_medium<nsp::Mono>(),
+                               nsp::HenyeyGreensteinPhase(nsp_examples::kPhaseG), sky);
+    }();
+    run<E>(state, scene, camera_rays());
+}
+
+template <class E>
+void BM_CloudUnderSky_NoSurfaces(benchmark::State& state) {
+    static const CloudOnly scene = [] {
+        Cloud cloud = nsp_examples::make_default_medium<nsp::Mono>();
+        nsp::GlobalMajorant<Cloud> majorant(cloud);
+        return CloudOnly({}, {{std::move(cloud), majorant, nsp::HenyeyGreensteinPhase(nsp_examples::kPhaseG)}},
+                         nsp::Materials<nsp::Mono, nsp::LambertianBsdf<nsp::Mono>>({}),
+                         Sky(nsp::LightSelection::Uniform, 2.f, {nsp::EnvironmentLight<nsp::Mono>{nsp::constant_coefficient<nsp::Mono>(1.f)}}),
+                         0);
+    }();
+    run<E>(state, scene, camera_rays());
+}
+
+using Uni = nsp::PathEstimator<nsp::strategy::Unidirectional>;
+using Nee = nsp::PathEstimator<nsp::strategy::NextEvent>;
+using Dmis = nsp::PathEstimator<nsp::strategy::DirectionalMis, nsp::mis::Balance>;
+using Nsmis = nsp::PathEstimator<nsp::strategy::NullScatteringMis, nsp::mis::Balance>;
+
+BENCHMARK_TEMPLATE(BM_Room, Uni)->Name("BM_Room/unidirectional");
+BENCHMARK_TEMPLATE(BM_Room, Nee)->Name("BM_Room/ratio-nee");
+BENCHMARK_TEMPLATE(BM_Room, Dmis)->Name("BM_Room/directional-mis:balance");
+BENCHMARK_TEMPLATE(BM_Room, Nsmis)->Name("BM_Room/uni-nee-mis:balance");
+BENCHMARK_TEMPLATE(BM_CloudUnderSky_Scene, Uni)->Name("BM_CloudUnderSky/Scene/unidirectional");
+BENCHMARK_TEMPLATE(BM_CloudUnderSky_NoSurfaces, Uni)->Name("BM_CloudUnderSky/NoSurfaces/unidirectional");
+BENCHMARK_TEMPLATE(BM_CloudUnderSky_Scene, Nsmis)->Name("BM_CloudUnderSky/Scene/uni-nee-mis:balance");
+BENCHMARK_TEMPLATE(BM_CloudUnderSky_NoSurfaces, Nsmis)->Name("BM_CloudUnderSky/NoSurfaces/uni-nee-mis:balance");
+
+}  // namespace
