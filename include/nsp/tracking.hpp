@@ -314,7 +314,10 @@ struct DeltaTrack {
     float t = 0.f;                     ///< distance of the real collision, or tmax
     typename S::Spectrum weight;       ///< product of per-vertex f/p factors (1 on grey media with a bounding majorant)
     float null_pdf_product = 1.f;      ///< prod_j P_n(n_j): the ratio p_track / p_ratio of the nulls (THEORY 5.1)
-    float event_density = 0.f;         ///< mu_bar(t) P_event(t) at a real collision: its pdf over Tbar (THEORY 5.4)
+    /// mu_bar(t) P_event(t) at a real collision: its pdf over Tbar (THEORY 5.4). It is 0 where the
+    /// product lies below float's range (an event of subnormal probability under a majorant below
+    /// 1/2, fuzzer finding 15); `equiangular_over_tracking` then gives inf, as it should.
+    float event_density = 0.f;
 };
 
 /// Visits nothing (the default of `DeltaCollision`).
@@ -349,12 +352,12 @@ struct DeltaCollision {
         float p_event;
         if (u < p.absorb) {
             out.end = SegmentEnd::Absorbed;
-            weight *= (c.sigma_a / (mu_bar * p.absorb)).template cast<double>();
+            weight *= real_weight(c.sigma_a, mu_bar, p.absorb);
             p_event = p.absorb;
         } else if (u < p.absorb + p.scatter || !(p.null > 0.f)) {
             // The second test keeps rounding from picking a null of probability 0.
             out.end = SegmentEnd::Scattered;
-            weight *= (c.sigma_s / (mu_bar * p.scatter)).template cast<double>();
+            weight *= real_weight(c.sigma_s, mu_bar, p.scatter);
             p_event = p.scatter;
         } else {
             const double p_null = detail::null_probability<A>(c, mu_bar);
@@ -366,9 +369,19 @@ struct DeltaCollision {
         }
         NSP_DEBUG_ASSERT(p_event > 0.f, "delta tracking chose a real event of probability 0");
         out.t = t;
-        out.event_density = mu_bar * p_event;
+        out.event_density = mu_bar * p_event;  // 0 where it lies below float's range (see DeltaTrack)
         if constexpr (Rec::enabled) rec.vertex(t, std::log(double(mu_bar) * p_event) - tau);
         return false;
+    }
+
+    /// sigma / (mu_bar P) of the chosen real event. In float where mu_bar P is a normal float (the
+    /// results of every earlier version, to the bit); in double below that, where the float
+    /// product underflows and would give an infinite weight (fuzzer finding 15).
+    static detail::DoubleSpectrum<typename S::Spectrum> real_weight(const typename S::Spectrum& sigma, float mu_bar,
+                                                                    float p) noexcept {
+        const float density = mu_bar * p;
+        if (density >= std::numeric_limits<float>::min()) return (sigma / density).template cast<double>();
+        return sigma.template cast<double>() * (1.0 / (double(mu_bar) * double(p)));
     }
 
     /// `out` with the accumulated weight and null-pdf product rounded to float.
