@@ -162,35 +162,25 @@ RadianceSample<typename Sc::Spectral> spectral_surface_radiance(const EstimatorO
             x = hit.p;
         }
         if (++depth > opts.max_depth) break;
-        const bool surface = material >= 0;
+        const SceneVertex v{material, medium, hit.ns};
         // Roulette survival is fixed before NEE, from the largest channel estimate (as in media).
         float rr = 1.f;
         if (opts.russian_roulette && depth >= opts.rr_start_depth)
             rr = std::min(opts.rr_max_survival, channel_estimate<CP>(st.f, st.uni, q, c).abs().maxCoeff());
         if constexpr (St::samples_lights) {
             const float u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
-            if (!(surface && sc.materials.is_delta(material))) {
+            if (!(v.on_surface() && sc.materials.is_delta(material))) {
                 const SampledLight<typename Sc::Spectral> ls = sc.lights.sample(x, u0, u1, u2, lambda);
                 if (ls.sample.pdf > 0.f) {
-                    const Vec3 wi = ls.sample.wi;
-                    Spectrum fs = Spectrum::Zero();
-                    float p = 0.f;
-                    if (surface) {
-                        sc.materials.visit(material, [&](const auto& b) {
-                            fs = b.eval(ray.d, wi, hit.ns, lambda);
-                            p = b.pdf(ray.d, wi, hit.ns);
-                        });
-                    } else {
-                        const auto& phase = sc.media[std::size_t(medium)].phase;
-                        fs = Spectrum::Constant(phase.eval(ray.d, wi));
-                        p = phase.pdf(ray.d, wi);
-                    }
+                    const auto fv = eval_vertex(sc, v, ray.d, ls.sample.wi, lambda);
+                    const Spectrum& fs = fv.value;
+                    const float p = fv.pdf;
                     if ((fs != 0.f).any()) {
                         const bool uni_alternative = St::combines && !ls.sample.delta;
-                        const float d = std::isfinite(ls.sample.distance) ? ls.sample.distance * (1.f - 1e-4f) : kInf;
-                        const auto sh = channel_shadow_through<CP, A>(sc, Ray{x, wi}, d,
-                                                                      surface ? hit.medium_entered(wi) : medium, lambda,
-                                                                      c, st.f, uni_alternative, rng, counter);
+                        const auto sh = channel_shadow_through<CP, A>(
+                            sc, Ray{x, fv.wi}, shadow_distance(ls.sample.distance),
+                            v.on_surface() ? hit.medium_entered(fv.wi) : medium, lambda, c, st.f, uni_alternative, rng,
+                            counter);
                         if (sh.end != SegmentEnd::Passed) {
                             status = shadow_status(sh.end);
                             if (status == Status::NonFinite) return {Spectrum::Zero(), status};
@@ -206,40 +196,23 @@ RadianceSample<typename Sc::Spectral> spectral_surface_radiance(const EstimatorO
         }
         if (rr < 1.f && !(rng.uniform() < rr)) break;
         const float v1 = rng.uniform(), v2 = rng.uniform();
-        Spectrum value;
-        float pdf = 0.f;
-        bool delta = false;
-        Vec3 wi;
-        if (surface) {
-            BsdfSample<typename Sc::Spectral> bs;
-            sc.materials.visit(material, [&](const auto& b) { bs = b.sample(ray.d, hit.ns, v1, v2, lambda); });
-            if (!(bs.pdf > 0.f)) break;
-            value = bs.value;
-            pdf = bs.pdf;
-            delta = bs.delta;
-            wi = bs.wi;
-            medium = hit.medium_entered(wi);
-        } else {
-            const PhaseSample ps = sc.media[std::size_t(medium)].phase.sample(ray.d, v1, v2);
-            if (!(ps.pdf > 0.f)) break;
-            value = Spectrum::Constant(ps.value);
-            pdf = ps.pdf;
-            wi = ps.wi;
-        }
+        const auto next = sample_vertex(sc, v, ray.d, v1, v2, lambda);
+        if (!(next.pdf > 0.f)) break;
+        if (v.on_surface()) medium = hit.medium_entered(next.wi);
         // The NEE alternative of the next segment starts from the prefix, without roulette; a
         // delta lobe has none.
-        camera_or_delta = delta;
-        nee_alternative = St::combines && !delta;
+        camera_or_delta = next.delta;
+        nee_alternative = St::combines && !next.delta;
         if (nee_alternative) st.nee = st.uni;
-        st.f *= value;
-        st.uni *= rr * pdf;
+        st.f *= next.value;
+        st.uni *= rr * next.pdf;
         if (const StateScale r = st.template renormalize<CP>(c); r != StateScale::Ok) {
             if (r == StateScale::Overflowed) status = Status::NonFinite;
             break;
         }
         prev = x;
         crossings = 0;
-        ray = Ray{x, wi};
+        ray = Ray{x, next.wi};
     }
     if (status == Status::NonFinite || !all_finite(L)) return {Spectrum::Zero(), Status::NonFinite};
     return {L, status};

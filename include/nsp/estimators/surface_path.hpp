@@ -48,6 +48,68 @@ bool crosses(const Sc& sc, const SurfaceHit& h) noexcept {
     return h.light < 0 && (h.material < 0 || sc.materials.passes_through(h.material));
 }
 
+/// A real vertex of a path through a SurfaceScene: on a surface (material >= 0, the hit's shading
+/// normal ns) or in medium `medium` (material -1). What both path loops ask of it: the value and
+/// pdf of a direction (NEE), and a sampled direction (the path's continuation).
+struct SceneVertex {
+    int material = -1;
+    int medium = -1;
+    Vec3 ns{0.f, 0.f, 1.f};
+    bool on_surface() const noexcept { return material >= 0; }
+};
+
+/// A direction's throughput factor at a vertex (BSDF f_s |n . wi| or phase f_p) and its pdf.
+template <SpectralMode S>
+struct VertexDirection {
+    Vec3 wi{0.f, 0.f, 1.f};
+    typename S::Spectrum value = S::Spectrum::Zero();
+    float pdf = 0.f;
+    bool delta = false;
+};
+
+/// The value and pdf of direction wi at vertex v for a path that arrived along wo.
+template <class Sc>
+VertexDirection<typename Sc::Spectral> eval_vertex(const Sc& sc, const SceneVertex& v, const Vec3& wo, const Vec3& wi,
+                                                   const typename Sc::Spectral::Wavelengths& lambda) noexcept {
+    VertexDirection<typename Sc::Spectral> out;
+    out.wi = wi;
+    if (v.on_surface()) {
+        sc.materials.visit(v.material, [&](const auto& b) {
+            out.value = b.eval(wo, wi, v.ns, lambda);
+            out.pdf = b.pdf(wo, wi, v.ns);
+        });
+    } else {
+        const auto& phase = sc.media[std::size_t(v.medium)].phase;
+        out.value = Sc::Spectrum::Constant(phase.eval(wo, wi));
+        out.pdf = phase.pdf(wo, wi);
+    }
+    return out;
+}
+
+/// The next direction at vertex v from (u1, u2): the BSDF's or the phase function's sample; pdf
+/// 0 when there is none.
+template <class Sc>
+VertexDirection<typename Sc::Spectral> sample_vertex(const Sc& sc, const SceneVertex& v, const Vec3& wo, float u1,
+                                                     float u2, const typename Sc::Spectral::Wavelengths& lambda) noexcept {
+    VertexDirection<typename Sc::Spectral> out;
+    if (v.on_surface()) {
+        sc.materials.visit(v.material, [&](const auto& b) {
+            const BsdfSample<typename Sc::Spectral> bs = b.sample(wo, v.ns, u1, u2, lambda);
+            out = {bs.wi, bs.value, bs.pdf, bs.delta};
+        });
+    } else {
+        const PhaseSample ps = sc.media[std::size_t(v.medium)].phase.sample(wo, u1, u2);
+        out = {ps.wi, Sc::Spectrum::Constant(ps.value), ps.pdf, false};
+    }
+    return out;
+}
+
+/// How far a shadow ray toward a light sample at `light_distance` runs: short of the light's own
+/// surface, which it must not count as a blocker (kInf for lights at infinity).
+inline float shadow_distance(float light_distance) noexcept {
+    return std::isfinite(light_distance) ? light_distance * (1.f - 1e-4f) : kInf;
+}
+
 /// The transmittance of a shadow ray from r.o, which lies in medium `medium`, over `distance`
 /// through the scene: one VertexKernels::shadow per medium between the null interfaces it
 /// crosses, transmittances and null-pdf products multiplied; 0 where a surface that is not a
@@ -156,36 +218,23 @@ RadianceSample<typename Sc::Spectral> surface_radiance(const K& k, const Sc& sc,
         if (++depth > k.options().max_depth) break;
         // Roulette survival is fixed before NEE: the continuing unidirectional path carries it.
         const float q = k.survival(depth, beta);
-        const bool surface = material >= 0;
+        const SceneVertex v{material, medium, hit.ns};
         if constexpr (St::samples_lights) {
             const float u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
-            if (!(surface && sc.materials.is_delta(material))) {
+            if (!(v.on_surface() && sc.materials.is_delta(material))) {
                 const SampledLight<typename Sc::Spectral> ls = sc.lights.sample(x, u0, u1, u2, lambda);
                 if (ls.sample.pdf > 0.f) {
-                    const Vec3 wi = ls.sample.wi;
-                    Spectrum f = Spectrum::Zero();
-                    float p = 0.f;
-                    if (surface) {
-                        sc.materials.visit(material, [&](const auto& b) {
-                            f = b.eval(ray.d, wi, hit.ns, lambda);
-                            p = b.pdf(ray.d, wi, hit.ns);
-                        });
-                    } else {
-                        const auto& phase = sc.media[std::size_t(medium)].phase;
-                        f = Spectrum::Constant(phase.eval(ray.d, wi));
-                        p = phase.pdf(ray.d, wi);
-                    }
-                    if ((f != 0.f).any()) {
-                        // Short of the light's own surface, which the shadow ray must not count as a blocker.
-                        const float d = std::isfinite(ls.sample.distance) ? ls.sample.distance * (1.f - 1e-4f) : kInf;
-                        const auto sh = shadow_through(k, sc, Ray{x, wi}, d, surface ? hit.medium_entered(wi) : medium,
-                                                       lambda, rng, counter);
+                    const auto f = eval_vertex(sc, v, ray.d, ls.sample.wi, lambda);
+                    if ((f.value != 0.f).any()) {
+                        const auto sh = shadow_through(k, sc, Ray{x, f.wi}, shadow_distance(ls.sample.distance),
+                                                       v.on_surface() ? hit.medium_entered(f.wi) : medium, lambda, rng,
+                                                       counter);
                         if (sh.status != Status::Ok) {
                             status = sh.status;
                         } else if ((sh.transmittance != 0.f).any()) {
                             const float w =
-                                k.light_weight(q, p, sh.null_pdf_product, ls.sample.pdf, ls.sample.delta);
-                            L += beta * sh.transmittance * ls.sample.radiance * f * (w / ls.sample.pdf);
+                                k.light_weight(q, f.pdf, sh.null_pdf_product, ls.sample.pdf, ls.sample.delta);
+                            L += beta * sh.transmittance * ls.sample.radiance * f.value * (w / ls.sample.pdf);
                         }
                     }
                 }
@@ -196,31 +245,16 @@ RadianceSample<typename Sc::Spectral> surface_radiance(const K& k, const Sc& sc,
             beta /= q;
         }
         const float v1 = rng.uniform(), v2 = rng.uniform();
-        Vec3 wi;
-        float pdf = 0.f;
-        bool delta = false;
-        if (surface) {
-            BsdfSample<typename Sc::Spectral> bs;
-            sc.materials.visit(material, [&](const auto& b) { bs = b.sample(ray.d, hit.ns, v1, v2, lambda); });
-            if (!(bs.pdf > 0.f)) break;
-            beta *= bs.value / bs.pdf;
-            wi = bs.wi;
-            pdf = bs.pdf;
-            delta = bs.delta;
-            medium = hit.medium_entered(wi);
-        } else {
-            const PhaseSample ps = sc.media[std::size_t(medium)].phase.sample(ray.d, v1, v2);
-            if (!(ps.pdf > 0.f)) break;
-            beta *= ps.value / ps.pdf;
-            wi = ps.wi;
-            pdf = ps.pdf;
-        }
+        const auto next = sample_vertex(sc, v, ray.d, v1, v2, lambda);
+        if (!(next.pdf > 0.f)) break;
+        beta *= next.value / next.pdf;
+        if (v.on_surface()) medium = hit.medium_entered(next.wi);
         if (!(beta != 0.f).any()) break;
-        from = VertexPdf::scattered(q, pdf, delta);
+        from = VertexPdf::scattered(q, next.pdf, next.delta);
         nulls = 1.f;
         prev = x;
         crossings = 0;
-        ray = Ray{x, wi};
+        ray = Ray{x, next.wi};
     }
     if (!all_finite(L)) return {Spectrum::Zero(), Status::NonFinite};
     return {L, status};
