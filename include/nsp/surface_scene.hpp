@@ -16,6 +16,8 @@
 // starts on (an epsilon, or its primitive id), as every renderer's does.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <tuple>
 #include <type_traits>
@@ -28,6 +30,7 @@
 #include "light_sampler.hpp"
 #include "majorant.hpp"
 #include "medium.hpp"
+#include "media/emissive.hpp"
 #include "phase.hpp"
 
 namespace nsp {
@@ -133,9 +136,54 @@ struct SurfaceScene {
                 detail::require_majorant_value<bound_policy_t<Maj>>(s.majorant.value(), s.medium.max_extinction(),
                                                                     "SurfaceScene: a medium's majorant value",
                                                                     " of that medium");
+        build_emission_selection();
     }
 
     bool has_medium(int i) const noexcept { return i >= 0 && i < int(media.size()); }
+
+    /// Emissive media: the probability with which NEE toward volume emission picks medium i
+    /// (THEORY 5.7), in proportion to its emitted power (total_power_estimate(), where the medium
+    /// has one; else the same for every medium), floored at 1e-3 of the largest so that a medium
+    /// whose estimate missed its emission is still sampled. 0 for an index outside the table.
+    /// Fixed at construction: a scene whose `media` change afterwards must be built again.
+    float emission_selection_pdf(int i) const noexcept {
+        return has_medium(i) && i < int(emission_pdf_.size()) ? emission_pdf_[std::size_t(i)] : 0.f;
+    }
+
+    /// The medium NEE toward volume emission samples for a uniform u in [0, 1) (-1: none emits).
+    int select_emission(float u) const noexcept {
+        float run = 0.f;
+        int last = -1;
+        for (std::size_t i = 0; i < emission_pdf_.size(); ++i) {
+            if (!(emission_pdf_[i] > 0.f)) continue;
+            run += emission_pdf_[i];
+            last = int(i);
+            if (u < run) return last;
+        }
+        return last;  // u rounded past the sum
+    }
+
+private:
+    void build_emission_selection() {
+        if constexpr (EmissiveMedium<M>) {
+            std::vector<double> w(media.size(), 1.0);
+            if constexpr (requires(const M& m) { { m.total_power_estimate() } -> std::convertible_to<double>; })
+                for (std::size_t i = 0; i < media.size(); ++i) {
+                    const double p = double(media[i].medium.total_power_estimate());
+                    w[i] = std::isfinite(p) && p > 0.0 ? p : 0.0;
+                }
+            const double largest = w.empty() ? 0.0 : *std::max_element(w.begin(), w.end());
+            double sum = 0.0;
+            for (double& x : w) {
+                x = largest > 0.0 ? std::max(x, 1e-3 * largest) : 1.0;
+                sum += x;
+            }
+            emission_pdf_.resize(media.size());
+            for (std::size_t i = 0; i < media.size(); ++i) emission_pdf_[i] = float(w[i] / sum);
+        }
+    }
+
+    std::vector<float> emission_pdf_;  ///< emissive media: emission_selection_pdf by medium
 };
 
 template <class Sc>

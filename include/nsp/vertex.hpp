@@ -35,6 +35,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <limits>
+#include <utility>
 
 #include "estimators/common.hpp"
 #include "mis.hpp"
@@ -71,6 +74,60 @@ template <PathStrategy St, mis::CombiningHeuristic H>
 float next_event_weight(const H& h, float survival, float direction_pdf, float null_pdf_product,
                         float light_pdf) noexcept {
     return mis::weight_among(h, light_pdf, unidirectional_pdf<St>(survival, direction_pdf, null_pdf_product));
+}
+
+/// The three techniques that can produce volume emission at a point y of a segment (THEORY 5.7).
+enum class EmissionTechnique : std::uint8_t {
+    Collision,  ///< y a tentative collision of the delta-tracked segment (the collision estimator)
+    Segment,    ///< y drawn on the segment in proportion to the power grid along it, nulls ratio-tracked
+    Nee,        ///< y drawn in the volume by the power grid from the segment's real vertex x, nulls ratio-tracked
+};
+
+/// The pdfs of the three emission techniques for one path whose last segment, from a real vertex
+/// x (or the camera), reaches y at distance d, on a common scale, the largest 1. In volume measure
+/// times d^2, the nulls' shared mu_bar Tbar factors left out (they cancel):
+/// - collision: q p_w [prod_j P_n(n_j)] mu_bar(y), the product for null-scattering strategies only
+///   (directional MIS leaves it out, as it does for lights);
+/// - segment:   q p_w p_seg(y), p_seg the segment technique's density along the ray (0 where it
+///   does not run);
+/// - nee:       d^2 p_V(y) (volume_pdf 0 where NEE has no vertex to start from: the camera).
+/// With roulette survival q and phase pdf p_w at x (1 and 1 for the camera ray). In double, so
+/// neither the products nor d^2 p_V underflow into 0 / 0 (found by the fuzzer, tests/fuzz). All
+/// zero when every pdf is; an infinite pdf stays inf and the others become 0 (emission_weight gives
+/// it the whole weight); NaN in, NaN out (and inf x 0, e.g. an infinite p_seg with q = 0).
+struct EmissionPdfs {
+    float collision = 0.f, segment = 0.f, nee = 0.f;
+};
+
+template <PathStrategy St>
+EmissionPdfs emission_pdfs(float survival, float phase_pdf, float null_pdf_product, float mu_bar, float segment_pdf,
+                           float dist2, float volume_pdf) noexcept {
+    const double direction = double(survival) * double(phase_pdf);
+    double collision = direction * double(mu_bar);
+    if constexpr (St::null_pdfs) collision *= double(null_pdf_product);
+    const double segment = direction * double(segment_pdf), nee = double(dist2) * double(volume_pdf);
+    const double largest = std::max({collision, segment, nee});
+    if (std::isnan(collision + segment + nee)) {
+        constexpr float nan = std::numeric_limits<float>::quiet_NaN();
+        return {nan, nan, nan};
+    }
+    if (!(largest > 0.0)) return {};
+    if (std::isinf(largest)) {  // an infinite pdf (a float input of inf) takes the weight: keep it inf, the rest 0
+        auto keep = [](double x) { return std::isinf(x) ? kInf : 0.f; };
+        return {keep(collision), keep(segment), keep(nee)};
+    }
+    return {float(collision / largest), float(segment / largest), float(nee / largest)};
+}
+
+/// The MIS weight of emission technique `which` for a path with pdfs `p`; the three weights of
+/// one path sum to 1 (0 for a technique whose pdf is 0).
+template <mis::CombiningHeuristic H>
+float emission_weight(const H& h, EmissionTechnique which, const EmissionPdfs& p) noexcept {
+    switch (which) {
+        case EmissionTechnique::Collision: return mis::weight_among(h, p.collision, p.segment, p.nee);
+        case EmissionTechnique::Segment: return mis::weight_among(h, p.segment, p.collision, p.nee);
+        default: return mis::weight_among(h, p.nee, p.collision, p.segment);
+    }
 }
 
 /// The last real vertex of a path, as the MIS weight of whatever its next segments reach needs it.
@@ -129,6 +186,18 @@ public:
                                            const typename M::Spectral::Wavelengths& lambda, R& rng, C& counter) const {
         if (!valid_ray(ray, t_max)) return {SegmentEnd::InvalidInput, 0.f, M::Spectral::Spectrum::Zero(), 1.f};
         return track_delta<A>(medium, majorant, ray, t_max, lambda, rng, counter);
+    }
+
+    /// track(), calling `visit(t, coefficients, mu_bar, weight, null_pdf_product)` at every
+    /// tentative collision before its event is chosen, with the weight and null-pdf product of
+    /// the nulls before it (see DeltaCollision): the collision estimator of volume emission
+    /// (THEORY 5.7) is such a visitor. `Visit` has `static constexpr bool enabled = true`.
+    template <Medium M, MajorantPolicy<M> Maj, UniformRng R, LookupCounter C, class Visit>
+    DeltaTrack<typename M::Spectral> track_visiting(const M& medium, const Maj& majorant, const Ray& ray, float t_max,
+                                                    const typename M::Spectral::Wavelengths& lambda, R& rng,
+                                                    C& counter, Visit visit) const {
+        if (!valid_ray(ray, t_max)) return {SegmentEnd::InvalidInput, 0.f, M::Spectral::Spectrum::Zero(), 1.f};
+        return track_delta_visiting<A>(medium, majorant, ray, t_max, lambda, rng, counter, std::move(visit));
     }
 
     /// The transmittance of a shadow ray through `medium` up to `distance` (ratio tracking), and

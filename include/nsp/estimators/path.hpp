@@ -80,60 +80,6 @@ float equiangular_mis_weight(const H& h, VertexTechnique which, float track_nee,
     }
 }
 
-/// The three techniques that can produce volume emission at a point y of a segment (THEORY 5.7).
-enum class EmissionTechnique : std::uint8_t {
-    Collision,  ///< y a tentative collision of the delta-tracked segment (the collision estimator)
-    Segment,    ///< y drawn on the segment in proportion to the power grid along it, nulls ratio-tracked
-    Nee,        ///< y drawn in the volume by the power grid from the segment's real vertex x, nulls ratio-tracked
-};
-
-/// The pdfs of the three emission techniques for one path whose last segment, from a real vertex
-/// x (or the camera), reaches y at distance d, on a common scale, the largest 1. In volume measure
-/// times d^2, the nulls' shared mu_bar Tbar factors left out (they cancel):
-/// - collision: q p_w [prod_j P_n(n_j)] mu_bar(y), the product for null-scattering strategies only
-///   (directional MIS leaves it out, as it does for lights);
-/// - segment:   q p_w p_seg(y), p_seg the segment technique's density along the ray (0 where it
-///   does not run);
-/// - nee:       d^2 p_V(y) (volume_pdf 0 where NEE has no vertex to start from: the camera).
-/// With roulette survival q and phase pdf p_w at x (1 and 1 for the camera ray). In double, so
-/// neither the products nor d^2 p_V underflow into 0 / 0 (found by the fuzzer, tests/fuzz). All
-/// zero when every pdf is; an infinite pdf stays inf and the others become 0 (emission_weight gives
-/// it the whole weight); NaN in, NaN out (and inf x 0, e.g. an infinite p_seg with q = 0).
-struct EmissionPdfs {
-    float collision = 0.f, segment = 0.f, nee = 0.f;
-};
-
-template <PathStrategy St>
-EmissionPdfs emission_pdfs(float survival, float phase_pdf, float null_pdf_product, float mu_bar, float segment_pdf,
-                           float dist2, float volume_pdf) noexcept {
-    const double direction = double(survival) * double(phase_pdf);
-    double collision = direction * double(mu_bar);
-    if constexpr (St::null_pdfs) collision *= double(null_pdf_product);
-    const double segment = direction * double(segment_pdf), nee = double(dist2) * double(volume_pdf);
-    const double largest = std::max({collision, segment, nee});
-    if (std::isnan(collision + segment + nee)) {
-        constexpr float nan = std::numeric_limits<float>::quiet_NaN();
-        return {nan, nan, nan};
-    }
-    if (!(largest > 0.0)) return {};
-    if (std::isinf(largest)) {  // an infinite pdf (a float input of inf) takes the weight: keep it inf, the rest 0
-        auto keep = [](double x) { return std::isinf(x) ? kInf : 0.f; };
-        return {keep(collision), keep(segment), keep(nee)};
-    }
-    return {float(collision / largest), float(segment / largest), float(nee / largest)};
-}
-
-/// The MIS weight of emission technique `which` for a path with pdfs `p`; the three weights of
-/// one path sum to 1 (0 for a technique whose pdf is 0).
-template <mis::CombiningHeuristic H>
-float emission_weight(const H& h, EmissionTechnique which, const EmissionPdfs& p) noexcept {
-    switch (which) {
-        case EmissionTechnique::Collision: return mis::weight_among(h, p.collision, p.segment, p.nee);
-        case EmissionTechnique::Segment: return mis::weight_among(h, p.segment, p.collision, p.nee);
-        default: return mis::weight_among(h, p.nee, p.collision, p.segment);
-    }
-}
-
 /// A path estimator: strategy St, MIS heuristic H (mis::None exactly for single-strategy
 /// estimators) and absorption policy A for the delta-tracked segments.
 template <PathStrategy St, mis::Heuristic H = mis::None, AbsorptionPolicy A = absorption::Weight>

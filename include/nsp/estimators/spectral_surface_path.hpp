@@ -18,7 +18,7 @@
 #include "../path_pdf.hpp"
 #include "../surface_scene.hpp"
 #include "common.hpp"
-#include "surface_path.hpp"
+#include "surface_walk.hpp"
 
 namespace nsp::detail {
 
