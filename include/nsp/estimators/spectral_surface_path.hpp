@@ -18,6 +18,7 @@
 #include "../path_pdf.hpp"
 #include "../surface_scene.hpp"
 #include "common.hpp"
+#include "spectral_surface_emission.hpp"
 #include "surface_walk.hpp"
 
 namespace nsp::detail {
@@ -77,11 +78,6 @@ ChannelShadow<typename Sc::Spectral> channel_shadow_through(const Sc& sc, Ray r,
     return bad;
 }
 
-/// The status of a path one of whose shadow rays ended with `end`.
-inline Status shadow_status(SegmentEnd end) noexcept {
-    return end == SegmentEnd::InvalidInput ? Status::InvalidInput : flight_status(end);
-}
-
 /// One path of SpectralPathEstimator<CP, St, H, A> through a SurfaceScene: sampling channel c
 /// drawn with probabilities q (selection), every channel's pdfs in the one-sample balance
 /// heuristic over channels and techniques (THEORY 5.3).
@@ -92,14 +88,14 @@ RadianceSample<typename Sc::Spectral> spectral_surface_radiance(const EstimatorO
                                                                 const ChannelSelection<typename Sc::Spectral>& selection,
                                                                 R& rng, C& counter) {
     using Spectrum = typename Sc::Spectrum;
+    constexpr bool kEmissive = EmissiveMedium<typename Sc::MediumType>;
     static_assert(!St::equiangular,
                   "nsp::SpectralPathEstimator over a SurfaceScene: the equiangular strategies aim at the point or "
                   "sphere light of nsp::Scene and do not render scenes with surfaces yet");
-    static_assert(!EmissiveMedium<typename Sc::MediumType>,
-                  "nsp::SpectralPathEstimator over a SurfaceScene: emissive media render in nsp::Scene only so far");
     const Spectrum& q = selection.probabilities();
     const int c = selection.sample(rng.uniform());
-    ChannelPathState<typename Sc::Spectral> st;
+    // An emissive medium's segment technique keeps its pdf in the state's second slot (eq.vertex).
+    ChannelPathState<typename Sc::Spectral, kEmissive> st;
     Spectrum L = Spectrum::Zero();
     Status status = Status::Ok;
     Ray ray = camera_ray;
@@ -107,6 +103,7 @@ RadianceSample<typename Sc::Spectral> spectral_surface_radiance(const EstimatorO
     Vec3 prev = ray.o;               // the last real vertex
     bool camera_or_delta = true;     // no real vertex yet, or the last one drew a delta lobe: NEE cannot reach what follows
     bool nee_alternative = false;    // combining, and light sampling from that vertex could have produced what the path reaches
+    float walked = 0.f;              // the distance from that vertex to the current ray's origin (emission's MIS)
     int crossings = 0;
     for (int depth = 0;;) {
         const SurfaceHit hit = sc.geometry.intersect(ray, kInf);
@@ -118,8 +115,17 @@ RadianceSample<typename Sc::Spectral> spectral_surface_radiance(const EstimatorO
         float t_medium = 0.f;
         if (sc.has_medium(medium)) {
             const auto& m = sc.media[std::size_t(medium)];
-            const ChannelTrack seg =
-                track_channels_delta<CP, A>(m.medium, m.majorant, ray, hit.t, lambda, c, st, nee_alternative, rng, counter);
+            ChannelTrack seg;
+            if constexpr (kEmissive) {
+                st.eq.vertex = st.uni;
+                seg = track_emissive_piece_channels<CP, St, A>(opts, sc, medium, ray, hit.t,
+                                                               St::hits_lights || camera_or_delta, nee_alternative,
+                                                               walked, lambda, q, c, st, rng, counter, L, status);
+                st.eq.vertex.setZero();  // used within the piece only
+            } else {
+                seg = track_channels_delta<CP, A>(m.medium, m.majorant, ray, hit.t, lambda, c, st, nee_alternative, rng,
+                                                  counter);
+            }
             if (const Status fs = flight_status(seg.end); fs != Status::Ok) {
                 status = fs;
                 break;
@@ -155,6 +161,7 @@ RadianceSample<typename Sc::Spectral> spectral_surface_radiance(const EstimatorO
                 }
                 medium = hit.medium_entered(ray.d);
                 ray.o = hit.p;
+                walked += hit.t;
                 continue;
             }
             if (hit.material < 0 || sc.materials.passes_through(hit.material)) break;  // an emitter without a BSDF
@@ -192,6 +199,13 @@ RadianceSample<typename Sc::Spectral> spectral_surface_radiance(const EstimatorO
                         }
                     }
                 }
+                if constexpr (kEmissive) {
+                    auto side = [&](const Vec3& wi) { return v.on_surface() ? hit.medium_entered(wi) : medium; };
+                    const Status es = channel_emission_event<CP, St, A>(opts, sc, v, x, ray.d, rr, side, lambda, q, c,
+                                                                        st, rng, counter, L);
+                    if (es == Status::NonFinite) return {Spectrum::Zero(), es};  // an overflowed flight
+                    if (es != Status::Ok) status = es;
+                }
             }
         }
         if (rr < 1.f && !(rng.uniform() < rr)) break;
@@ -211,6 +225,7 @@ RadianceSample<typename Sc::Spectral> spectral_surface_radiance(const EstimatorO
             break;
         }
         prev = x;
+        walked = 0.f;
         crossings = 0;
         ray = Ray{x, next.wi};
     }

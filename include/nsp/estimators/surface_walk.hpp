@@ -137,4 +137,9 @@ ShadowTransmittance<typename Sc::Spectral> shadow_through(const K& k, const Sc& 
     return {Sp::Spectrum::Zero(), 1.f, Status::InvalidInput};
 }
 
+/// The status of a path one of whose shadow rays ended with `end`.
+inline Status shadow_status(SegmentEnd end) noexcept {
+    return end == SegmentEnd::InvalidInput ? Status::InvalidInput : flight_status(end);
+}
+
 }  // namespace nsp::detail
