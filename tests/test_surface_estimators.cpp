@@ -61,6 +61,8 @@ void for_each_strategy(F check) {
     check(PathEstimator<strategy::DirectionalMis, mis::Balance>{}, "directional-mis");
     check(PathEstimator<strategy::NullScatteringMis, mis::Balance>{}, "uni-nee-mis balance");
     check(PathEstimator<strategy::NullScatteringMis, mis::Power, absorption::Event>{}, "uni-nee-mis power event");
+    check(PathEstimator<strategy::EquiangularNextEvent>{}, "equiangular-nee");
+    check(PathEstimator<strategy::EquiangularMis, mis::Balance>{}, "equiangular-mis balance");
 }
 
 /// The six walls of [-1, 1]^3 as quad lights emitting `le` inward, and as shapes naming them
@@ -86,7 +88,8 @@ TEST_CASE("surface estimators: the furnace of six emitting walls around a medium
     // everywhere and in every direction, whatever the phase function, the density, the light
     // selection and which walls are Lambertian or mirrors of the same reflectance. The camera is
     // inside the medium; six lights go through the light sampler.
-    // NEE alone (ratio-nee) is left out here: QuadLight samples by area, and in a closed box the
+    // NEE alone (ratio-nee, and equiangular-nee, whose lights come from NEE alone) is left out
+    // here: QuadLight samples by area, and in a closed box the
     // second moment of that estimate diverges (logarithmically) for vertices near an edge or a
     // wall, so its standard error says nothing (measured: 1.88 +- 0.04 at 40000 paths, then a
     // rare huge sample). The white furnace below checks it; the combined strategies keep the
@@ -99,7 +102,7 @@ TEST_CASE("surface estimators: the furnace of six emitting walls around a medium
             const Sc sc(shapes, {medium(Box{Vec3(-1.f), Vec3(1.f)}, 0.f, 1.5f)}, materials(),
                         Ls(sel, 2.f, walls, {}), 0);
             for_each_strategy([&](const auto& est, const char* name) {
-                if (std::string(name) == "ratio-nee") return;
+                if (std::string(name) == "ratio-nee" || std::string(name) == "equiangular-nee") return;
                 CAPTURE(std::string(name));
                 CAPTURE(mirrors.size());
                 const Stat s = estimate(est, sc, 20000, 11 + mirrors.size(), [](Pcg32& rng) {
@@ -248,6 +251,88 @@ TEST_CASE("surface estimators: single scattering in a slab over a Lambertian pla
     check(PathEstimator<strategy::DirectionalMis, mis::Balance>(opts), "directional-mis");
     check(PathEstimator<strategy::NullScatteringMis, mis::Balance>(opts), "uni-nee-mis balance");
     check(PathEstimator<strategy::NullScatteringMis, mis::Power, absorption::Event>(opts), "uni-nee-mis power event");
+}
+
+/// The distance from p (inside `b`) along unit d to the box's boundary.
+double exit_distance(const Box& b, const Vec3& p, const Vec3& d) {
+    double t = std::numeric_limits<double>::infinity();
+    for (int a = 0; a < 3; ++a) {
+        if (d[a] > 0.f) t = std::min(t, (double(b.hi[a]) - p[a]) / d[a]);
+        if (d[a] < 0.f) t = std::min(t, (double(b.lo[a]) - p[a]) / d[a]);
+    }
+    return t;
+}
+
+TEST_CASE("surface estimators: single scattering from two point lights in a cube over a floor (quadrature)") {
+    // Two point lights inside a homogeneous cube [-1, 1]^3 (sigma_s 0.8, sigma_a 0.2, HG 0.3)
+    // behind null interfaces, over a Lambertian floor (albedo 0.6) at y = -1.5; max_depth 1. The
+    // camera ray enters the cube at s_in, leaves it at s_out and hits the floor at F, passing
+    // 0.15 from light 0, where an equiangular vertex pays. With T(l) = exp(-sigma_t l):
+    //   L = sum_i int_{s_in}^{s_out} sigma_s f_p(d . w_i) T(s - s_in) I_i T(r_i) / r_i^2 ds
+    //     + T(s_out - s_in) sum_i (0.6 / pi) I_i cos_i T(c_i) / |l_i - F|^2,
+    // r_i = |x - l_i|, c_i the part of F -> l_i inside the cube; the integral by composite Simpson
+    // in double with 20000 intervals. Light selection by power gives the two equiangular targets
+    // probabilities 2/3 and 1/3: equiangular vertices come from a mixture.
+    const double sigma_s = 0.8, sigma_a = 0.2, sigma_t = sigma_s + sigma_a, rho = 0.6, g = 0.3;
+    using Ps = LightSampler<S, PointLight<S>>;
+    using PSc = SurfaceScene<Shapes, M, GlobalMajorant<M>, HenyeyGreensteinPhase, Mats, Ps>;
+    const Box cube{Vec3(-1.f), Vec3(1.f)};
+    Shapes shapes;
+    shapes.boxes.push_back({cube.lo, cube.hi, {-1, -1, 0, -1}});
+    shapes.quads.push_back({Vec3(-20.f, -1.5f, 20.f), Vec3(40.f, 0.f, 0.f), Vec3(0.f, 0.f, -40.f), {0, -1, -1, -1}});
+    const std::vector<PointLight<S>> points{{Vec3(0.1f, -0.7f, -0.45f), Spectrum::Constant(2.f)},
+                                            {Vec3(-0.5f, -0.3f, 0.6f), Spectrum::Constant(1.f)}};
+    const PSc sc(shapes, {medium(cube, float(sigma_a), float(sigma_s), float(g))}, materials(float(rho)),
+                 Ps(LightSelection::Power, 4.f, points), -1);
+    REQUIRE(sc.lights.equiangular_count() == 2);
+    CHECK(sc.lights.equiangular_pmf(0) == doctest::Approx(2.0 / 3.0));
+    const Vec3 eye(0.1f, 0.8f, -4.f), dir = glm::normalize(Vec3(-0.1f, -2.3f, 5.f));
+    const double s_in = (-1.0 - eye.z) / dir.z, s_out = (-1.0 - eye.y) / dir.y, s_floor = (-1.5 - eye.y) / dir.y;
+    const HenyeyGreensteinPhase phase{float(g)};
+    auto single = [&](double s) {
+        const Vec3 x = eye + float(s) * dir;
+        double sum = 0.0;
+        for (const auto& l : points) {
+            const Vec3 to = l.position - x;
+            const double r = glm::length(to);
+            sum += sigma_s * phase.eval(dir, to / float(r)) * std::exp(-sigma_t * (s - s_in)) * l.intensity[0] *
+                   std::exp(-sigma_t * r) / (r * r);
+        }
+        return sum;
+    };
+    const int n = 20000;
+    const double h = (s_out - s_in) / n;
+    double integral = single(s_in) + single(s_out);
+    for (int i = 1; i < n; ++i) integral += (i % 2 ? 4.0 : 2.0) * single(s_in + i * h);
+    integral *= h / 3.0;
+    const Vec3 f = eye + float(s_floor) * dir;
+    double floor_term = 0.0;
+    for (const auto& l : points) {
+        const Vec3 to = l.position - f;
+        const double dist = glm::length(to);
+        const Vec3 w = to / float(dist);
+        floor_term += rho / kPi * l.intensity[0] * w.y * std::exp(-sigma_t * exit_distance(cube, l.position, -w)) /
+                      (dist * dist);
+    }
+    const double expected = integral + std::exp(-sigma_t * (s_out - s_in)) * floor_term;
+    EstimatorOptions opts;
+    opts.max_depth = 1;
+    EstimatorOptions fixed = opts;
+    fixed.adaptive_equiangular = false;
+    auto check = [&](const auto& est, const char* name) {
+        CAPTURE(std::string(name));
+        const Stat s = estimate(est, sc, 40000, 19, [&](Pcg32&) { return Ray{eye, dir}; });
+        CAPTURE(s.mean);
+        CAPTURE(s.se());
+        CAPTURE(expected);
+        CHECK(std::abs(s.mean - expected) <= kSigmas * s.se());
+    };
+    check(PathEstimator<strategy::NextEvent>(opts), "ratio-nee");
+    check(PathEstimator<strategy::NullScatteringMis, mis::Balance>(opts), "uni-nee-mis balance");
+    check(PathEstimator<strategy::EquiangularNextEvent>(opts), "equiangular-nee");
+    check(PathEstimator<strategy::EquiangularMis, mis::Balance>(opts), "equiangular-mis balance");
+    check(PathEstimator<strategy::EquiangularMis, mis::Power>(fixed), "equiangular-mis power, every segment");
+    check(PathEstimator<strategy::EquiangularMis, mis::Balance, absorption::Event>(opts), "equiangular-mis event");
 }
 
 /// A geometry that reports one fixed hit for every ray.

@@ -9,7 +9,9 @@
 #pragma once
 
 #include <algorithm>
+#include <concepts>
 #include <cstdint>
+#include <optional>
 #include <tuple>
 #include <type_traits>
 #include <utility>
@@ -63,6 +65,41 @@ public:
             e.cdf = float(cdf / total);
         }
         if (!entries_.empty()) entries_.back().cdf = 1.f;
+        // The equiangular strategies' targets: the lights with a point to aim at, by the same
+        // selection probabilities renormalised over them.
+        double aim_total = 0.0;
+        std::size_t entry = 0;
+        for_each_light([&](const auto& l, int, int) {
+            if (const auto p = aim_point(l)) {
+                targets_.push_back({*p, entries_[entry].pmf, 0.f});
+                aim_total += double(entries_[entry].pmf);
+            }
+            ++entry;
+        });
+        double aim_cdf = 0.0;
+        for (Target& t : targets_) {
+            aim_cdf += double(t.pmf);
+            t.pmf = aim_total > 0.0 ? float(double(t.pmf) / aim_total) : 0.f;
+            t.cdf = aim_total > 0.0 ? float(aim_cdf / aim_total) : 0.f;
+        }
+        if (!targets_.empty()) targets_.back().cdf = 1.f;
+    }
+
+    /// The equiangular strategies' targets (THEORY 5.4): one per light with a point to aim at
+    /// (a PointLight's position, a SphereLight's centre, a QuadLight's centre, or a host model's
+    /// `equiangular_point()`), in light order; lights at infinity and DirectionalLight have none.
+    int equiangular_count() const noexcept { return int(targets_.size()); }
+    /// Target k's point.
+    const Vec3& equiangular_point(int k) const noexcept { return targets_[std::size_t(k)].point; }
+    /// The probability with which an equiangular vertex aims at target k: its light's selection
+    /// probability, renormalised over the targets.
+    float equiangular_pmf(int k) const noexcept { return targets_[std::size_t(k)].pmf; }
+    /// The target for a uniform u in [0, 1) (-1: there is none).
+    int pick_equiangular(float u) const noexcept {
+        if (targets_.empty()) return -1;
+        const auto it = std::upper_bound(targets_.begin(), targets_.end(), u,
+                                         [](float x, const Target& t) { return x < t.cdf; });
+        return int(std::min(std::size_t(it - targets_.begin()), targets_.size() - 1));
     }
 
     int count() const noexcept { return int(entries_.size()); }
@@ -143,6 +180,17 @@ private:
         if constexpr (requires { validate_light(l); }) validate_light(l);
     }
 
+    /// The point an equiangular vertex aims at for light l, if it has one.
+    template <class L>
+    static std::optional<Vec3> aim_point(const L& l) noexcept {
+        if constexpr (requires { { l.equiangular_point() } -> std::convertible_to<Vec3>; }) return l.equiangular_point();
+        else if constexpr (requires { { l.position } -> std::convertible_to<Vec3>; }) return l.position;
+        else if constexpr (requires { { l.center } -> std::convertible_to<Vec3>; }) return l.center;
+        else if constexpr (requires { l.corner + 0.5f * (l.edge_u + l.edge_v); })
+            return Vec3(l.corner + 0.5f * (l.edge_u + l.edge_v));
+        else return std::nullopt;
+    }
+
     template <class L>
     static constexpr bool is_infinite() noexcept {
         if constexpr (requires { L::is_infinite; }) return bool(L::is_infinite);
@@ -152,6 +200,11 @@ private:
     std::tuple<std::vector<Ls>...> lights_;
     std::vector<Entry> entries_;
     std::vector<int> infinite_;
+    struct Target {
+        Vec3 point;
+        float pmf, cdf;
+    };
+    std::vector<Target> targets_;
 };
 
 }  // namespace nsp

@@ -42,44 +42,6 @@
 
 namespace nsp {
 
-/// The three techniques that can produce a path's last real vertex x and its light vertex y
-/// when equiangular sampling is on (THEORY 5.4).
-enum class VertexTechnique : std::uint8_t {
-    TrackNee,        ///< x by tracking, y by NEE
-    TrackHit,        ///< x by tracking, y by tracking from x (hitting the light)
-    EquiangularNee,  ///< x by equiangular sampling (nulls before it ratio-tracked), y by NEE
-};
-
-/// p_equiangular / p_tracking of a real vertex that delta tracking drew at distance t, from the
-/// equiangular density there, the nulls' prod P_n and mu_bar(t) P_s(t) (DeltaTrack's
-/// `event_density`). The shared factors (prefix, Tbar, mu_bar at the nulls) cancel; inf if the
-/// tracking pdf underflowed to 0.
-inline float equiangular_over_tracking(float eq_pdf, float null_pdf_product, float event_density) noexcept {
-    return eq_pdf / (null_pdf_product * event_density);
-}
-
-/// p_tracking / p_equiangular of a real scattering vertex drawn by equiangular sampling with
-/// density `eq_pdf` > 0, whose nulls ratio tracking drew with delta-tracking product
-/// `null_pdf_product`, coefficients `c` and majorant `mu_bar` there: prod P_n mu_bar P_s / p_eq
-/// (THEORY 5.4). 0 where tracking cannot collide (mu_bar = 0).
-template <AbsorptionPolicy A, SpectralMode S>
-float tracking_over_equiangular(float eq_pdf, float null_pdf_product, const Coefficients<S>& c, float mu_bar) noexcept {
-    if (!(mu_bar > 0.f)) return 0.f;
-    return null_pdf_product * mu_bar * event_probabilities<A>(c, mu_bar).scatter / eq_pdf;
-}
-
-/// The MIS weight of technique `which` for one path, from the three techniques' pdfs relative to
-/// any common reference (`track_nee`, `track_hit` = 0 for a point light, `eq_nee`). The three
-/// weights of one path sum to 1.
-template <mis::CombiningHeuristic H>
-float equiangular_mis_weight(const H& h, VertexTechnique which, float track_nee, float track_hit, float eq_nee) noexcept {
-    switch (which) {
-        case VertexTechnique::TrackNee: return mis::weight_among(h, track_nee, track_hit, eq_nee);
-        case VertexTechnique::TrackHit: return mis::weight_among(h, track_hit, track_nee, eq_nee);
-        default: return mis::weight_among(h, eq_nee, track_nee, track_hit);
-    }
-}
-
 /// A path estimator: strategy St, MIS heuristic H (mis::None exactly for single-strategy
 /// estimators) and absorption policy A for the delta-tracked segments.
 template <PathStrategy St, mis::Heuristic H = mis::None, AbsorptionPolicy A = absorption::Weight>

@@ -19,6 +19,7 @@
 #include "../vertex.hpp"
 #include "common.hpp"
 #include "surface_emission.hpp"
+#include "surface_equiangular.hpp"
 #include "surface_walk.hpp"
 
 namespace nsp::detail {
@@ -31,9 +32,6 @@ RadianceSample<typename Sc::Spectral> surface_radiance(const K& k, const Sc& sc,
     using St = typename K::Strategy;
     using Spectrum = typename Sc::Spectrum;
     constexpr bool kEmissive = EmissiveMedium<typename Sc::MediumType>;
-    static_assert(!St::equiangular,
-                  "nsp::PathEstimator over a SurfaceScene: the equiangular strategies aim at the point or sphere light "
-                  "of nsp::Scene and do not render scenes with surfaces yet");
     Spectrum L = Spectrum::Zero(), beta = Spectrum::Ones();
     Status status = Status::Ok;
     Ray ray = camera_ray;
@@ -41,8 +39,21 @@ RadianceSample<typename Sc::Spectral> surface_radiance(const K& k, const Sc& sc,
     VertexPdf from = VertexPdf::from_camera();  // the last real vertex, for the MIS weight of what the path hits
     float nulls = 1.f;                          // prod P_n of the segments since that vertex
     Vec3 prev = ray.o;
+    float from_eq = 0.f;  // p_equiangular / p_tracking of that vertex (equiangular strategies; 0 on a surface)
     float walked = 0.f;  // the distance from that vertex to the current ray's origin (emission's MIS)
     int crossings = 0;
+    // The MIS weight of a light the segments from `from` reach, sampled there with `light_pdf`:
+    // against NEE, and with equiangular MIS also against equiangular + NEE (relative to tracking
+    // + NEE: hitting is p_uni / p_light, equiangular + NEE the vertex's p_eq / p_track).
+    auto hit_weight = [&](float light_pdf) {
+        if constexpr (St::equiangular && St::combines) {
+            if (from.camera || from.delta || !(light_pdf > 0.f)) return 1.f;
+            const float s = unidirectional_pdf<St>(from.survival, from.direction_pdf, nulls) / light_pdf;
+            return equiangular_mis_weight(k.heuristic(), VertexTechnique::TrackHit, 1.f, s, from_eq);
+        } else {
+            return k.hit_weight(from, nulls, light_pdf);
+        }
+    };
     for (int depth = 0;;) {
         const SurfaceHit hit = sc.geometry.intersect(ray, kInf);
         if (!usable_hit(sc, hit)) {
@@ -51,8 +62,25 @@ RadianceSample<typename Sc::Spectral> surface_radiance(const K& k, const Sc& sc,
         }
         bool in_medium = false;
         float t_medium = 0.f;
+        float eq_ratio = 0.f;    // p_equiangular / p_tracking of a medium vertex drawn on this piece
+        bool eq_covers = false;  // the equiangular technique could have drawn it
         if (sc.has_medium(medium)) {
             const auto& m = sc.media[std::size_t(medium)];
+            // Equiangular: a real vertex on this piece aimed at the lights, and NEE from it.
+            [[maybe_unused]] PieceEquiangular<Sc> eq;
+            [[maybe_unused]] float eq_select = 1.f;  // the probability of drawing this piece's equiangular vertex
+            if constexpr (St::equiangular) {
+                const Interval in = m.medium.bounds().clip(ray, 0.f, hit.t);
+                eq = PieceEquiangular<Sc>(sc, ray, in.t0, in.t1);
+                if (eq.valid()) {
+                    eq_select = eq.template selection<St, typename Sc::MediumType>(k.options(), m.majorant, lambda);
+                    if (depth < k.options().max_depth && (eq_select >= 1.f || rng.uniform() < eq_select)) {
+                        const Status es =
+                            equiangular_event(k, sc, medium, ray, eq, eq_select, depth + 1, beta, lambda, rng, counter, L);
+                        if (es != Status::Ok) status = es;
+                    }
+                }
+            }
             DeltaTrack<typename Sc::Spectral> seg;
             if constexpr (kEmissive)
                 seg = track_emissive_piece(k, sc, medium, ray, hit.t, PieceStart{from, nulls, walked}, lambda, rng,
@@ -68,6 +96,13 @@ RadianceSample<typename Sc::Spectral> surface_radiance(const K& k, const Sc& sc,
             if (seg.end == SegmentEnd::Scattered) {
                 in_medium = true;
                 t_medium = seg.t;
+                if constexpr (St::equiangular) {
+                    eq_covers = eq.valid();
+                    // inf where the tracking pdf underflowed: equiangular then takes the weight
+                    if (eq_covers)
+                        eq_ratio = equiangular_over_tracking(eq_select * eq.density(seg.t), seg.null_pdf_product,
+                                                             seg.event_density);
+                }
             } else if (seg.end != SegmentEnd::Passed) {
                 break;  // absorbed
             }
@@ -81,12 +116,12 @@ RadianceSample<typename Sc::Spectral> surface_radiance(const K& k, const Sc& sc,
                 if (k.counts_hit(from))
                     for (const int i : sc.lights.infinite())
                         L += beta * sc.lights.emitted(i, ray.d, lambda) *
-                             k.hit_weight(from, nulls, from.camera ? 0.f : sc.lights.pdf(i, prev, ray.d));
+                             hit_weight(from.camera ? 0.f : sc.lights.pdf(i, prev, ray.d));
                 break;
             }
             if (hit.light >= 0 && k.counts_hit(from))
                 L += beta * sc.lights.emitted(hit.light, ray.d, lambda) *
-                     k.hit_weight(from, nulls, from.camera ? 0.f : sc.lights.pdf(hit.light, prev, ray.d));
+                     hit_weight(from.camera ? 0.f : sc.lights.pdf(hit.light, prev, ray.d));
             if (crosses(sc, hit)) {  // a null interface: no vertex, the segment goes on in the next medium
                 if (++crossings > kMaxInterfaceCrossings) {
                     status = Status::InvalidInput;
@@ -107,26 +142,15 @@ RadianceSample<typename Sc::Spectral> surface_radiance(const K& k, const Sc& sc,
         const float q = k.survival(depth, beta);
         const SceneVertex v{material, medium, hit.ns};
         if constexpr (St::samples_lights) {
-            const float u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
-            if (!(v.on_surface() && sc.materials.is_delta(material))) {
-                const SampledLight<typename Sc::Spectral> ls = sc.lights.sample(x, u0, u1, u2, lambda);
-                if (ls.sample.pdf > 0.f) {
-                    const auto f = eval_vertex(sc, v, ray.d, ls.sample.wi, lambda);
-                    if ((f.value != 0.f).any()) {
-                        const auto sh = shadow_through(k, sc, Ray{x, f.wi}, shadow_distance(ls.sample.distance),
-                                                       v.on_surface() ? hit.medium_entered(f.wi) : medium, lambda, rng,
-                                                       counter);
-                        if (sh.status != Status::Ok) {
-                            status = sh.status;
-                        } else if ((sh.transmittance != 0.f).any()) {
-                            const float w =
-                                k.light_weight(q, f.pdf, sh.null_pdf_product, ls.sample.pdf, ls.sample.delta);
-                            L += beta * sh.transmittance * ls.sample.radiance * f.value * (w / ls.sample.pdf);
-                        }
-                    }
-                }
-                if constexpr (kEmissive) {
-                    auto side = [&](const Vec3& wi) { return v.on_surface() ? hit.medium_entered(wi) : medium; };
+            auto side = [&](const Vec3& wi) { return v.on_surface() ? hit.medium_entered(wi) : medium; };
+            // Equiangular + NEE alone leaves the lights of a vertex its own vertices cover to them.
+            if (St::combines || !St::equiangular || !eq_covers) {
+                const Status ns = light_event(k, sc, v, x, ray.d, q, side, 1.f, eq_ratio, false, lambda, rng, counter,
+                                              beta, L);
+                if (ns != Status::Ok) status = ns;
+            }
+            if constexpr (kEmissive) {
+                if (!(v.on_surface() && sc.materials.is_delta(material))) {
                     const Status es = emission_event(k, sc, v, x, ray.d, q, side, lambda, rng, counter, beta, L);
                     if (es != Status::Ok) status = es;
                 }
@@ -143,6 +167,7 @@ RadianceSample<typename Sc::Spectral> surface_radiance(const K& k, const Sc& sc,
         if (v.on_surface()) medium = hit.medium_entered(next.wi);
         if (!(beta != 0.f).any()) break;
         from = VertexPdf::scattered(q, next.pdf, next.delta);
+        from_eq = eq_ratio;
         nulls = 1.f;
         prev = x;
         walked = 0.f;
