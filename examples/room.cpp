@@ -2,12 +2,15 @@
 // a diffuse floor in an open room under a small rectangular light and a dim sky, rendered over an
 // nsp::SurfaceScene with the efficiency tables the other scenes have (docs/surfaces.md reads
 // them): the grey cloud (Mono, 96x96 by default) with every strategy of nsp::PathEstimator that
-// renders surfaces, then the chromatic cloud (Rgb, half the size and spp) with the grey-majorant
-// PathEstimator against nsp::SpectralPathEstimator's per-channel pdfs.
+// renders surfaces (the equiangular ones aimed at the lamp's centre), then the chromatic cloud
+// (Rgb, half the size and spp) with the grey-majorant PathEstimator against
+// nsp::SpectralPathEstimator's per-channel pdfs, then the glowing plume (the cloud's smoke with a
+// flame in it, an emissive medium; Mono, half the size and spp) with emission and lights in one MIS.
 //
 //   nsp_room [--res N] [--spp N] [--threads N] [--out DIR] [--no-png] [--picture-res N]
 //
-// Writes DIR/room_sheet.png and DIR/room_rgb_sheet.png (each table's rows at one exposure) and
+// Writes DIR/room_sheet.png, DIR/room_rgb_sheet.png and DIR/room_plume_sheet.png (each table's
+// rows at one exposure) and
 // DIR/room.png (the grey room, uni-nee-mis balance, 128 spp, --picture-res pixels square) unless
 // --no-png. Exits 1 if any path ended with a status other than Ok.
 #include <algorithm>
@@ -176,6 +179,8 @@ int main(int argc, char** argv) {
     run(grey, PathEstimator<strategy::DirectionalMis, mis::Power>{}, "directional-mis_power");
     run(grey, PathEstimator<strategy::NullScatteringMis, mis::Balance>{}, "uni-nee-mis_balance");
     run(grey, PathEstimator<strategy::NullScatteringMis, mis::Power>{}, "uni-nee-mis_power");
+    run(grey, PathEstimator<strategy::EquiangularNextEvent>{}, "equiangular-nee");  // aimed at the lamp's centre
+    run(grey, PathEstimator<strategy::EquiangularMis, mis::Balance>{}, "equiangular-mis_balance");
     const std::uint64_t failed_grey = print_table("Room (mono", rows, 4, res, spp, threads);  // z against uni-nee-mis_balance
     std::printf("room: uni-nee-mis_balance / best single strategy (%s) in cpu-s*var: %.3g; unidirectional / ratio-nee: %.3g\n",
                 rows[cost(rows, 0) <= cost(rows, 1) ? 0 : 1].name.c_str(), cost(rows, 4) / std::min(cost(rows, 0), cost(rows, 1)),
@@ -203,7 +208,23 @@ int main(int argc, char** argv) {
                 "(the grey estimator's variance is practically infinite on this medium: its sample variance "
                 "understates it; docs/chromatic.md)\n",
                 cost(chromatic, 0) / cost(chromatic, 3));
-    const std::uint64_t failed = failed_grey + failed_chroma;
+
+    // Table 3: the plume (the cloud's smoke with a flame inside it, an emissive medium), Mono, in
+    // the same room: emission and the lights in one MIS.
+    using PM = Emissive<DenseGridMedium<Mono>>;
+    const PM plume = nsp_examples::make_plume_medium<Mono>();
+    const auto plume_room = nsp_examples::make_room_scene(plume, GlobalMajorant<PM>(plume));
+    const std::size_t first_plume = rows.size();
+    run(plume_room, PathEstimator<strategy::Unidirectional>{}, "unidirectional");
+    run(plume_room, PathEstimator<strategy::NextEvent>{}, "ratio-nee");
+    run(plume_room, PathEstimator<strategy::NullScatteringMis, mis::Balance>{}, "uni-nee-mis_balance");
+    run(plume_room, PathEstimator<strategy::EquiangularMis, mis::Balance>{}, "equiangular-mis_balance");
+    std::vector<Row> plume_rows(rows.begin() + std::ptrdiff_t(first_plume), rows.end());
+    const std::uint64_t failed_plume = print_table("Room, glowing plume (mono", plume_rows, 2, run_res, run_spp, threads);
+    std::printf("room plume: uni-nee-mis_balance / best single strategy (%s) in cpu-s*var: %.3g\n",
+                plume_rows[cost(plume_rows, 0) <= cost(plume_rows, 1) ? 0 : 1].name.c_str(),
+                cost(plume_rows, 2) / std::min(cost(plume_rows, 0), cost(plume_rows, 1)));
+    const std::uint64_t failed = failed_grey + failed_chroma + failed_plume;
 
     if (!no_png) {
         std::filesystem::create_directories(out);
@@ -218,12 +239,13 @@ int main(int argc, char** argv) {
             nsp_examples::write_contact_sheet(path, tiles, nsp_examples::exposure_for(images));
         };
         sheet(out + "/room_sheet.png", 0, first);
-        sheet(out + "/room_rgb_sheet.png", first, rows.size());
+        sheet(out + "/room_rgb_sheet.png", first, first_plume);
+        sheet(out + "/room_plume_sheet.png", first_plume, rows.size());
         const Row picture = render(grey, PathEstimator<strategy::NullScatteringMis, mis::Balance>{}, "picture",
                                    picture_res, 128, threads, 99);
         nsp_examples::write_png(out + "/room.png", picture.image, nsp_examples::exposure_for({&picture.image}));
-        std::fprintf(stderr, "  room: %s/room_sheet.png, %s/room_rgb_sheet.png, %s/room.png (%.1f s)\n", out.c_str(),
-                     out.c_str(), out.c_str(), picture.seconds);
+        std::fprintf(stderr, "  room: %s/room_sheet.png, %s/room_rgb_sheet.png, %s/room_plume_sheet.png, %s/room.png (%.1f s)\n",
+                     out.c_str(), out.c_str(), out.c_str(), out.c_str(), picture.seconds);
     }
     return failed == 0 ? 0 : 1;
 }

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <tuple>
 #include <type_traits>
 #include <vector>
 
@@ -27,6 +28,16 @@ using SceneFor = SurfaceScene<Shapes, EM, MajorantFor<typename E::Channels, EM>,
 
 // k = 5 standard errors per channel, estimated from the samples, with fixed seeds: deterministic.
 constexpr double kSigmas = 5.0;
+
+/// The channel policies' strategies, and equiangular MIS beside the emission's techniques.
+using Estimators = decltype(std::tuple_cat(
+    SpectralEstimatorsWith<absorption::Weight>{},
+    std::tuple<SpectralPathEstimator<channels::SpectralMis, strategy::EquiangularMis, mis::Balance>>{}));
+
+/// A quad light of radiance 0 that no surface shows: an equiangular target.
+QuadLight<S> dark_lamp() {
+    return {Vec3(-0.3f, 0.2f, -0.3f), Vec3(0.6f, 0.f, 0.f), Vec3(0.f, 0.f, 0.6f), Spec::Zero()};
+}
 
 /// A homogeneous medium over `box` emitting le_c everywhere in it, under estimator E's majorant
 /// kind: a grey one 1.5 times the largest extinction, or the per-channel extinction bound.
@@ -82,11 +93,11 @@ TEST_CASE_TEMPLATE_DEFINE("spectral surface emission: a floor under an emitting 
     const SceneFor<E> sc(shapes,
                          {emitting<E>(Box{Vec3(-1.f, 1.f, -1.f), Vec3(1.f, 3.f, 1.f)}, mu_a, Spec::Zero(), le, 0.f),
                           emitting<E>(below, Spec::Constant(1.f), Spec::Zero(), Spec::Constant(1.f), 0.f)},
-                         Mats({LambertianBsdf<S>(rho)}, {}), Ls(LightSelection::Uniform, 1.f, {}, {}), -1);
+                         Mats({LambertianBsdf<S>(rho)}, {}), Ls(LightSelection::Uniform, 1.f, {dark_lamp()}, {}), -1);
     const Vec3 eye(3.f, 0.5f, 0.f);
     check_against(E{}, sc, 12000, 51, [&](Pcg32&) { return Ray{eye, glm::normalize(-eye)}; }, expected);
 }
-TEST_CASE_TEMPLATE_APPLY(spectral_floor_sphere, SpectralEstimatorsWith<absorption::Weight>);
+TEST_CASE_TEMPLATE_APPLY(spectral_floor_sphere, Estimators);
 
 TEST_CASE_TEMPLATE_DEFINE("spectral surface emission: white walls around two nested emitting media, L_c = L_e,c", E,
                           spectral_emissive_furnace) {
@@ -115,7 +126,7 @@ TEST_CASE_TEMPLATE_DEFINE("spectral surface emission: white walls around two nes
                         emitting<E>(Box{Vec3(-0.6f), Vec3(0.6f)}, chroma<S>(0.8f, 1.2f, 0.6f), chroma<S>(0.7f, 0.4f, 1.f), le,
                                     -0.4f)},
                        Mats({LambertianBsdf<S>(Spec::Ones())}, {MirrorBsdf<S>(Spec::Ones())}),
-                       Ls(LightSelection::Uniform, 2.f, {}, {}), 0);
+                       Ls(LightSelection::Uniform, 2.f, {dark_lamp()}, {}), 0);
         check_against(E{}, sc, 8000, 61, [](Pcg32& rng) {
             return Ray{Vec3(0.1f, -0.2f, 0.8f), uniform_sphere(rng.uniform(), rng.uniform())};
         }, le);
@@ -125,6 +136,6 @@ TEST_CASE_TEMPLATE_DEFINE("spectral surface emission: white walls around two nes
         }, le);
     }
 }
-TEST_CASE_TEMPLATE_APPLY(spectral_emissive_furnace, SpectralEstimatorsWith<absorption::Weight>);
+TEST_CASE_TEMPLATE_APPLY(spectral_emissive_furnace, Estimators);
 
 }  // namespace

@@ -9,6 +9,7 @@
 #include <limits>
 #include <type_traits>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "host/shapes.hpp"
@@ -21,6 +22,15 @@ using nsp_host::Shapes;
 
 // k = 5 standard errors per channel, estimated from the samples, with fixed seeds: deterministic.
 constexpr double kSigmas = 5.0;
+
+/// The equiangular strategies over surfaces: three-way MIS under each channel policy that
+/// weighs channels by their own or shared pdfs, equiangular + NEE alone, absorption as an event.
+using SpectralEquiangular =
+    std::tuple<SpectralPathEstimator<channels::Independent, strategy::EquiangularMis, mis::Balance>,
+               SpectralPathEstimator<channels::SpectralTrackingAverage, strategy::EquiangularMis, mis::Balance>,
+               SpectralPathEstimator<channels::SpectralMis, strategy::EquiangularMis, mis::Balance>,
+               SpectralPathEstimator<channels::SpectralMis, strategy::EquiangularNextEvent>,
+               SpectralPathEstimator<channels::SpectralMis, strategy::EquiangularMis, mis::Balance, absorption::Event>>;
 
 template <SpectralMode S>
 using Mats = Materials<S, LambertianBsdf<S>, MirrorBsdf<S>>;
@@ -97,6 +107,7 @@ TEST_CASE_TEMPLATE_DEFINE("spectral surfaces: the white furnace gives 1 in every
     check_zero_error(run(E{}, white_furnace<E, Rgb>(), 12000, 41, furnace_ray, Rgb::Spectrum::Ones()));
 }
 TEST_CASE_TEMPLATE_APPLY(spectral_white_furnace, SpectralEstimatorsWith<absorption::Weight>);
+TEST_CASE_TEMPLATE_APPLY(spectral_white_furnace, SpectralEquiangular);
 
 TEST_CASE("spectral surfaces: the white furnace gives 1 at every wavelength (Hero<4>)") {
     using H = Hero<4>;
@@ -109,9 +120,11 @@ TEST_CASE("spectral surfaces: the white furnace gives 1 at every wavelength (Her
 TEST_CASE_TEMPLATE_DEFINE("spectral surfaces: six emitting walls of chromatic albedo, L_c = 1 / (1 - albedo_c)", E,
                           spectral_wall_furnace) {
     // Walls of albedo (0.5, 0.3, 0.7) emitting 1 around a medium of albedo 1: L_c = 1 / (1 - a_c).
-    // NEE alone is left out, as in tests/test_surface_estimators.cpp: area-sampled quads in a
-    // closed box give it an infinite variance (the white furnace above checks it).
-    if constexpr (!std::is_same_v<typename E::Strategy, strategy::NextEvent>) {
+    // NEE alone (and equiangular + NEE, whose lights come from NEE alone) is left out, as in
+    // tests/test_surface_estimators.cpp: area-sampled quads in a closed box give it an infinite
+    // variance (the white furnace above checks it).
+    if constexpr (!std::is_same_v<typename E::Strategy, strategy::NextEvent> &&
+                  !std::is_same_v<typename E::Strategy, strategy::EquiangularNextEvent>) {
         CAPTURE(spectral_estimator_name<E>());
         Shapes shapes;
         std::vector<QuadLight<Rgb>> walls;
@@ -138,6 +151,7 @@ TEST_CASE_TEMPLATE_DEFINE("spectral surfaces: six emitting walls of chromatic al
     }
 }
 TEST_CASE_TEMPLATE_APPLY(spectral_wall_furnace, SpectralEstimatorsWith<absorption::Weight>);
+TEST_CASE_TEMPLATE_APPLY(spectral_wall_furnace, SpectralEquiangular);
 
 TEST_CASE_TEMPLATE_DEFINE("spectral surfaces: chromatic media nested behind null interfaces, exp(-tau_c) per channel", E,
                           spectral_nested) {
@@ -162,6 +176,77 @@ TEST_CASE_TEMPLATE_DEFINE("spectral surfaces: chromatic media nested behind null
                          Rgb::Spectrum((-0.5f * tau).exp())));
 }
 TEST_CASE_TEMPLATE_APPLY(spectral_nested, SpectralEstimatorsWith<absorption::Weight>);
+TEST_CASE_TEMPLATE_APPLY(spectral_nested, SpectralEquiangular);
+
+TEST_CASE_TEMPLATE_DEFINE("spectral surfaces: single scattering from two point lights in a cube over a floor (quadrature)",
+                          E, spectral_point_lights) {
+    // tests/test_surface_estimators.cpp's scene per channel: two point lights of chromatic
+    // intensity in a cube [-1, 1]^3 of chromatic sigma_s, sigma_a (HG 0.4) behind null interfaces
+    // over a Lambertian floor at y = -1.5 of chromatic albedo; max_depth 1; the camera ray passes
+    // 0.15 from light 0. Per channel, with T_c(l) = exp(-sigma_t,c l):
+    //   L_c = sum_i int sigma_s,c f_p T_c(s - s_in) I_i,c T_c(r_i) / r_i^2 ds + T_c(s_out - s_in) sum_i rho_c / pi I_i,c cos_i T_c(c_i) / d_i^2
+    // (composite Simpson in double, 20000 intervals).
+    if constexpr (std::is_same_v<typename E::Strategy, strategy::Unidirectional>) return;  // a point light is never hit
+    CAPTURE(spectral_estimator_name<E>());
+    using M = HomogeneousMedium<Rgb>;
+    using Ps = LightSampler<Rgb, PointLight<Rgb>>;
+    using PSc = SurfaceScene<Shapes, M, MajorantFor<typename E::Channels, M>, HenyeyGreensteinPhase, Mats<Rgb>, Ps>;
+    const Rgb::Spectrum sigma_s(0.8f, 0.5f, 1.1f), sigma_a(0.2f, 0.4f, 0.1f), rho(0.6f, 0.3f, 0.8f);
+    const Rgb::Spectrum sigma_t = sigma_s + sigma_a;
+    const Box cube{Vec3(-1.f), Vec3(1.f)};
+    Shapes shapes;
+    shapes.boxes.push_back({cube.lo, cube.hi, {-1, -1, 0, -1}});
+    shapes.quads.push_back({Vec3(-20.f, -1.5f, 20.f), Vec3(40.f, 0.f, 0.f), Vec3(0.f, 0.f, -40.f), {0, -1, -1, -1}});
+    const std::vector<PointLight<Rgb>> points{{Vec3(0.1f, -0.7f, -0.45f), Rgb::Spectrum(2.f, 1.f, 1.5f)},
+                                              {Vec3(-0.5f, -0.3f, 0.6f), Rgb::Spectrum(0.5f, 1.f, 0.8f)}};
+    const PSc sc(shapes, {medium_for<E, Rgb>(cube, sigma_a, sigma_s)}, Mats<Rgb>({LambertianBsdf<Rgb>(rho)}, {}),
+                 Ps(LightSelection::Power, 4.f, points), -1);
+    const Vec3 eye(0.1f, 0.8f, -4.f), dir = glm::normalize(Vec3(-0.1f, -2.3f, 5.f));
+    const double s_in = (-1.0 - eye.z) / dir.z, s_out = (-1.0 - eye.y) / dir.y, s_floor = (-1.5 - eye.y) / dir.y;
+    const HenyeyGreensteinPhase phase{0.4f};
+    auto exit_distance = [&](const Vec3& p, const Vec3& d) {
+        double t = std::numeric_limits<double>::infinity();
+        for (int a = 0; a < 3; ++a) {
+            if (d[a] > 0.f) t = std::min(t, (double(cube.hi[a]) - p[a]) / d[a]);
+            if (d[a] < 0.f) t = std::min(t, (double(cube.lo[a]) - p[a]) / d[a]);
+        }
+        return t;
+    };
+    Rgb::Spectrum expected;
+    for (int c = 0; c < 3; ++c) {
+        const double st = sigma_t[c];
+        auto single = [&](double s) {
+            const Vec3 x = eye + float(s) * dir;
+            double sum = 0.0;
+            for (const auto& l : points) {
+                const Vec3 to = l.position - x;
+                const double r = glm::length(to);
+                sum += double(sigma_s[c]) * phase.eval(dir, to / float(r)) * std::exp(-st * (s - s_in)) * l.intensity[c] *
+                       std::exp(-st * r) / (r * r);
+            }
+            return sum;
+        };
+        const int n = 20000;
+        const double h = (s_out - s_in) / n;
+        double integral = single(s_in) + single(s_out);
+        for (int i = 1; i < n; ++i) integral += (i % 2 ? 4.0 : 2.0) * single(s_in + i * h);
+        integral *= h / 3.0;
+        const Vec3 f = eye + float(s_floor) * dir;
+        double floor_term = 0.0;
+        for (const auto& l : points) {
+            const Vec3 to = l.position - f;
+            const double dist = glm::length(to);
+            const Vec3 w = to / float(dist);
+            floor_term += rho[c] / kPi * l.intensity[c] * w.y * std::exp(-st * exit_distance(l.position, -w)) / (dist * dist);
+        }
+        expected[c] = float(integral + std::exp(-st * (s_out - s_in)) * floor_term);
+    }
+    EstimatorOptions opts;
+    opts.max_depth = 1;
+    check_zero_error(run(E(opts), sc, 20000, 47, [&](Pcg32&) { return Ray{eye, dir}; }, expected));
+}
+TEST_CASE_TEMPLATE_APPLY(spectral_point_lights, SpectralEquiangular);
+TEST_CASE_TEMPLATE_APPLY(spectral_point_lights, SpectralEstimatorsOf<channels::SpectralMis, absorption::Weight>);
 
 TEST_CASE("spectral surfaces: a bad hit gives Status::InvalidInput and 0") {
     struct NanHit {

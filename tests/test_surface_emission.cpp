@@ -65,6 +65,13 @@ void for_each_strategy(F check) {
     EstimatorOptions off;
     off.emission_along_segments = false;
     check(PathEstimator<strategy::NullScatteringMis, mis::Balance>{off}, "uni-nee-mis, no segment technique");
+    check(PathEstimator<strategy::EquiangularMis, mis::Balance>{}, "equiangular-mis");
+}
+
+/// A quad light of radiance 0 that no surface shows: an equiangular target, so that the
+/// equiangular strategies draw their vertices beside the emission's three techniques.
+QuadLight<S> dark_lamp() {
+    return {Vec3(-0.3f, 0.2f, -0.3f), Vec3(0.6f, 0.f, 0.f), Vec3(0.f, 0.f, 0.6f), Spectrum::Zero()};
 }
 
 /// The six walls of [-1, 1]^3 facing inward into medium 0, Lambertian (material 0) or mirrors
@@ -96,6 +103,7 @@ Sc furnace(float wall_albedo, float wall_le, const std::vector<int>& mirrors) {
     Shapes shapes;
     std::vector<QuadLight<S>> lights;
     walls(wall_le, mirrors, shapes, lights);
+    lights.push_back(dark_lamp());
     shapes.spheres.push_back({Vec3(0.f), 0.6f, {-1, -1, 1, 0}});
     const Mats mats({LambertianBsdf<S>(Spectrum::Constant(wall_albedo))}, {MirrorBsdf<S>(Spectrum::Constant(wall_albedo))});
     return Sc(shapes,
@@ -189,7 +197,7 @@ TEST_CASE("surface emission: a Lambertian floor under an emitting absorbing sphe
     const Sc sc(shapes,
                 {emitting(Box{Vec3(-1.f, 1.f, -1.f), Vec3(1.f, 3.f, 1.f)}, float(mu_a), 0.f, float(le), 0.f),
                  emitting(below, 1.f, 0.f, 1.f, 0.f)},
-                mats, Ls(LightSelection::Uniform, 1.f, {}, {}), -1);
+                mats, Ls(LightSelection::Uniform, 1.f, {dark_lamp()}, {}), -1);
     CHECK(sc.emission_selection_pdf(0) > 0.3f);
     CHECK(sc.emission_selection_pdf(0) < 0.7f);
     const Vec3 eye(3.f, 0.5f, 0.f);
@@ -214,7 +222,7 @@ TEST_CASE("surface emission: an emitting absorber in three pieces of two media b
     const Sc sc(shapes,
                 {emitting(Box{Vec3(-1.f), Vec3(1.f)}, 0.5f, 0.f, 1.f, 0.f),
                  emitting(Box{Vec3(-0.5f), Vec3(0.5f)}, 1.f, 0.f, 2.f, 0.f)},
-                mats, Ls(LightSelection::Uniform, 1.f, {}, {}), -1);
+                mats, Ls(LightSelection::Uniform, 1.f, {dark_lamp()}, {}), -1);
     const double a = 1.0 - std::exp(-0.25);
     const double expected = a + std::exp(-0.25) * 2.0 * (1.0 - std::exp(-1.0)) + std::exp(-1.25) * a;
     for_each_strategy([&](const auto& est, const char* name) {

@@ -6,7 +6,8 @@
 // through every medium a segment crosses: track_channels_delta multiplies each piece's null and
 // Tbar factors into it, and a crossing adds none. A surface vertex multiplies f by the BSDF's
 // value per channel and every channel's pdf by the same direction pdf; after a delta lobe the
-// next segment has no NEE alternative.
+// next segment has no NEE alternative. Emissive media (spectral_surface_emission.hpp) and the
+// equiangular strategies (spectral_surface_equiangular.hpp) work per piece, as in the grey loop.
 #pragma once
 
 #include <cmath>
@@ -19,64 +20,10 @@
 #include "../surface_scene.hpp"
 #include "common.hpp"
 #include "spectral_surface_emission.hpp"
+#include "spectral_surface_equiangular.hpp"
 #include "surface_walk.hpp"
 
 namespace nsp::detail {
-
-/// A shadow ray's per-channel factors through a SurfaceScene (see ChannelShadow), the pieces
-/// between null interfaces multiplied; f = 0 where a surface blocks it. `end` Passed, or the
-/// first failed piece's end (Aborted, Rejected, Overflowed), or InvalidInput for a bad hit.
-template <ChannelPolicy CP, AbsorptionPolicy A, class Sc, UniformRng R, LookupCounter C>
-ChannelShadow<typename Sc::Spectral> channel_shadow_through(const Sc& sc, Ray r, float distance, int medium,
-                                                            const typename Sc::Spectral::Wavelengths& lambda, int c,
-                                                            const typename Sc::Spectrum& weights, bool uni_alternative,
-                                                            R& rng, C& counter) {
-    using Sp = typename Sc::Spectral;
-    ChannelShadow<Sp> out;
-    auto blocked = [] {
-        ChannelShadow<Sp> b;
-        b.f.setZero();
-        return b;
-    };
-    for (int crossing = 0; crossing <= kMaxInterfaceCrossings; ++crossing) {
-        const SurfaceHit h = sc.geometry.intersect(r, distance);
-        if (!usable_hit(sc, h)) {
-            ChannelShadow<Sp> bad = blocked();
-            bad.end = SegmentEnd::InvalidInput;
-            return bad;
-        }
-        if (sc.has_medium(medium)) {
-            const auto& m = sc.media[std::size_t(medium)];
-            const auto s = track_channels_ratio<CP, A>(m.medium, m.majorant, r, h.found() ? h.t : distance, lambda, c,
-                                                       typename Sc::Spectrum(weights * out.f), uni_alternative, rng,
-                                                       counter);
-            if (s.end == SegmentEnd::Terminated) return blocked();
-            if (s.end != SegmentEnd::Passed) {
-                ChannelShadow<Sp> failed = blocked();
-                failed.end = s.end;
-                return failed;
-            }
-            out.f *= s.f;
-            out.nee *= s.nee;
-            out.uni *= s.uni;
-            // One common factor for the three keeps many pieces inside float's range; it cancels.
-            const float k = std::max(out.nee.maxCoeff(), out.uni.maxCoeff());
-            if (k > 0.f && std::isfinite(k)) {
-                out.f /= k;
-                out.nee /= k;
-                out.uni /= k;
-            }
-        }
-        if (!h.found()) return out;
-        if (!crosses(sc, h)) return blocked();
-        medium = h.medium_entered(r.d);
-        r.o = h.p;
-        distance -= h.t;
-    }
-    ChannelShadow<Sp> bad = blocked();
-    bad.end = SegmentEnd::InvalidInput;
-    return bad;
-}
 
 /// One path of SpectralPathEstimator<CP, St, H, A> through a SurfaceScene: sampling channel c
 /// drawn with probabilities q (selection), every channel's pdfs in the one-sample balance
@@ -89,13 +36,12 @@ RadianceSample<typename Sc::Spectral> spectral_surface_radiance(const EstimatorO
                                                                 R& rng, C& counter) {
     using Spectrum = typename Sc::Spectrum;
     constexpr bool kEmissive = EmissiveMedium<typename Sc::MediumType>;
-    static_assert(!St::equiangular,
-                  "nsp::SpectralPathEstimator over a SurfaceScene: the equiangular strategies aim at the point or "
-                  "sphere light of nsp::Scene and do not render scenes with surfaces yet");
     const Spectrum& q = selection.probabilities();
     const int c = selection.sample(rng.uniform());
-    // An emissive medium's segment technique keeps its pdf in the state's second slot (eq.vertex).
-    ChannelPathState<typename Sc::Spectral, kEmissive> st;
+    // The equiangular strategies and an emissive medium's segment technique keep their pdfs in
+    // the state's second slot (eq: the pdf of a piece's prefix with its nulls ratio-tracked).
+    constexpr bool kEq = St::equiangular || kEmissive;
+    ChannelPathState<typename Sc::Spectral, kEq> st;
     Spectrum L = Spectrum::Zero();
     Status status = Status::Ok;
     Ray ray = camera_ray;
@@ -113,15 +59,32 @@ RadianceSample<typename Sc::Spectral> spectral_surface_radiance(const EstimatorO
         }
         bool in_medium = false;
         float t_medium = 0.f;
+        Spectrum eq_pdf = Spectrum::Zero();  // every channel's equiangular pdf of a medium vertex drawn on this piece
+        bool eq_covers = false;              // the equiangular technique could have drawn it
         if (sc.has_medium(medium)) {
             const auto& m = sc.media[std::size_t(medium)];
+            if constexpr (kEq) st.eq.vertex = st.uni;
+            // Equiangular: a real vertex on this piece aimed at the lights, and NEE from it.
+            [[maybe_unused]] PieceEquiangular<Sc> eq;
+            [[maybe_unused]] float eq_select = 1.f;
+            if constexpr (St::equiangular) {
+                const Interval in = m.medium.bounds().clip(ray, 0.f, hit.t);
+                eq = PieceEquiangular<Sc>(sc, ray, in.t0, in.t1);
+                if (eq.valid()) {
+                    eq_select = eq.template selection<St, typename Sc::MediumType>(opts, m.majorant, lambda);
+                    if (depth < opts.max_depth && (eq_select >= 1.f || rng.uniform() < eq_select)) {
+                        const Status es = channel_equiangular_event<CP, St, A>(opts, sc, medium, ray, eq, eq_select,
+                                                                               depth + 1, lambda, q, c, st, rng, counter, L);
+                        if (es == Status::NonFinite) return {Spectrum::Zero(), es};  // an overflowed flight
+                        if (es != Status::Ok) status = es;
+                    }
+                }
+            }
             ChannelTrack seg;
             if constexpr (kEmissive) {
-                st.eq.vertex = st.uni;
                 seg = track_emissive_piece_channels<CP, St, A>(opts, sc, medium, ray, hit.t,
                                                                St::hits_lights || camera_or_delta, nee_alternative,
                                                                walked, lambda, q, c, st, rng, counter, L, status);
-                st.eq.vertex.setZero();  // used within the piece only
             } else {
                 seg = track_channels_delta<CP, A>(m.medium, m.majorant, ray, hit.t, lambda, c, st, nee_alternative, rng,
                                                   counter);
@@ -133,14 +96,22 @@ RadianceSample<typename Sc::Spectral> spectral_surface_radiance(const EstimatorO
             if (seg.end == SegmentEnd::Scattered) {
                 in_medium = true;
                 t_medium = seg.t;
+                if constexpr (St::equiangular) {
+                    eq_covers = eq.valid();
+                    if (eq_covers) eq_pdf = st.eq.vertex * (eq_select * eq.density(seg.t));
+                }
             } else if (seg.end != SegmentEnd::Passed) {
                 break;  // absorbed, or no pdf left
             }
+            if constexpr (kEq) st.eq.vertex.setZero();  // the piece's alone
         }
         // An emitter reached: every channel's pdf of the path, tracking and (where it exists) NEE.
         auto add_emitter = [&](int light) {
             Spectrum pdf = st.uni;
-            if (nee_alternative) pdf += sc.lights.pdf(light, prev, ray.d) * st.nee;
+            if (nee_alternative) {
+                if constexpr (St::equiangular) pdf += sc.lights.pdf(light, prev, ray.d) * (st.nee + st.eq.nee);
+                else pdf += sc.lights.pdf(light, prev, ray.d) * st.nee;
+            }
             L += channel_estimate<CP>(st.f, pdf, q, c) * sc.lights.emitted(light, ray.d, lambda);
         };
         int material = -1;
@@ -175,32 +146,16 @@ RadianceSample<typename Sc::Spectral> spectral_surface_radiance(const EstimatorO
         if (opts.russian_roulette && depth >= opts.rr_start_depth)
             rr = std::min(opts.rr_max_survival, channel_estimate<CP>(st.f, st.uni, q, c).abs().maxCoeff());
         if constexpr (St::samples_lights) {
-            const float u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
-            if (!(v.on_surface() && sc.materials.is_delta(material))) {
-                const SampledLight<typename Sc::Spectral> ls = sc.lights.sample(x, u0, u1, u2, lambda);
-                if (ls.sample.pdf > 0.f) {
-                    const auto fv = eval_vertex(sc, v, ray.d, ls.sample.wi, lambda);
-                    const Spectrum& fs = fv.value;
-                    const float p = fv.pdf;
-                    if ((fs != 0.f).any()) {
-                        const bool uni_alternative = St::combines && !ls.sample.delta;
-                        const auto sh = channel_shadow_through<CP, A>(
-                            sc, Ray{x, fv.wi}, shadow_distance(ls.sample.distance),
-                            v.on_surface() ? hit.medium_entered(fv.wi) : medium, lambda, c, st.f, uni_alternative, rng,
-                            counter);
-                        if (sh.end != SegmentEnd::Passed) {
-                            status = shadow_status(sh.end);
-                            if (status == Status::NonFinite) return {Spectrum::Zero(), status};
-                        } else if ((sh.f != 0.f).any()) {
-                            Spectrum seg_pdf = ls.sample.pdf * sh.nee;
-                            if (uni_alternative) seg_pdf += (rr * p) * sh.uni;
-                            L += channel_estimate<CP>(Spectrum(st.f * sh.f * fs), Spectrum(st.uni * seg_pdf), q, c) *
-                                 ls.sample.radiance;
-                        }
-                    }
-                }
-                if constexpr (kEmissive) {
-                    auto side = [&](const Vec3& wi) { return v.on_surface() ? hit.medium_entered(wi) : medium; };
+            auto side = [&](const Vec3& wi) { return v.on_surface() ? hit.medium_entered(wi) : medium; };
+            // Equiangular + NEE alone leaves the lights of a vertex its own vertices cover to them.
+            if (St::combines || !St::equiangular || !eq_covers) {
+                const Status ns = channel_light_event<CP, St, A>(sc, v, x, ray.d, rr, side, lambda, q, c, st.f, st.uni,
+                                                                 eq_pdf, rng, counter, L);
+                if (ns == Status::NonFinite) return {Spectrum::Zero(), ns};  // an overflowed flight
+                if (ns != Status::Ok) status = ns;
+            }
+            if constexpr (kEmissive) {
+                if (!(v.on_surface() && sc.materials.is_delta(material))) {
                     const Status es = channel_emission_event<CP, St, A>(opts, sc, v, x, ray.d, rr, side, lambda, q, c,
                                                                         st, rng, counter, L);
                     if (es == Status::NonFinite) return {Spectrum::Zero(), es};  // an overflowed flight
@@ -217,7 +172,10 @@ RadianceSample<typename Sc::Spectral> spectral_surface_radiance(const EstimatorO
         // delta lobe has none.
         camera_or_delta = next.delta;
         nee_alternative = St::combines && !next.delta;
-        if (nee_alternative) st.nee = st.uni;
+        if (nee_alternative) {
+            st.nee = st.uni;
+            if constexpr (St::equiangular) st.eq.nee = eq_pdf;  // kept apart: emission NEE is from tracked vertices only
+        }
         st.f *= next.value;
         st.uni *= rr * next.pdf;
         if (const StateScale r = st.template renormalize<CP>(c); r != StateScale::Ok) {

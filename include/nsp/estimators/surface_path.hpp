@@ -6,7 +6,10 @@
 // real vertex like a scattering one, with the BSDF's pdf where a medium vertex has the phase
 // function's. Shadow rays cross interfaces the same way, one ratio-tracked piece per medium,
 // their transmittances and null products multiplied. Emitters are the light sampler's lights:
-// surfaces whose hit names one, and the lights at infinity for rays that leave the scene.
+// surfaces whose hit names one, and the lights at infinity for rays that leave the scene, and
+// emissive media (surface_emission.hpp: collision estimator, segment technique and volume NEE per
+// piece). The equiangular strategies draw a vertex on every piece in a medium, aimed at the light
+// sampler's targets (surface_equiangular.hpp).
 #pragma once
 
 #include <cmath>
