@@ -13,6 +13,7 @@
 
 #include "host/shapes.hpp"
 #include "spectral.hpp"
+#include "surfaces.hpp"
 
 namespace {
 
@@ -110,16 +111,10 @@ TEST_CASE_TEMPLATE_DEFINE("spectral surface emission: white walls around two nes
         CAPTURE(spectral_estimator_name<E>());
         const Spec le(0.7f, 0.4f, 1.1f);
         Shapes shapes;
-        for (int a = 0; a < 3; ++a)
-            for (const float side : {-1.f, 1.f}) {
-                Vec3 corner(-1.f), eb(0.f), ec(0.f);
-                corner[a] = side;
-                eb[(a + 1) % 3] = 2.f;
-                ec[(a + 2) % 3] = 2.f;
-                const Vec3 u = side < 0.f ? eb : ec, v = side < 0.f ? ec : eb;  // cross(u, v) inward
-                const bool mirror = shapes.quads.size() == 0 || shapes.quads.size() == 3;
-                shapes.quads.push_back({corner, u, v, {mirror ? 1 : 0, -1, -1, 0}});
-            }
+        for (const CubeFace& f : inward_cube_faces()) {
+            const bool mirror = shapes.quads.size() == 0 || shapes.quads.size() == 3;
+            shapes.quads.push_back({f.corner, f.u, f.v, {mirror ? 1 : 0, -1, -1, 0}});
+        }
         shapes.spheres.push_back({Vec3(0.f), 0.6f, {-1, -1, 1, 0}});
         SceneFor<E> sc(shapes,
                        {emitting<E>(Box{Vec3(-1.f), Vec3(1.f)}, chroma<S>(1.f, 0.5f, 1.5f), chroma<S>(1.5f, 1.f, 0.8f), le, 0.3f),

@@ -14,6 +14,7 @@
 
 #include "host/shapes.hpp"
 #include "spectral.hpp"
+#include "surfaces.hpp"
 
 namespace {
 
@@ -128,17 +129,11 @@ TEST_CASE_TEMPLATE_DEFINE("spectral surfaces: six emitting walls of chromatic al
         CAPTURE(spectral_estimator_name<E>());
         Shapes shapes;
         std::vector<QuadLight<Rgb>> walls;
-        for (int a = 0; a < 3; ++a)
-            for (const float side : {-1.f, 1.f}) {
-                Vec3 corner(-1.f), eb(0.f), ec(0.f);
-                corner[a] = side;
-                eb[(a + 1) % 3] = 2.f;
-                ec[(a + 2) % 3] = 2.f;
-                const Vec3 u = side < 0.f ? eb : ec, v = side < 0.f ? ec : eb;  // normal inward
-                const int index = int(walls.size());
-                walls.push_back({corner, u, v, Rgb::Spectrum::Ones()});
-                shapes.quads.push_back({corner, u, v, {index == 4 ? 1 : 0, index, -1, 0}});
-            }
+        for (const CubeFace& f : inward_cube_faces()) {
+            const int index = int(walls.size());
+            walls.push_back({f.corner, f.u, f.v, Rgb::Spectrum::Ones()});
+            shapes.quads.push_back({f.corner, f.u, f.v, {index == 4 ? 1 : 0, index, -1, 0}});
+        }
         const Rgb::Spectrum albedo(0.5f, 0.3f, 0.7f);
         const SceneFor<E, Rgb> sc(shapes, {medium_for<E, Rgb>(Box{Vec3(-1.f), Vec3(1.f)}, Rgb::Spectrum::Zero(),
                                                               Rgb::Spectrum(0.5f, 1.5f, 3.f))},
@@ -204,14 +199,6 @@ TEST_CASE_TEMPLATE_DEFINE("spectral surfaces: single scattering from two point l
     const Vec3 eye(0.1f, 0.8f, -4.f), dir = glm::normalize(Vec3(-0.1f, -2.3f, 5.f));
     const double s_in = (-1.0 - eye.z) / dir.z, s_out = (-1.0 - eye.y) / dir.y, s_floor = (-1.5 - eye.y) / dir.y;
     const HenyeyGreensteinPhase phase{0.4f};
-    auto exit_distance = [&](const Vec3& p, const Vec3& d) {
-        double t = std::numeric_limits<double>::infinity();
-        for (int a = 0; a < 3; ++a) {
-            if (d[a] > 0.f) t = std::min(t, (double(cube.hi[a]) - p[a]) / d[a]);
-            if (d[a] < 0.f) t = std::min(t, (double(cube.lo[a]) - p[a]) / d[a]);
-        }
-        return t;
-    };
     Rgb::Spectrum expected;
     for (int c = 0; c < 3; ++c) {
         const double st = sigma_t[c];
@@ -237,7 +224,7 @@ TEST_CASE_TEMPLATE_DEFINE("spectral surfaces: single scattering from two point l
             const Vec3 to = l.position - f;
             const double dist = glm::length(to);
             const Vec3 w = to / float(dist);
-            floor_term += rho[c] / kPi * l.intensity[c] * w.y * std::exp(-st * exit_distance(l.position, -w)) / (dist * dist);
+            floor_term += rho[c] / kPi * l.intensity[c] * w.y * std::exp(-st * exit_distance(cube, l.position, -w)) / (dist * dist);
         }
         expected[c] = float(integral + std::exp(-st * (s_out - s_in)) * floor_term);
     }

@@ -11,6 +11,7 @@
 
 #include "common.hpp"
 #include "host/shapes.hpp"
+#include "surfaces.hpp"
 
 namespace {
 
@@ -77,22 +78,16 @@ QuadLight<S> dark_lamp() {
 /// The six walls of [-1, 1]^3 facing inward into medium 0, Lambertian (material 0) or mirrors
 /// (material 1, the walls in `mirrors`), emitting `le` as quad lights when le > 0.
 void walls(float le, const std::vector<int>& mirrors, Shapes& shapes, std::vector<QuadLight<S>>& lights) {
-    for (int a = 0; a < 3; ++a)
-        for (const float side : {-1.f, 1.f}) {
-            Vec3 corner(-1.f), eb(0.f), ec(0.f);
-            corner[a] = side;
-            eb[(a + 1) % 3] = 2.f;
-            ec[(a + 2) % 3] = 2.f;
-            const Vec3 u = side < 0.f ? eb : ec, v = side < 0.f ? ec : eb;  // cross(u, v) inward
-            const int index = int(shapes.quads.size());
-            const bool mirror = std::find(mirrors.begin(), mirrors.end(), index) != mirrors.end();
-            int light = -1;
-            if (le > 0.f) {
-                light = int(lights.size());
-                lights.push_back({corner, u, v, Spectrum::Constant(le)});
-            }
-            shapes.quads.push_back({corner, u, v, {mirror ? 1 : 0, light, -1, 0}});
+    for (const CubeFace& f : inward_cube_faces()) {
+        const int index = int(shapes.quads.size());
+        const bool mirror = std::find(mirrors.begin(), mirrors.end(), index) != mirrors.end();
+        int light = -1;
+        if (le > 0.f) {
+            light = int(lights.size());
+            lights.push_back({f.corner, f.u, f.v, Spectrum::Constant(le)});
         }
+        shapes.quads.push_back({f.corner, f.u, f.v, {mirror ? 1 : 0, light, -1, 0}});
+    }
 }
 
 /// Medium 0 fills the box [-1, 1]^3 but for a sphere of radius 0.6 at the origin behind a null

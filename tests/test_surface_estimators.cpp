@@ -14,6 +14,7 @@
 
 #include "common.hpp"
 #include "host/shapes.hpp"
+#include "surfaces.hpp"
 
 namespace {
 
@@ -68,19 +69,12 @@ void for_each_strategy(F check) {
 /// The six walls of [-1, 1]^3 as quad lights emitting `le` inward, and as shapes naming them
 /// (normals inward; medium 0 on that side); the walls in `mirrors` are mirrors, the rest Lambertian.
 void box_walls(float le, const std::vector<int>& mirrors, Shapes& shapes, std::vector<QuadLight<S>>& lights) {
-    for (int a = 0; a < 3; ++a)
-        for (const float side : {-1.f, 1.f}) {
-            Vec3 corner(-1.f), eb(0.f), ec(0.f);
-            corner[a] = side;
-            eb[(a + 1) % 3] = 2.f;
-            ec[(a + 2) % 3] = 2.f;
-            // cross(eb, ec) is +e_a: inward on the side -1, swapped on the side +1.
-            const Vec3 u = side < 0.f ? eb : ec, v = side < 0.f ? ec : eb;
-            const int index = int(lights.size());
-            const bool mirror = std::find(mirrors.begin(), mirrors.end(), index) != mirrors.end();
-            lights.push_back({corner, u, v, Spectrum::Constant(le)});
-            shapes.quads.push_back({corner, u, v, {mirror ? 1 : 0, index, -1, 0}});
-        }
+    for (const CubeFace& f : inward_cube_faces()) {
+        const int index = int(lights.size());
+        const bool mirror = std::find(mirrors.begin(), mirrors.end(), index) != mirrors.end();
+        lights.push_back({f.corner, f.u, f.v, Spectrum::Constant(le)});
+        shapes.quads.push_back({f.corner, f.u, f.v, {mirror ? 1 : 0, index, -1, 0}});
+    }
 }
 
 TEST_CASE("surface estimators: the furnace of six emitting walls around a medium of albedo 1 (L = 2), camera inside") {
@@ -251,16 +245,6 @@ TEST_CASE("surface estimators: single scattering in a slab over a Lambertian pla
     check(PathEstimator<strategy::DirectionalMis, mis::Balance>(opts), "directional-mis");
     check(PathEstimator<strategy::NullScatteringMis, mis::Balance>(opts), "uni-nee-mis balance");
     check(PathEstimator<strategy::NullScatteringMis, mis::Power, absorption::Event>(opts), "uni-nee-mis power event");
-}
-
-/// The distance from p (inside `b`) along unit d to the box's boundary.
-double exit_distance(const Box& b, const Vec3& p, const Vec3& d) {
-    double t = std::numeric_limits<double>::infinity();
-    for (int a = 0; a < 3; ++a) {
-        if (d[a] > 0.f) t = std::min(t, (double(b.hi[a]) - p[a]) / d[a]);
-        if (d[a] < 0.f) t = std::min(t, (double(b.lo[a]) - p[a]) / d[a]);
-    }
-    return t;
 }
 
 TEST_CASE("surface estimators: single scattering from two point lights in a cube over a floor (quadrature)") {

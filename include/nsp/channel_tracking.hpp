@@ -137,6 +137,23 @@ EventProbabilities shared_event_probabilities(const Coefficients<S>& k, float mu
     return {p[0], p[1], p[2]};
 }
 
+/// Every channel's tracking density mu_bar_c P_s,c of a real scattering vertex with coefficients
+/// k under majorant mu_v (a Spectrum per channel, or a grey float): the channel's own (channel
+/// policies with own pdfs) or the one spectral tracking shares, from the throughput w there. What
+/// an equiangular vertex's tracking pdf needs (THEORY 5.4 with 5.3).
+template <ChannelPolicy CP, AbsorptionPolicy A, SpectralMode S, class V>
+typename S::Spectrum channel_scatter_densities(const Coefficients<S>& k, const V& mu_v,
+                                               const typename S::Spectrum& w) noexcept {
+    using Spectrum = typename S::Spectrum;
+    if constexpr (CP::own_pdfs) {
+        return channel_event_densities<A, S>(k, detail::broadcast_majorant<Spectrum>(mu_v)).scatter;
+    } else {
+        const float m = channel_of(mu_v, 0);
+        return m > 0.f ? Spectrum(Spectrum::Constant(m * shared_event_probabilities<A, CP::throughput_weighted, S>(k, m, w).scatter))
+                       : Spectrum(Spectrum::Zero());
+    }
+}
+
 /// How a per-channel delta-tracked segment ended, and where.
 struct ChannelTrack {
     SegmentEnd end = SegmentEnd::Passed;  ///< Passed, Scattered, Absorbed, Terminated (weight 0), Overflowed or Aborted

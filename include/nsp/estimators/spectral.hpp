@@ -391,7 +391,6 @@ private:
         if (!v) return Status::Rejected;
         const auto& k = v->k;
         const auto& mu_v = v->mu;
-        const Spectrum mu = detail::broadcast_majorant<Spectrum>(mu_v);
         const Spectrum f_x = st.f * sh.f * k.sigma_s;
         if (!(f_x != 0.f).any()) return Status::Ok;
         const Spectrum p_eq = st.uni * sh.nee * ds.pdf;
@@ -399,15 +398,7 @@ private:
         float rr = 1.f;
         if constexpr (St::combines) {
             // Every channel's tracking pdf of the same nulls and of a real scattering vertex at x.
-            Spectrum scatter;
-            if constexpr (CP::own_pdfs) {
-                scatter = channel_event_densities<A, S>(k, mu).scatter;
-            } else {
-                const float m = channel_of(mu_v, 0);
-                scatter = m > 0.f ? Spectrum(Spectrum::Constant(
-                                        m * shared_event_probabilities<A, CP::throughput_weighted, S>(k, m, st.f * sh.f).scatter))
-                                  : Spectrum(Spectrum::Zero());
-            }
+            const Spectrum scatter = channel_scatter_densities<CP, A, S>(k, mu_v, Spectrum(st.f * sh.f));
             p_track = st.uni * sh.uni * scatter;
             // The survival tracking would give x: a function of the path (its f and tracking pdfs).
             if (opts_.russian_roulette && depth >= opts_.rr_start_depth)

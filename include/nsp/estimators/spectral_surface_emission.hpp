@@ -20,6 +20,7 @@
 #include "../path_pdf.hpp"
 #include "../surface_scene.hpp"
 #include "common.hpp"
+#include "surface_emission.hpp"
 #include "surface_walk.hpp"
 
 namespace nsp::detail {
@@ -186,18 +187,10 @@ Status channel_emission_event(const EstimatorOptions& opts, const Sc& sc, const 
                               const typename Sc::Spectral::Wavelengths& lambda, const typename Sc::Spectrum& q, int c,
                               const State& st, R& rng, C& counter, typename Sc::Spectrum& L) {
     using Spectrum = typename Sc::Spectrum;
-    const float us = rng.uniform(), u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform(), u3 = rng.uniform();
-    const int i = sc.select_emission(us);
-    if (i < 0) return Status::Ok;
-    const float select = sc.emission_selection_pdf(i);
+    const auto e = draw_emission_point(sc, x, rng);
+    if (!e) return Status::Ok;
+    const auto& [i, select, y, dist, dist2, wi] = *e;
     const auto& m = sc.media[std::size_t(i)];
-    const VolumeSample y = m.medium.sample_emission(u0, u1, u2, u3);
-    if (!(y.pdf > 0.f) || !(select > 0.f)) return Status::Ok;
-    const Vec3 dv = y.p - x;
-    const float dist2 = glm::dot(dv, dv);
-    if (!(dist2 > 0.f) || !std::isfinite(dist2)) return Status::Ok;
-    const float dist = std::sqrt(dist2);
-    const Vec3 wi = dv / dist;
     const auto fv = eval_vertex(sc, v, wo, wi, lambda);
     if (!(fv.value != 0.f).any()) return Status::Ok;
     const bool with_along = St::combines && opts.emission_along_segments;

@@ -139,7 +139,6 @@ Status channel_equiangular_event(const EstimatorOptions& opts, const Sc& sc, int
     if (!v) return Status::Rejected;
     const auto& k = v->k;
     const auto& mu_v = v->mu;
-    const Spectrum mu = broadcast_majorant<Spectrum>(mu_v);
     const Spectrum f_x = st.f * sh.f * k.sigma_s;
     if (!(f_x != 0.f).any()) return Status::Ok;
     const Spectrum p_eq = st.uni * sh.nee * ds.pdf;
@@ -147,15 +146,7 @@ Status channel_equiangular_event(const EstimatorOptions& opts, const Sc& sc, int
     float rr = 1.f;
     if constexpr (St::combines) {
         // Every channel's tracking pdf of the same nulls and of a real scattering vertex at x.
-        Spectrum scatter;
-        if constexpr (CP::own_pdfs) {
-            scatter = channel_event_densities<A, S>(k, mu).scatter;
-        } else {
-            const float mb = channel_of(mu_v, 0);
-            scatter = mb > 0.f ? Spectrum(Spectrum::Constant(
-                                     mb * shared_event_probabilities<A, CP::throughput_weighted, S>(k, mb, st.f * sh.f).scatter))
-                               : Spectrum(Spectrum::Zero());
-        }
+        const Spectrum scatter = channel_scatter_densities<CP, A, S>(k, mu_v, Spectrum(st.f * sh.f));
         p_track = st.uni * sh.uni * scatter;
         // The survival tracking would give x: a function of the path (its f and tracking pdfs).
         if (opts.russian_roulette && depth >= opts.rr_start_depth)

@@ -17,6 +17,7 @@
 #pragma once
 
 #include <cmath>
+#include <optional>
 
 #include "../core/counter.hpp"
 #include "../core/rng.hpp"
@@ -188,6 +189,35 @@ EmissionShadow<typename Sc::Spectral> emission_shadow(const K& k, const Sc& sc, 
     return fail(Status::InvalidInput);
 }
 
+/// A point of an emissive medium drawn for volume NEE from x (THEORY 5.7 with 5.8): the medium
+/// `index`, picked with probability `select`, the point with its power-grid pdf, and the way to it.
+struct EmissionPoint {
+    int index = -1;
+    float select = 0.f;
+    VolumeSample y;
+    float dist = 0.f, dist2 = 0.f;
+    Vec3 wi{0.f, 0.f, 1.f};  ///< unit direction from x toward y
+};
+
+/// Picks an emissive medium by power and draws a point from its power grid with five random
+/// numbers; std::nullopt when nothing emits or the point is x itself.
+template <class Sc, UniformRng R>
+std::optional<EmissionPoint> draw_emission_point(const Sc& sc, const Vec3& x, R& rng) noexcept {
+    const float us = rng.uniform(), u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform(), u3 = rng.uniform();
+    EmissionPoint e;
+    e.index = sc.select_emission(us);
+    if (e.index < 0) return std::nullopt;
+    e.select = sc.emission_selection_pdf(e.index);
+    e.y = sc.media[std::size_t(e.index)].medium.sample_emission(u0, u1, u2, u3);
+    if (!(e.y.pdf > 0.f) || !(e.select > 0.f)) return std::nullopt;
+    const Vec3 dv = e.y.p - x;
+    e.dist2 = glm::dot(dv, dv);
+    if (!(e.dist2 > 0.f) || !std::isfinite(e.dist2)) return std::nullopt;
+    e.dist = std::sqrt(e.dist2);
+    e.wi = dv / e.dist;
+    return e;
+}
+
 /// NEE toward the emitting volume from real vertex `v` at x (arrived along wo, roulette survival
 /// q, throughput beta; `side_medium` the medium a shadow ray in direction wi starts in, given by
 /// `start_medium(wi)`): adds the weighted contribution to L; returns a failed flight's status.
@@ -196,18 +226,10 @@ Status emission_event(const K& k, const Sc& sc, const SceneVertex& v, const Vec3
                       StartMedium start_medium, const typename Sc::Spectral::Wavelengths& lambda, R& rng, C& counter,
                       const typename Sc::Spectrum& beta, typename Sc::Spectrum& L) {
     using St = typename K::Strategy;
-    const float us = rng.uniform(), u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform(), u3 = rng.uniform();
-    const int i = sc.select_emission(us);
-    if (i < 0) return Status::Ok;
-    const float select = sc.emission_selection_pdf(i);
+    const auto e = draw_emission_point(sc, x, rng);
+    if (!e) return Status::Ok;
+    const auto& [i, select, y, dist, dist2, wi] = *e;
     const auto& m = sc.media[std::size_t(i)];
-    const VolumeSample y = m.medium.sample_emission(u0, u1, u2, u3);
-    if (!(y.pdf > 0.f) || !(select > 0.f)) return Status::Ok;
-    const Vec3 dv = y.p - x;
-    const float dist2 = glm::dot(dv, dv);
-    if (!(dist2 > 0.f) || !std::isfinite(dist2)) return Status::Ok;
-    const float dist = std::sqrt(dist2);
-    const Vec3 wi = dv / dist;
     const auto f = eval_vertex(sc, v, wo, wi, lambda);
     if (!(f.value != 0.f).any()) return Status::Ok;
     const bool with_along = St::combines && k.options().emission_along_segments;
