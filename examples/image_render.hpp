@@ -31,6 +31,7 @@ inline double thread_cpu_seconds() {
 struct Row {
     std::string name;
     double seconds = 0.0, cpu_seconds = 0.0, lookups = 0.0, variance = 0.0, mean = 0.0, se = 0.0;
+    double steps = 0.0;  ///< majorant DDA steps per sample (grid and tree majorants)
     std::uint64_t failed = 0;  ///< paths with a status other than Ok
     nsp_examples::Image image;
 };
@@ -49,7 +50,7 @@ Row render_image(const Sc& scene, const E& estimator, const std::string& name, i
     std::vector<double> pixel_var(std::size_t(res) * std::size_t(res), 0.0), pixel_mean(pixel_var.size(), 0.0);
     std::atomic<int> next{0};
     struct Totals {
-        std::uint64_t lookups = 0, failed = 0;
+        std::uint64_t lookups = 0, steps = 0, failed = 0;
         double cpu = 0.0;
     };
     std::vector<Totals> totals(static_cast<std::size_t>(threads));
@@ -78,15 +79,17 @@ Row render_image(const Sc& scene, const E& estimator, const std::string& name, i
                 pixel_var[pixel] = m2 / (spp - 1);
             }
         out.lookups = counter.count();
+        out.steps = counter.steps;
         out.cpu = thread_cpu_seconds() - cpu0;
     };
     std::vector<std::thread> pool;
     for (int t = 0; t < threads; ++t) pool.emplace_back(work, std::ref(totals[std::size_t(t)]));
     for (auto& t : pool) t.join();
     row.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    double lookups = 0.0;
+    double lookups = 0.0, steps = 0.0;
     for (const Totals& t : totals) {
         lookups += double(t.lookups);
+        steps += double(t.steps);
         row.cpu_seconds += t.cpu;
         row.failed += t.failed;
     }
@@ -97,6 +100,7 @@ Row render_image(const Sc& scene, const E& estimator, const std::string& name, i
         sum_mean += pixel_mean[p];
     }
     row.lookups = lookups / samples;
+    row.steps = steps / samples;
     row.variance = sum_var / n_pixels;
     row.mean = sum_mean / n_pixels;
     row.se = std::sqrt(row.variance / samples);  // the image mean's standard error (pixels independent)

@@ -19,7 +19,7 @@ cd "$(dirname "$0")/.."
 # nsp_test_majorants (every strategy x heuristic x majorant x mode, the slowest to compile); the
 # kernels they drive run here through the stability suite and in the fuzzer. Name them as
 # arguments to run them too.
-default_tests="nsp_test_tracking nsp_test_stability nsp_test_debug nsp_debug_check_fires"
+default_tests="nsp_test_tracking nsp_test_stability nsp_test_debug nsp_debug_check_fires nsp_test_volume_files"
 read -r -a tests <<< "${*:-${NSP_SANITIZE_TESTS:-$default_tests}}"
 
 # clang, not g++: with the sanitizers on, g++ took several times its Release time on these
@@ -28,7 +28,7 @@ scripts/install-packages.sh run-sanitizers clang libclang-rt-dev
 
 CC=clang CXX=clang++ NSP_BUILD_DIR=build-asan NSP_CMAKE_ARGS="-DCMAKE_BUILD_TYPE=Debug \
 -DCMAKE_CXX_FLAGS_DEBUG=-O1 -DNSP_SANITIZE=address,undefined -DNSP_BUILD_EXAMPLES=OFF \
--DNSP_BUILD_BENCHMARKS=OFF" scripts/setup.sh "${tests[@]}"
+-DNSP_BUILD_BENCHMARKS=OFF -DNSP_WITH_OPENVDB=OFF" scripts/setup.sh "${tests[@]}"
 
 export ASAN_OPTIONS="halt_on_error=1:abort_on_error=1:detect_leaks=1:detect_stack_use_after_return=1"
 export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1"

@@ -81,7 +81,9 @@ using PdfCasesOf = std::tuple<PdfCase<S, CP, absorption::Event, ChannelKind>, Pd
                               PdfCase<S, CP, absorption::Event, SignedChannelGridKind>>;
 
 using PdfCases = decltype(std::tuple_cat(PdfCasesOf<Rgb, channels::SpectralMis>{}, PdfCasesOf<Hero<4>, channels::SpectralMis>{},
-                                         PdfCasesOf<Rgb, channels::Independent>{}, PdfCasesOf<Hero<4>, channels::Independent>{}));
+                                         PdfCasesOf<Rgb, channels::Independent>{}, PdfCasesOf<Hero<4>, channels::Independent>{},
+                                         std::tuple<PdfCase<Rgb, channels::SpectralMis, absorption::Weight, ChannelTreeKind>,
+                                                    PdfCase<Hero<4>, channels::Independent, absorption::Event, ChannelTreeKind>>{}));
 
 // Tolerance on log pdfs: float accumulation of a few dozen factors (relative ~1e-6 each) and of
 // optical depths up to ~10; 1e-3 is far below any error in a factor or a missing term.
@@ -226,7 +228,8 @@ using RatioCases = std::tuple<PdfCase<Rgb, channels::SpectralMis, absorption::We
                               PdfCase<Hero<4>, channels::SpectralMis, absorption::Event, GlobalKind>,
                               PdfCase<Rgb, channels::SpectralMis, absorption::Weight, ChannelGridKind>,
                               PdfCase<Hero<4>, channels::SpectralMis, absorption::Event, SignedChannelGridKind>,
-                              PdfCase<Rgb, channels::SpectralMis, absorption::Weight, SignedGridKind>>;
+                              PdfCase<Rgb, channels::SpectralMis, absorption::Weight, SignedGridKind>,
+                              PdfCase<Rgb, channels::SpectralMis, absorption::Event, ChannelTreeKind>>;
 TEST_CASE_TEMPLATE_APPLY(channel_ratio_pdfs, RatioCases);
 
 /// Spectral tracking's pdf in double from the vertices: one grey majorant mu, event probabilities

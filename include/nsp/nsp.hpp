@@ -15,6 +15,7 @@
 #include "light_sampler.hpp"
 #include "majorant.hpp"
 #include "majorants/grid.hpp"
+#include "majorants/tree.hpp"
 #include "media/emissive.hpp"
 #include "media/exponential.hpp"
 #include "media/grid.hpp"

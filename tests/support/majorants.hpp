@@ -37,6 +37,19 @@ struct ChannelGridKind {
     template <class M> using type = ChannelGridMajorant<M>;
     template <class M> static type<M> make(const M& m) { return type<M>(m, kTestGridRes); }
 };
+/// The tree majorants over a layout that does not align with the test grids' voxels either:
+/// 2 x 2 x 1 coarse cells, each split into 2^3 where the density varies.
+inline constexpr std::array<int, 3> kTestTreeCoarse{2, 2, 1};
+struct TreeKind {
+    static constexpr const char* name = "tree";
+    template <class M> using type = TreeMajorant<M>;
+    template <class M> static type<M> make(const M& m) { return type<M>(m, kTestTreeCoarse, 2); }
+};
+struct ChannelTreeKind {
+    static constexpr const char* name = "channel-tree";
+    template <class M> using type = ChannelTreeMajorant<M>;
+    template <class M> static type<M> make(const M& m) { return type<M>(m, kTestTreeCoarse, 2); }
+};
 /// Half the global bound, signed weights (policy a): unbiased; applies to every medium.
 struct SignedGlobalKind {
     static constexpr const char* name = "global-signed-0.5";
@@ -80,10 +93,10 @@ void for_each_kind(F&& f) {
 
 /// The grey majorant kinds the pdf suites run over besides the global majorant: every model and
 /// every bound policy whose pdfs are evaluated independently (Reject only discards).
-using PdfGreyKinds = std::tuple<SignedGlobalKind, GridKind, SignedGridKind, ClampGridKind>;
+using PdfGreyKinds = std::tuple<SignedGlobalKind, GridKind, SignedGridKind, ClampGridKind, TreeKind>;
 
 /// The grey majorant kinds whose estimates are unbiased for the medium itself.
-using UnbiasedGreyKinds = std::tuple<GlobalKind, GridKind, SignedGridKind>;
+using UnbiasedGreyKinds = std::tuple<GlobalKind, GridKind, SignedGridKind, TreeKind>;
 
 /// True when channel c's majorant is positive somewhere on [0, tmax] of `ray`.
 template <Medium M, class Maj>

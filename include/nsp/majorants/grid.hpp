@@ -66,28 +66,49 @@ public:
             int i = int(std::floor((p - box.lo[a]) / cell[a]));
             i = std::clamp(i, 0, res[a] - 1);
             step_[a] = r.d[a] > 0.f ? 1 : (r.d[a] < 0.f ? -1 : 0);
-            if (step_[a] > 0) {  // cell i spans [plane(i), plane(i + 1)) in t
-                while (i > 0 && plane_t(a, i) > t_) --i;
-                while (i < res[a] - 1 && plane_t(a, i + 1) <= t_) ++i;
-                next_[a] = plane_t(a, i + 1);
-            } else if (step_[a] < 0) {  // cell i spans [plane(i + 1), plane(i)) in t
-                while (i < res[a] - 1 && plane_t(a, i + 1) > t_) ++i;
-                while (i > 0 && plane_t(a, i) <= t_) --i;
-                next_[a] = plane_t(a, i);
-            } else {  // parallel: the cell holding o[a]; a ray on a face takes the higher cell
-                while (i < res[a] - 1 && r.o[a] >= plane(a, i + 1)) ++i;
-                while (i > 0 && r.o[a] < plane(a, i)) --i;
-                next_[a] = std::numeric_limits<float>::infinity();
-            }
-            cell_[a] = i;
+            locate(a, i, r.o[a]);
+        }
+    }
+
+    /// A walk through the cells of one cell of a coarser walk (a tree majorant's brick) over
+    /// [in.t0, in.t1], with the ray's inverse direction `inv` as the coarser walk has it (0 where
+    /// the component is 0 or denormal) and 1 / cell size `inv_cell`: no division but where `inv`
+    /// is 0, so entering a brick costs a few multiplications per axis.
+    GridWalk(const Box& box, const std::array<int, 3>& res, const Vec3& cell, const Vec3& inv_cell, const Ray& r,
+             const float* inv, Interval in) noexcept
+        : t_(in.t0), t_end_(in.t1), done_(!(in.t0 < in.t1)) {
+        if (done_) return;
+        for (int a = 0; a < 3; ++a) {
+            lo_[a] = box.lo[a];
+            h_[a] = cell[a];
+            o_[a] = r.o[a];
+            d_[a] = r.d[a];
+            inv_[a] = inv[a];
+            res_[a] = res[a];
+            step_[a] = r.d[a] > 0.f ? 1 : (r.d[a] < 0.f ? -1 : 0);
+            locate(a, std::clamp(int((r.o[a] + r.d[a] * t_ - box.lo[a]) * inv_cell[a]), 0, res[a] - 1), r.o[a]);
         }
     }
 
     /// The next cell crossed (flat index x + nx (y + ny z)) and its stretch [t0, t1); false at the end.
     bool next(std::size_t& index, float& t0, float& t1) noexcept {
+        int c[3];
+        return next(index, t0, t1, c);
+    }
+
+    /// As next(index, t0, t1), and the cell's coordinates c.
+    bool next(std::size_t& index, float& t0, float& t1, int (&c)[3]) noexcept {
         if (done_) return false;
         ++steps_;
-        const int a = next_[0] < next_[1] ? (next_[0] < next_[2] ? 0 : 2) : (next_[1] < next_[2] ? 1 : 2);
+        int a = next_[0] < next_[1] ? (next_[0] < next_[2] ? 0 : 2) : (next_[1] < next_[2] ? 1 : 2);
+        // A step that would leave the grid before t_end is rounding (t_end is where the ray leaves
+        // the grid's box): the cell covers the rest on that axis, so no stretch of [t0, t_end) is
+        // left without a majorant, and the cell is not repeated.
+        while (next_[a] < t_end_ && (cell_[a] + step_[a] < 0 || cell_[a] + step_[a] >= res_[a])) [[unlikely]] {
+            next_[a] = std::numeric_limits<float>::infinity();
+            a = next_[0] < next_[1] ? (next_[0] < next_[2] ? 0 : 2) : (next_[1] < next_[2] ? 1 : 2);
+        }
+        c[0] = cell_[0], c[1] = cell_[1], c[2] = cell_[2];
         index = std::size_t(cell_[0]) + std::size_t(res_[0]) * (std::size_t(cell_[1]) + std::size_t(res_[1]) * std::size_t(cell_[2]));
         t0 = t_;
         t1 = std::max(t_, std::min(next_[a], t_end_));
@@ -96,14 +117,37 @@ public:
             done_ = true;
         } else {
             cell_[a] += step_[a];
-            if (cell_[a] < 0 || cell_[a] >= res_[a]) done_ = true;  // left the box (rounding only)
-            else next_[a] = plane_t(a, step_[a] > 0 ? cell_[a] + 1 : cell_[a]);
+            next_[a] = plane_t(a, step_[a] > 0 ? cell_[a] + 1 : cell_[a]);
         }
         return true;
     }
 
     /// Cells visited so far (DDA steps).
     std::uint32_t steps() const noexcept { return steps_; }
+
+private:
+    /// From a first guess i, the cell of axis a the walk is in at t_ (by the same plane crossings
+    /// every walk of the ray computes), and its exit.
+    void locate(int a, int i, float o) noexcept {
+        if (step_[a] > 0) {  // cell i spans [plane(i), plane(i + 1)) in t
+            while (i > 0 && plane_t(a, i) > t_) --i;
+            while (i < res_[a] - 1 && plane_t(a, i + 1) <= t_) ++i;
+            next_[a] = plane_t(a, i + 1);
+        } else if (step_[a] < 0) {  // cell i spans [plane(i + 1), plane(i)) in t
+            while (i < res_[a] - 1 && plane_t(a, i + 1) > t_) ++i;
+            while (i > 0 && plane_t(a, i) <= t_) --i;
+            next_[a] = plane_t(a, i);
+        } else {  // parallel: the cell holding o; a ray on a face takes the higher cell
+            while (i < res_[a] - 1 && o >= plane(a, i + 1)) ++i;
+            while (i > 0 && o < plane(a, i)) --i;
+            next_[a] = std::numeric_limits<float>::infinity();
+        }
+        cell_[a] = i;
+    }
+
+public:
+    /// 1 / d per axis (0 where d is 0 or denormal), as a brick walk takes it.
+    const float* inverse_direction() const noexcept { return inv_; }
 
 private:
     /// Plane k of axis a, lo + k h: the grid's cell faces.

@@ -1,0 +1,397 @@
+// nsp/io/nanovdb.hpp: media from NanoVDB density grids (fog volumes), and .nvdb files.
+//
+// Optional: needs NanoVDB's headers (Debian: libnanovdb-dev; header-only, no library to link).
+// `nsp/nsp.hpp` does not include it. A NanoVdbMedium is a float density grid, looked up with
+// NanoVDB's own trilinear sampler (values at integer index coordinates, the grid's background 0
+// beyond them), scaled per channel by a coefficient per unit density as DenseGridMedium is. It is
+// a RegionBoundedMedium (so it takes every grid majorant) and a TreeLayoutMedium: TreeMajorant
+// puts its coarse cells on the grid's lower internal nodes (128 voxels a side), splits them into
+// 32-voxel cells and those into the leaves (8 voxels a side), with every bound widened by the voxel layer a trilinear
+// lookup reads across a node's faces.
+//
+// Construction and loading validate everything and throw nsp::InvalidArgument with a message
+// that names the file or grid and what is wrong; lookups never throw and read no mutable state.
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <nanovdb/NanoVDB.h>
+#include <nanovdb/util/GridBuilder.h>
+#include <nanovdb/util/GridHandle.h>
+#include <nanovdb/util/GridValidator.h>
+#include <nanovdb/util/HostBuffer.h>
+#include <nanovdb/util/IO.h>
+#include <nanovdb/util/SampleFromVoxels.h>
+
+#include "../core/error.hpp"
+#include "../majorants/tree.hpp"
+#include "../media/validate.hpp"
+#include "../medium.hpp"
+#include "vol.hpp"
+
+namespace nsp::io {
+
+using NanoHandle = nanovdb::GridHandle<nanovdb::HostBuffer>;
+
+/// A validated NanoVDB float fog volume and what nsp precomputes over it: the box outside which
+/// its density is 0, the largest value and each leaf's largest value (for density bounds).
+class NanoDensityGrid {
+public:
+    /// Takes the grid out of `handle` (its first grid). `what` names it in messages (e.g.
+    /// "grid 'density' of 'smoke.nvdb'"). Throws InvalidArgument unless it is a float grid of
+    /// class fog volume (or unknown), with background 0, an axis-aligned transform (positive
+    /// voxel sizes, no rotation or shear), at least one active voxel, and every value (voxels,
+    /// inactive ones included, and tiles) finite and >= 0.
+    NanoDensityGrid(NanoHandle handle, std::string what) : handle_(std::move(handle)), what_(std::move(what)) {
+        if (handle_.empty()) nsp::detail::fail(what_, " holds no grid");
+        grid_ = handle_.grid<float>();
+        if (!grid_)
+            nsp::detail::fail(what_, " holds ", nanovdb::toStr(handle_.gridType()),
+                         " values; nsp reads float density grids (fog volumes)");
+        const nanovdb::GridClass cls = grid_->gridClass();
+        if (cls == nanovdb::GridClass::LevelSet)
+            nsp::detail::fail(what_, " is a level set (a signed distance field), not a fog volume; convert it to a fog "
+                         "volume (e.g. OpenVDB's sdfToFogVolume) first");
+        if (cls != nanovdb::GridClass::FogVolume && cls != nanovdb::GridClass::Unknown)
+            nsp::detail::fail(what_, " has grid class ", nanovdb::toStr(cls), ", not a fog volume");
+        const float background = grid_->tree().background();
+        if (background != 0.f)
+            nsp::detail::fail(what_, " has background value ", background,
+                         ", which is not allowed: a fog volume's density is 0 outside its active voxels");
+        if (grid_->activeVoxelCount() == 0) nsp::detail::fail(what_, " is empty: it has no active voxels");
+        read_transform();
+        scan_values();
+    }
+
+    /// The trilinear density at world point p (0 outside bounds()).
+    float density(const Vec3& p) const noexcept {
+        if (!bounds_.contains(p)) return 0.f;
+        const auto acc = grid_->getAccessor();
+        const nanovdb::SampleFromVoxels<decltype(acc), 1, false> sample(acc);
+        return sample(nanovdb::Vec3f((p.x - t_f_.x) * inv_s_.x, (p.y - t_f_.y) * inv_s_.y, (p.z - t_f_.z) * inv_s_.z));
+    }
+
+    /// The largest density a lookup can return in world region `region`: the largest voxel value
+    /// among those the trilinear lookups there read (region widened by 1/1000 voxel for rounding).
+    float density_bound(const Box& region) const noexcept {
+        int lo[3], hi[3];
+        for (int a = 0; a < 3; ++a) {
+            const double x0 = (double(region.lo[a]) - t_[a]) / s_[a] - 1e-3, x1 = (double(region.hi[a]) - t_[a]) / s_[a] + 1e-3;
+            const double l = std::max(std::floor(x0), double(nz_lo_[a])), h = std::min(std::floor(x1) + 1.0, double(nz_hi_[a]));
+            if (!(l <= h)) return 0.f;
+            lo[a] = int(l);
+            hi[a] = int(h);
+        }
+        const auto acc = grid_->getAccessor();
+        const auto* first = grid_->tree().getFirstLeaf();
+        float m = 0.f;
+        for (int bz = lo[2] & ~7; bz <= hi[2]; bz += 8)
+            for (int by = lo[1] & ~7; by <= hi[1]; by += 8)
+                for (int bx = lo[0] & ~7; bx <= hi[0]; bx += 8) {
+                    const nanovdb::Coord block(bx, by, bz);
+                    const auto* leaf = acc.probeLeaf(block);
+                    if (!leaf) {  // a tile (or the background): one value over the block
+                        m = std::max(m, acc.getValue(block));
+                        continue;
+                    }
+                    const bool inside = bx >= lo[0] && by >= lo[1] && bz >= lo[2] && bx + 7 <= hi[0] && by + 7 <= hi[1] &&
+                                        bz + 7 <= hi[2];
+                    if (inside) {
+                        m = std::max(m, leaf_max_[std::size_t(leaf - first)]);
+                        continue;
+                    }
+                    for (int z = std::max(bz, lo[2]); z <= std::min(bz + 7, hi[2]); ++z)
+                        for (int y = std::max(by, lo[1]); y <= std::min(by + 7, hi[1]); ++y)
+                            for (int x = std::max(bx, lo[0]); x <= std::min(bx + 7, hi[0]); ++x)
+                                m = std::max(m, leaf->getValue(nanovdb::Coord(x, y, z)));
+                }
+        return m;
+    }
+
+    /// The world box outside which the density is 0: the non-zero values' index box widened by
+    /// one voxel (the trilinear ramp down to the background), mapped to world space.
+    Box bounds() const noexcept { return bounds_; }
+    float max_density() const noexcept { return max_; }
+
+    /// Coarse cells on the lower internal nodes (128^3 voxels, aligned as the tree aligns them),
+    /// split into 4^3 cells of 32^3 voxels and those into 4^3 cells on the leaves (8^3 voxels);
+    /// with `leaf_split` in {2, 4, 8} each leaf splits once more into leaf_split^3 cells.
+    TreeLayout tree_layout(int leaf_split = 1) const noexcept {
+        TreeLayout l;
+        l.split = {4, 4, leaf_split > 1 ? leaf_split : 0};
+        constexpr int C = 128;
+        for (int a = 0; a < 3; ++a) {
+            // Coarse cell k covers index space [128 k, 128 (k + 1)), the lookups between the voxels
+            // of lower node k (a lookup between integer coordinates i and i + 1 reads voxels i and
+            // i + 1); a finest cell j covers [8 j, 8 (j + 1)), leaf j's.
+            const int k0 = floor_div(nz_lo_[a] - 1, C), k1 = floor_div(nz_hi_[a] + 1, C);
+            l.coarse[a] = k1 - k0 + 1;
+            l.box.lo[a] = float(t_[a] + s_[a] * (double(C) * k0));
+            l.box.hi[a] = float(t_[a] + s_[a] * (double(C) * (k1 + 1)));
+            l.box.lo[a] = std::min(l.box.lo[a], bounds_.lo[a]);  // rounding: the box must contain the bounds
+            l.box.hi[a] = std::max(l.box.hi[a], bounds_.hi[a]);
+        }
+        return l;
+    }
+
+    /// Index box of the non-zero values, the voxel size and the index-to-world translation.
+    std::array<int, 3> nonzero_lo() const noexcept { return nz_lo_; }
+    std::array<int, 3> nonzero_hi() const noexcept { return nz_hi_; }
+    Vec3 voxel_size() const noexcept { return Vec3(float(s_.x), float(s_.y), float(s_.z)); }
+    std::uint64_t active_voxels() const noexcept { return grid_->activeVoxelCount(); }
+    std::uint32_t leaf_count() const noexcept { return grid_->tree().nodeCount(0); }
+    /// Bytes: the NanoVDB buffer and the leaf maxima.
+    std::size_t memory_bytes() const noexcept { return handle_.size() + leaf_max_.size() * sizeof(float); }
+    const std::string& name() const noexcept { return what_; }
+    const nanovdb::FloatGrid& grid() const noexcept { return *grid_; }
+
+private:
+    static int floor_div(int a, int b) noexcept { return a >= 0 ? a / b : -((-a + b - 1) / b); }
+
+    void read_transform() {
+        const nanovdb::Map& map = grid_->map();
+        for (int r = 0; r < 3; ++r)
+            for (int c = 0; c < 3; ++c) {
+                const double m = map.mMatD[3 * r + c];
+                if (!std::isfinite(m))
+                    nsp::detail::fail(what_, ": its index-to-world transform has the entry ", m, " at (", r, ", ", c,
+                                 "); it must be finite");
+                if (r != c && std::abs(m) > 1e-9 * (std::abs(map.mMatD[4 * r]) + std::abs(map.mMatD[4 * c])))
+                    nsp::detail::fail(what_, ": its index-to-world transform is rotated or sheared (entry ", m, " at (", r, ", ",
+                                 c, ")); nsp reads axis-aligned grids: resample it to an axis-aligned transform");
+            }
+        for (int a = 0; a < 3; ++a) {
+            s_[a] = map.mMatD[4 * a];
+            t_[a] = map.mVecD[a];
+            if (!(s_[a] > 0.0) || !std::isfinite(t_[a]))
+                nsp::detail::fail(what_, ": its voxel size on axis ", a, " is ", s_[a], " and its translation ", t_[a],
+                             "; the size must be > 0 (no mirroring) and both finite");
+            inv_s_[a] = float(1.0 / s_[a]);
+        }
+        t_f_ = Vec3(float(t_.x), float(t_.y), float(t_.z));
+    }
+
+    /// Checks every value, records each leaf's maximum, the largest value and the index box of
+    /// the non-zero ones (voxels and tiles).
+    void scan_values() {
+        const auto& tree = grid_->tree();
+        nz_lo_ = {INT32_MAX, INT32_MAX, INT32_MAX};
+        nz_hi_ = {INT32_MIN, INT32_MIN, INT32_MIN};
+        auto check = [&](float v, const nanovdb::Coord& ijk, const char* kind) {
+            if (!std::isfinite(v) || v < 0.f)
+                nsp::detail::fail(what_, ": the value ", v, " of the ", kind, " at index (", ijk[0], ", ", ijk[1], ", ", ijk[2],
+                             ") is not allowed: densities must be finite and >= 0");
+        };
+        auto extend = [&](const nanovdb::Coord& lo, int dim) {
+            for (int a = 0; a < 3; ++a) {
+                nz_lo_[a] = std::min(nz_lo_[a], lo[a]);
+                nz_hi_[a] = std::max(nz_hi_[a], lo[a] + dim - 1);
+            }
+        };
+        const std::uint32_t leaves = tree.nodeCount(0);
+        leaf_max_.assign(leaves, 0.f);
+        for (std::uint32_t i = 0; i < leaves; ++i) {
+            const auto& leaf = tree.getFirstLeaf()[i];
+            float m = 0.f;
+            for (std::uint32_t n = 0; n < 512; ++n) {
+                const float v = leaf.getValue(n);
+                check(v, leaf.offsetToGlobalCoord(n), "voxel");
+                if (v > 0.f) extend(leaf.offsetToGlobalCoord(n), 1);
+                m = std::max(m, v);
+            }
+            leaf_max_[i] = m;
+            max_ = std::max(max_, m);
+        }
+        auto tiles = [&](const auto* nodes, std::uint32_t count, std::uint32_t size, int dim, const char* kind) {
+            for (std::uint32_t i = 0; i < count; ++i)
+                for (std::uint32_t n = 0; n < size; ++n) {
+                    if (nodes[i].data()->isChild(n)) continue;
+                    const float v = nodes[i].data()->getValue(n);
+                    check(v, nodes[i].offsetToGlobalCoord(n), kind);
+                    if (v > 0.f) extend(nodes[i].offsetToGlobalCoord(n), dim);
+                    max_ = std::max(max_, v);
+                }
+        };
+        if (tree.nodeCount(1) > 0) tiles(tree.getFirstLower(), tree.nodeCount(1), 16 * 16 * 16, 8, "tile (8^3 voxels)");
+        if (tree.nodeCount(2) > 0) tiles(tree.getFirstUpper(), tree.nodeCount(2), 32 * 32 * 32, 128, "tile (128^3 voxels)");
+        const auto& root = tree.root();
+        for (std::uint32_t i = 0; i < root.tileCount(); ++i) {
+            const auto* tile = root.data()->tile(i);
+            if (tile->isChild()) continue;
+            check(tile->value, tile->origin(), "tile (4096^3 voxels)");
+            if (tile->value > 0.f) extend(tile->origin(), 4096);
+            max_ = std::max(max_, tile->value);
+        }
+        if (!(max_ > 0.f)) {  // every value 0: an empty medium over the active voxels' box
+            const auto& b = tree.bbox();
+            for (int a = 0; a < 3; ++a) nz_lo_[a] = b.min()[a], nz_hi_[a] = b.max()[a];
+        }
+        for (int a = 0; a < 3; ++a) {
+            bounds_.lo[a] = float(t_[a] + s_[a] * double(nz_lo_[a] - 1));
+            bounds_.hi[a] = float(t_[a] + s_[a] * double(nz_hi_[a] + 1));
+            if (!(bounds_.lo[a] < bounds_.hi[a]) || !std::isfinite(bounds_.lo[a]) || !std::isfinite(bounds_.hi[a]))
+                nsp::detail::fail(what_, ": its world box on axis ", a, " is [", bounds_.lo[a], ", ", bounds_.hi[a],
+                             "]; it must be finite and not empty in float");
+        }
+    }
+
+    NanoHandle handle_;
+    std::string what_;
+    const nanovdb::FloatGrid* grid_ = nullptr;
+    glm::dvec3 s_{1.0}, t_{0.0};  ///< world = s * index + t, per axis
+    Vec3 inv_s_{1.f}, t_f_{0.f};
+    std::array<int, 3> nz_lo_{}, nz_hi_{};
+    Box bounds_;
+    float max_ = 0.f;
+    std::vector<float> leaf_max_;
+};
+
+/// A NanoVDB fog volume as a medium: mu_a(p) = density(p) sigma_a_scale, mu_s(p) = density(p)
+/// sigma_s_scale. Copies share the grid (read-only).
+template <SpectralMode S>
+class NanoVdbMedium {
+public:
+    using Spectral = S;
+    using Spectrum = typename S::Spectrum;
+    using Coefficient = typename S::Coefficient;
+
+    /// Throws InvalidArgument on a null grid, a negative or non-finite scale, or an extinction
+    /// bound that overflows.
+    NanoVdbMedium(std::shared_ptr<const NanoDensityGrid> grid, const Coefficient& sigma_a_scale,
+                  const Coefficient& sigma_s_scale)
+        : grid_(std::move(grid)), sigma_a_(sigma_a_scale), sigma_s_(sigma_s_scale) {
+        if (!grid_) nsp::detail::fail("NanoVdbMedium: the density grid is null");
+        nsp::detail::require_coefficient(sigma_a_, "NanoVdbMedium sigma_a_scale");
+        nsp::detail::require_coefficient(sigma_s_, "NanoVdbMedium sigma_s_scale");
+        nsp::detail::require_finite_extinction(max_extinction(),
+                                          "NanoVdbMedium extinction bound max(sigma_a_scale + sigma_s_scale) x max density");
+    }
+
+    Box bounds() const noexcept { return grid_->bounds(); }
+    float density(const Vec3& p) const noexcept { return grid_->density(p); }
+
+    Coefficients<S> coefficients(const Vec3& p, const typename S::Wavelengths& l) const noexcept {
+        const float d = grid_->density(p);
+        return {S::sample(sigma_a_, l) * d, S::sample(sigma_s_, l) * d};
+    }
+    /// Trilinear weights are convex: max density times the extinction scale bounds mu_t.
+    Spectrum extinction_bound(const typename S::Wavelengths& l) const noexcept {
+        return (S::sample(sigma_a_, l) + S::sample(sigma_s_, l)) * grid_->max_density();
+    }
+    float max_extinction() const noexcept { return max_value(sigma_a_ + sigma_s_) * grid_->max_density(); }
+    Coefficient extinction_bound_coefficient() const { return scale<Coefficient>(sigma_a_ + sigma_s_, grid_->max_density()); }
+    Coefficient extinction_per_density() const { return sigma_a_ + sigma_s_; }
+    float density_bound(const Box& region) const noexcept { return grid_->density_bound(region); }
+    TreeLayout tree_layout(int leaf_split = 1) const noexcept { return grid_->tree_layout(leaf_split); }
+    const NanoDensityGrid& grid() const noexcept { return *grid_; }
+
+private:
+    std::shared_ptr<const NanoDensityGrid> grid_;
+    Coefficient sigma_a_, sigma_s_;
+};
+
+static_assert(TreeLayoutMedium<NanoVdbMedium<Mono>> && TreeLayoutMedium<NanoVdbMedium<Rgb>>);
+
+namespace detail_nvdb {
+inline void require_readable(const std::string& path) {
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(path, ec) || !std::ifstream(path, std::ios::binary))
+        nsp::detail::fail("cannot open '", path, "': no such file, or it cannot be read");
+}
+
+/// "'a', 'b'" or "none".
+inline std::string list_names(const std::vector<std::string>& names) {
+    if (names.empty()) return "none";
+    std::string s;
+    for (const auto& n : names) s += (s.empty() ? "'" : ", '") + n + "'";
+    return s;
+}
+}  // namespace detail_nvdb
+
+/// The names of the grids in a .nvdb file. Throws InvalidArgument if it cannot be read or is not
+/// a NanoVDB file.
+inline std::vector<std::string> nvdb_grid_names(const std::string& path) {
+    detail_nvdb::require_readable(path);
+    std::vector<std::string> names;
+    try {
+        for (const auto& m : nanovdb::io::readGridMetaData(path)) names.push_back(m.gridName);
+    } catch (const std::exception& e) {
+        nsp::detail::fail("'", path, "' is not a NanoVDB file nsp can read: ", e.what());
+    }
+    return names;
+}
+
+/// Loads the float fog volume `grid` from a .nvdb file and validates it (its checksum too).
+/// Throws InvalidArgument naming the file on a missing or unreadable file, one that is not
+/// NanoVDB, no grid of that name (the message lists the grids there are), a truncated or
+/// corrupted grid, or any check of NanoDensityGrid.
+inline std::shared_ptr<const NanoDensityGrid> load_nvdb(const std::string& path, const std::string& grid = "density") {
+    const std::vector<std::string> names = nvdb_grid_names(path);
+    if (std::find(names.begin(), names.end(), grid) == names.end())
+        nsp::detail::fail("'", path, "' has no grid named '", grid, "'; its grids are ", detail_nvdb::list_names(names));
+    NanoHandle handle;
+    try {
+        handle = nanovdb::io::readGrid<nanovdb::HostBuffer>(path, grid);
+    } catch (const std::exception& e) {
+        nsp::detail::fail("cannot read grid '", grid, "' of '", path, "': ", e.what());
+    }
+    const std::string what = "grid '" + grid + "' of '" + path + "'";
+    if (handle.empty()) nsp::detail::fail("cannot read ", what, ": the file ends before the grid does (truncated)");
+    if (const auto* g = handle.grid<float>(); g && !nanovdb::isValid(*g, true, false))
+        nsp::detail::fail(what, " is corrupted or truncated: it fails NanoVDB's validation (checksum or layout)");
+    return std::make_shared<const NanoDensityGrid>(std::move(handle), what);
+}
+
+/// Channel `channel` of a voxel grid (e.g. a .vol file's, nsp/io/vol.hpp) as a NanoVDB fog
+/// volume named `name`: voxel (x, y, z) at index (x, y, z), its centre at world
+/// bounds.lo + (x + 1/2, y + 1/2, z + 1/2) * voxel size, zeros left inactive (sparse). Inside the
+/// box between the outer voxel centres the medium is the same as to_dense_medium's; beyond them
+/// NanoVDB's lookup ramps down to 0 over one voxel where DenseGridMedium clamps to the face, so
+/// the two agree everywhere when the outer voxel layer is 0. Throws InvalidArgument on a bad
+/// channel or a grid whose values are all 0 (NanoVDB would have no active voxel).
+inline NanoHandle to_nanovdb(const VoxelGrid& g, int channel = 0, const std::string& name = "density") {
+    const std::vector<float> v = g.channel(channel);
+    nanovdb::GridBuilder<float> builder(0.f, nanovdb::GridClass::FogVolume);
+    builder.setChecksum(nanovdb::ChecksumMode::Full);  // load_nvdb then detects any corrupted byte
+    auto acc = builder.getAccessor();
+    std::size_t i = 0, active = 0;
+    for (int z = 0; z < g.resolution[2]; ++z)
+        for (int y = 0; y < g.resolution[1]; ++y)
+            for (int x = 0; x < g.resolution[0]; ++x, ++i)
+                if (v[i] != 0.f) {
+                    acc.setValue(nanovdb::Coord(x, y, z), v[i]);
+                    ++active;
+                }
+    if (active == 0) nsp::detail::fail("to_nanovdb: channel ", channel, " of the grid is 0 everywhere: a NanoVDB fog volume needs an active voxel");
+    double mat[3][3] = {}, inv[3][3] = {}, t[3];
+    for (int a = 0; a < 3; ++a) {
+        const double h = (double(g.bounds.hi[a]) - double(g.bounds.lo[a])) / double(g.resolution[a]);
+        mat[a][a] = h;
+        inv[a][a] = 1.0 / h;
+        t[a] = double(g.bounds.lo[a]) + 0.5 * h;
+    }
+    nanovdb::Map map;
+    map.set(mat, inv, t, 1.0);
+    return builder.getHandle<nanovdb::AbsDiff>(map, name);
+}
+
+/// Writes a NanoVDB grid as a .nvdb file (no compression). Throws InvalidArgument if it cannot.
+inline void write_nvdb(const std::string& path, const NanoHandle& handle) {
+    try {
+        nanovdb::io::writeGrid(path, handle);
+    } catch (const std::exception& e) {
+        nsp::detail::fail("cannot write '", path, "': ", e.what());
+    }
+    if (!std::filesystem::exists(path)) nsp::detail::fail("cannot write '", path, "'");
+}
+
+}  // namespace nsp::io

@@ -1,0 +1,502 @@
+// nsp/majorants/tree.hpp: majorants that follow a sparse volume's tree, walked hierarchically
+// (THEORY 4, step 1, over several levels).
+//
+// A coarse grid over the medium (by default 8 cells along its longest axis; on a NanoVDB grid's
+// tree, optionally, its lower internal nodes of 128 voxels a side) whose cells are each empty, uniform (one value: a constant tile, or a cell whose
+// parts all bound the same) or split into n^3 cells of the next level where a surface-area cost
+// model says the steps pay for the lookups they save, down to the finest level (by default two
+// splits of 4^3; on a VDB tree 128 -> 32 -> 8 voxels, its leaves). Every
+// value is the medium's density bound over the cell (widened by the voxels a trilinear lookup
+// reads across the cell's faces, as RegionBoundedMedium promises), padded for rounding. Along a
+// ray one DDA per level walks the cells, entering a split cell's node only where the ray crosses
+// it: empty space costs one step per empty cell of the coarsest level that is empty, not one per
+// finest cell, and memory is what the split cells need. The iterator keeps one walk per level in
+// fixed arrays (no heap).
+//
+// A medium that knows its tree says where the nodes are (`tree_layout()`, e.g.
+// io/nanovdb.hpp's NanoVdbMedium); any other RegionBoundedMedium takes a layout of the caller's
+// choice over its bounds. Grey (TreeMajorant) and per channel (ChannelTreeMajorant), as the
+// grid majorants of majorants/grid.hpp, whose DDA this walk reuses at every level.
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include "../core/error.hpp"
+#include "../majorant.hpp"
+#include "../media/validate.hpp"
+#include "../medium.hpp"
+#include "grid.hpp"
+
+namespace nsp {
+
+/// Most levels below the coarse grid a tree majorant may have.
+inline constexpr int kMaxTreeSplits = 3;
+
+/// Where a tree majorant's cells lie: `coarse` cells over `box`; where a cell's bound is neither 0
+/// nor the same over its parts, it splits into split[0]^3 cells, those into split[1]^3, and so
+/// on (a 0 ends the list). `box` must contain the medium's bounds.
+///
+/// A cell splits only where that pays: by a surface-area cost model (as bounding volume
+/// hierarchies are built), a random ray crossing a cell costs one DDA step plus mu_bar times its
+/// mean chord (4 V / S) tentative collisions, each a lookup; split, it costs the step plus each
+/// part's cost weighted by the part's share of the cell's surface (the chance a ray through the
+/// cell crosses it). `step_cost` is a DDA step's cost in lookups (0: split wherever the bound
+/// varies); the default, 0.3, is what bench/bench_majorants measures on this machine (a step
+/// about 20 ns, a trilinear lookup 50 to 75 ns).
+struct TreeLayout {
+    Box box;
+    std::array<int, 3> coarse{1, 1, 1};
+    std::array<int, kMaxTreeSplits> split{8, 0, 0};
+    float step_cost = 0.3f;
+
+    /// The number of levels below the coarse grid.
+    int splits() const noexcept {
+        int n = 0;
+        while (n < kMaxTreeSplits && split[std::size_t(n)] > 0) ++n;
+        return n;
+    }
+};
+
+/// A medium that states the layout of its own sparse tree (coarse cells on its internal nodes,
+/// the finest cells on its leaves).
+template <class M>
+concept TreeLayoutMedium = RegionBoundedMedium<M> && requires(const M& m) {
+    { m.tree_layout() } -> std::same_as<TreeLayout>;
+};
+
+namespace detail {
+
+/// The storage shared by the grey and per-channel tree majorants: the coarse grid's cells, then
+/// per level the nodes (split cells), each n^3 cells of that level's split n; every cell holds its
+/// padded bound and the node it splits into (-1 for none: empty or uniform).
+template <RegionBoundedMedium M>
+class MajorantTree {
+public:
+    MajorantTree(const M& medium, const TreeLayout& layout, float scale, const char* what)
+        : bounds_(medium.bounds()), layout_(layout), levels_(layout.splits() + 1) {
+        std::size_t n = 1;
+        for (int a = 0; a < 3; ++a) {
+            if (layout.coarse[a] < 1 || layout.coarse[a] > 4096)
+                fail(what, " coarse resolution[", a, "] = ", layout.coarse[a], " is not allowed: it must lie in [1, 4096]");
+            n *= std::size_t(layout.coarse[a]);
+        }
+        if (n > (std::size_t(1) << 24))
+            fail(what, " coarse resolution ", layout.coarse[0], "x", layout.coarse[1], "x", layout.coarse[2], " has ", n,
+                 " cells; at most 2^24 are allowed");
+        for (int l = 0; l < kMaxTreeSplits; ++l) {
+            const int k = layout.split[std::size_t(l)];
+            if (k < 0 || k > 64)
+                fail(what, " split[", l, "] = ", k, " cells per axis is not allowed: it must lie in [1, 64] (0 ends the list)");
+            if (l >= levels_ - 1 && k != 0)
+                fail(what, " split[", l, "] = ", k, " follows a 0: the split list ends at its first 0");
+        }
+        const Box& box = layout.box;
+        for (int a = 0; a < 3; ++a) {
+            if (!std::isfinite(box.lo[a]) || !std::isfinite(box.hi[a]) || !(box.lo[a] < box.hi[a]))
+                fail(what, ": the layout's box on axis ", a, " is [", box.lo[a], ", ", box.hi[a],
+                     "]; it must be finite with lo < hi");
+            if (!(box.lo[a] <= bounds_.lo[a] && bounds_.hi[a] <= box.hi[a]))
+                fail(what, ": the layout's box on axis ", a, " is [", box.lo[a], ", ", box.hi[a],
+                     "], which does not contain the medium's bounds [", bounds_.lo[a], ", ", bounds_.hi[a], "]");
+            cell_[0][a] = (box.hi[a] - box.lo[a]) / float(layout.coarse[a]);
+            for (int l = 1; l < levels_; ++l) cell_[l][a] = cell_[l - 1][a] / float(layout.split[std::size_t(l - 1)]);
+            for (int l = 0; l < levels_; ++l) {
+                if (!std::isfinite(cell_[l][a]) || !(cell_[l][a] > 0.f) || !std::isfinite(1.f / cell_[l][a]))
+                    fail(what, " cell size of level ", l, " on axis ", a, " = ", cell_[l][a],
+                         " is not allowed: it must be finite and > 0");
+                inv_cell_[l][a] = 1.f / cell_[l][a];
+            }
+        }
+        if (!std::isfinite(layout.step_cost) || layout.step_cost < 0.f)
+            fail(what, " step_cost = ", layout.step_cost, " is not allowed: it must be finite and >= 0 (lookups per DDA step)");
+        require_coefficient(medium.extinction_per_density(),
+                            (std::string(what) + ": the medium's extinction per unit density").c_str());
+        unit_ = max_value(medium.extinction_per_density());
+        pad_ = kGridMajorantPad * scale;
+        scale_ = scale;
+        values_[0].assign(n, 0.f);
+        if (levels_ > 1) child_[0].assign(n, -1);
+        std::size_t i = 0;
+        for (int z = 0; z < layout.coarse[2]; ++z)
+            for (int y = 0; y < layout.coarse[1]; ++y)
+                for (int x = 0; x < layout.coarse[0]; ++x, ++i) {
+                    const int c[3] = {x, y, z};
+                    const Built b = build(medium, 0, cell_box(box, 0, c, layout.coarse), c, what);
+                    values_[0][i] = b.value;
+                    if (levels_ > 1) child_[0][i] = b.node;
+                    cost_ += b.cost;
+                }
+        for (auto& v : values_) v.shrink_to_fit();
+        for (auto& v : child_) v.shrink_to_fit();
+        for (int l = 0; l < levels_; ++l) {
+            res_[l] = res(l);
+            stride_[l] = per_node(l);
+        }
+    }
+
+    /// Cell c of a level-l grid of `res` cells over `parent` (the last cell's faces on parent's).
+    Box cell_box(const Box& parent, int l, const int* c, const std::array<int, 3>& res) const noexcept {
+        Box b;
+        for (int a = 0; a < 3; ++a) {
+            b.lo[a] = c[a] == 0 ? parent.lo[a] : parent.lo[a] + float(c[a]) * cell_[l][a];
+            b.hi[a] = c[a] + 1 == res[a] ? parent.hi[a] : parent.lo[a] + float(c[a] + 1) * cell_[l][a];
+        }
+        return b;
+    }
+    /// The cells per axis of a node of level l (l >= 1), or of the coarse grid.
+    std::array<int, 3> res(int l) const noexcept {
+        if (l == 0) return layout_.coarse;
+        const int k = layout_.split[std::size_t(l - 1)];
+        return {k, k, k};
+    }
+
+    /// The coarse walk of the ray over the part of [tmin, tmax] inside the medium's bounds.
+    GridWalk walk(const Ray& r, float tmin, float tmax) const noexcept {
+        return {layout_.box, layout_.coarse, cell_[0], r, bounds_.clip(r, tmin, tmax)};
+    }
+    /// The walk through cell c (box `cell`) of level l - 1 over [t0, t1], whose node is of level l.
+    GridWalk child_walk(int l, const Box& cell, const Ray& r, const float* inv_d, float t0, float t1) const noexcept {
+        return {cell, res_[l], cell_[l], inv_cell_[l], r, inv_d, Interval{t0, t1}};
+    }
+
+    /// Cell i of node `node` of level l (the coarse grid: node 0 of level 0).
+    float value(int l, std::int32_t node, std::size_t i) const noexcept {
+        return values_[l][std::size_t(node) * stride_[l] + i];
+    }
+    /// The node cell i of node `node` of level l splits into, or -1 (the finest level has none).
+    std::int32_t child(int l, std::int32_t node, std::size_t i) const noexcept {
+        return l + 1 < levels_ ? child_[l][std::size_t(node) * stride_[l] + i] : -1;
+    }
+    /// The values and children (null at the finest level) of node `node` of level l.
+    const float* node_values(int l, std::int32_t node) const noexcept {
+        return values_[l].data() + std::size_t(node) * stride_[l];
+    }
+    const std::int32_t* node_children(int l, std::int32_t node) const noexcept {
+        return l + 1 < levels_ ? child_[l].data() + std::size_t(node) * stride_[l] : nullptr;
+    }
+    /// The cells per axis of level l's nodes (precomputed).
+    const std::array<int, 3>& level_res(int l) const noexcept { return res_[l]; }
+
+    /// The value of the finest cell holding p (0 outside the medium's bounds).
+    float at_point(const Vec3& p) const noexcept {
+        if (!bounds_.contains(p)) return 0.f;
+        Box b = layout_.box;
+        std::int32_t node = 0;
+        for (int l = 0;; ++l) {
+            const auto r = res(l);
+            int c[3];
+            for (int a = 0; a < 3; ++a) c[a] = std::clamp(int((p[a] - b.lo[a]) * inv_cell_[l][a]), 0, r[a] - 1);
+            const std::size_t i = std::size_t(c[0]) + std::size_t(r[0]) * (std::size_t(c[1]) + std::size_t(r[1]) * std::size_t(c[2]));
+            const std::int32_t ch = child(l, node, i);
+            if (ch < 0) return value(l, node, i);
+            b = cell_box(b, l, c, r);
+            node = ch;
+        }
+    }
+
+    int levels() const noexcept { return levels_; }
+    /// The cost model's expected cost, in lookups, of rays crossing every coarse cell once.
+    double expected_cost() const noexcept { return cost_; }
+    TreeLayout layout() const noexcept { return layout_; }
+    std::size_t coarse_cells() const noexcept { return values_[0].size(); }
+    /// Split cells of level l (nodes of level l + 1).
+    std::size_t split_cells(int l = 0) const noexcept { return l + 1 < levels_ ? values_[l + 1].size() / per_node(l + 1) : 0; }
+    std::size_t empty_cells() const noexcept {
+        std::size_t k = 0;
+        for (std::size_t i = 0; i < values_[0].size(); ++i) k += child(0, 0, i) < 0 && !(values_[0][i] > 0.f);
+        return k;
+    }
+    /// Bytes of storage: a float per cell of every level, and a node index per cell of every level
+    /// but the finest.
+    std::size_t memory_bytes() const noexcept {
+        std::size_t b = 0;
+        for (int l = 0; l < levels_; ++l) b += values_[l].size() * sizeof(float) + child_[l].size() * sizeof(std::int32_t);
+        return b;
+    }
+
+private:
+    std::size_t per_node(int l) const noexcept {
+        if (l == 0) return 0;  // one node: the coarse grid
+        const std::size_t k = std::size_t(layout_.split[std::size_t(l - 1)]);
+        return k * k * k;
+    }
+
+    /// The padded bound of cell `region` of level l and the node it splits into (-1: none).
+    /// What build() decides for a cell: its padded bound, the node it splits into (-1: none) and
+    /// its expected cost per crossing in lookups (the surface-area cost model of TreeLayout).
+    struct Built {
+        float value;
+        std::int32_t node;
+        double cost;
+    };
+
+    /// A random line's mean chord through box b, 4 V / S (Cauchy), and b's surface.
+    static double chord(const Box& b) noexcept {
+        const double x = double(b.hi.x) - b.lo.x, y = double(b.hi.y) - b.lo.y, z = double(b.hi.z) - b.lo.z;
+        return 2.0 * x * y * z / (x * y + y * z + z * x);
+    }
+    static double surface(const Box& b) noexcept {
+        const double x = double(b.hi.x) - b.lo.x, y = double(b.hi.y) - b.lo.y, z = double(b.hi.z) - b.lo.z;
+        return 2.0 * (x * y + y * z + z * x);
+    }
+
+    /// Builds cell `region` of level l: its bound and, where that pays, its split (children first).
+    Built build(const M& medium, int l, const Box& region, const int* c, const char* what) {
+        const float d = medium.density_bound(region);
+        if (!std::isfinite(d) || d < 0.f)
+            fail(what, " level-", l, " cell (", c[0], ", ", c[1], ", ", c[2], "): the medium's density bound = ", d,
+                 " is not allowed: it must be finite and >= 0");
+        const float v = d * pad_;
+        if (!std::isfinite(v * unit_))
+            fail(what, " level-", l, " cell (", c[0], ", ", c[1], ", ", c[2], ") majorant = density bound ", d, " x scale ",
+                 scale_, " x extinction per density ", unit_, " is not allowed: it must be finite");
+        if (d * unit_ > 0.f && !(v * unit_ > 0.f))
+            fail(what, " level-", l, " cell (", c[0], ", ", c[1], ", ", c[2], ") majorant = density bound ", d, " x scale ",
+                 scale_, " x extinction per density ", unit_, " rounds to 0 where the extinction may be ", d * unit_,
+                 "; it must be > 0 there");
+        // As one cell: a step, and mu_bar times the mean chord tentative collisions.
+        const double step = double(layout_.step_cost);
+        const double as_leaf = step + double(v) * double(unit_) * chord(region);
+        if (!(v > 0.f) || l + 1 >= levels_) return {v, -1, as_leaf};  // empty, or a finest cell
+        const auto r = res(l + 1);
+        const std::size_t k = per_node(l + 1);
+        // Nodes the children add below: dropped again if the cell stays whole.
+        std::size_t mark[kMaxTreeSplits + 1];
+        for (int m = l + 1; m < levels_; ++m) mark[m] = values_[m].size();
+        std::vector<float> vals(k);
+        std::vector<std::int32_t> kids(k);
+        bool uniform = true;
+        double as_split = step;  // the step into the cell, then each child in proportion to its surface
+        const double area = surface(region);
+        std::size_t j = 0;
+        for (int z = 0; z < r[2]; ++z)
+            for (int y = 0; y < r[1]; ++y)
+                for (int x = 0; x < r[0]; ++x, ++j) {
+                    const int g[3] = {x, y, z};
+                    const Box part = cell_box(region, l + 1, g, r);
+                    const Built b = build(medium, l + 1, part, g, what);
+                    vals[j] = b.value;
+                    kids[j] = b.node;
+                    as_split += surface(part) / area * b.cost;
+                    uniform = uniform && b.node < 0 && b.value == vals[0];
+                }
+        if (uniform || !(as_split < as_leaf)) {  // a constant tile, or a split that does not pay
+            for (int m = l + 1; m < levels_; ++m) {
+                values_[m].resize(mark[m]);
+                if (m + 1 < levels_) child_[m].resize(mark[m]);
+            }
+            return uniform ? Built{vals[0], -1, step + double(vals[0]) * double(unit_) * chord(region)} : Built{v, -1, as_leaf};
+        }
+        const auto node = std::int32_t(values_[l + 1].size() / k);
+        values_[l + 1].insert(values_[l + 1].end(), vals.begin(), vals.end());
+        if (l + 2 < levels_) child_[l + 1].insert(child_[l + 1].end(), kids.begin(), kids.end());
+        return {v, node, as_split};
+    }
+
+    Box bounds_;
+    TreeLayout layout_;
+    int levels_;
+    Vec3 cell_[kMaxTreeSplits + 1]{}, inv_cell_[kMaxTreeSplits + 1]{};
+    float unit_ = 1.f, pad_ = 1.f, scale_ = 1.f;
+    double cost_ = 0.0;
+    std::vector<float> values_[kMaxTreeSplits + 1];
+    std::vector<std::int32_t> child_[kMaxTreeSplits + 1];
+    // What the walk reads per step, precomputed.
+    std::array<int, 3> res_[kMaxTreeSplits + 1]{};
+    std::size_t stride_[kMaxTreeSplits + 1]{};
+};
+
+/// Walks a MajorantTree depth first: a DDA per level, entering a split cell's node where the
+/// walk crosses it; yields the segments with a non-zero bound, each with value bound * unit.
+template <RegionBoundedMedium M, class V>
+class TreeSegmentIterator {
+public:
+    TreeSegmentIterator() = default;
+    TreeSegmentIterator(const MajorantTree<M>* tree, const Ray& r, float tmin, float tmax, const V& unit) noexcept
+        : tree_(tree), ray_(r), unit_(unit) {
+        std::construct_at(&walks_[0].w, tree->walk(r, tmin, tmax));
+        boxes_[0] = tree->layout().box;
+        vals_[0] = tree->node_values(0, 0);
+        kids_[0] = tree->node_children(0, 0);
+    }
+
+    std::optional<MajorantSegment<V>> next() noexcept {
+        std::size_t i;
+        float t0, t1;
+        int c[3];
+        for (;;) {
+            GridWalk& w = walks_[depth_].w;
+            const float* vals = vals_[depth_];
+            const std::int32_t* kids = kids_[depth_];
+            bool descended = false;
+            while (w.next(i, t0, t1, c)) {
+                if (kids && kids[i] >= 0) {  // a split cell: walk its node
+                    if (!(t1 > t0)) continue;
+                    const std::int32_t child = kids[i];
+                    const Box cell = tree_->cell_box(boxes_[depth_], depth_, c, tree_->level_res(depth_));
+                    ++depth_;
+                    boxes_[depth_] = cell;
+                    vals_[depth_] = tree_->node_values(depth_, child);
+                    kids_[depth_] = tree_->node_children(depth_, child);
+                    std::construct_at(&walks_[depth_].w,
+                                      tree_->child_walk(depth_, cell, ray_, walks_[0].w.inverse_direction(), t0, t1));
+                    descended = true;
+                    break;
+                }
+                const float v = vals[i];
+                if (v > 0.f && t1 > t0) return MajorantSegment<V>{t0, t1, V(unit_ * v)};
+            }
+            if (descended) continue;
+            if (depth_ == 0) return std::nullopt;
+            done_steps_ += w.steps();
+            --depth_;
+        }
+    }
+
+    /// DDA steps taken so far, at every level (empty cells included).
+    std::uint32_t steps() const noexcept {
+        std::uint32_t s = done_steps_;
+        for (int l = 0; l <= depth_; ++l) s += walks_[l].w.steps();
+        return s;
+    }
+
+private:
+    const MajorantTree<M>* tree_ = nullptr;
+    Ray ray_{};
+    V unit_{};
+    int depth_ = 0;
+    std::uint32_t done_steps_ = 0;
+    /// A walk's storage, left unconstructed until the walk enters that level: an iterator is made
+    /// per flight, and zeroing every level's walk each time cost more than the walk (measured).
+    union Slot {
+        Slot() noexcept {}
+        GridWalk w;
+    };
+    static_assert(std::is_trivially_destructible_v<GridWalk> && std::is_trivially_copyable_v<GridWalk>);
+
+    const float* vals_[kMaxTreeSplits + 1];          ///< per level: the values of the node walked
+    const std::int32_t* kids_[kMaxTreeSplits + 1];  ///< per level: its children (null: finest level)
+    Box boxes_[kMaxTreeSplits + 1];
+    Slot walks_[kMaxTreeSplits + 1];
+};
+
+/// A layout over a medium's own bounds: `coarse` cells, each split once into brick^3.
+template <RegionBoundedMedium M>
+TreeLayout layout_over_bounds(const M& medium, std::array<int, 3> coarse, int brick) {
+    if (brick < 1 || brick > 64)
+        fail("TreeMajorant brick = ", brick, " cells per coarse cell and axis is not allowed: it must lie in [1, 64]");
+    return {medium.bounds(), coarse, {brick, 0, 0}, 0.3f};
+}
+
+/// The default layout over a medium's bounds: cubic-ish coarse cells, 8 along the longest axis
+/// and proportionally fewer (at least 1) along the others, each splitting into 4^3 and again into
+/// 4^3 where the cost model says it pays: the finest cells are 1/128 of the longest extent.
+/// Measured on the sparse plume and the dense cloud (docs/volumes.md), this adapts better than
+/// cells on a VDB tree's nodes, which ignore where in a node the density lies.
+template <RegionBoundedMedium M>
+TreeLayout adaptive_layout(const M& medium) {
+    const Box b = medium.bounds();
+    const Vec3 e = b.hi - b.lo;
+    const float longest = std::max({e.x, e.y, e.z});
+    TreeLayout l{b, {1, 1, 1}, {4, 4, 0}, 0.3f};
+    for (int a = 0; a < 3; ++a)
+        l.coarse[a] = longest > 0.f && std::isfinite(longest) ? std::clamp(int(std::lround(8.f * e[a] / longest)), 1, 8) : 1;
+    return l;
+}
+
+}  // namespace detail
+
+/// A grey tree majorant: per cell the bound of the density times the largest extinction per
+/// unit density over every channel (and wavelength). `scale` multiplies every cell: >= 1 under
+/// bound::Guaranteed; any value > 0 under bound::Signed, Clamp or Reject.
+template <RegionBoundedMedium M, BoundPolicy B = bound::Guaranteed>
+class TreeMajorant {
+public:
+    using Bound = B;
+
+    /// The adaptive layout over the medium's bounds (detail::adaptive_layout). For a medium with
+    /// its own tree, TreeMajorant(medium, medium.tree_layout()) puts the cells on its nodes instead.
+    explicit TreeMajorant(const M& medium, float scale = 1.f)
+        : TreeMajorant(medium, detail::adaptive_layout(medium), scale) {}
+    /// Over the medium's bounds: `coarse` cells per axis, each split into `brick`^3.
+    TreeMajorant(const M& medium, std::array<int, 3> coarse, int brick, float scale = 1.f)
+        : TreeMajorant(medium, detail::layout_over_bounds(medium, coarse, brick), scale) {}
+    /// Throws InvalidArgument on a layout outside [1, 4096] coarse cells per axis (2^24 in all) or
+    /// [1, 64] cells per split and axis, a box that does not contain the medium's
+    /// bounds, a scale the policy does not allow, or a cell majorant that overflows, or rounds to
+    /// 0 where the density is not 0.
+    TreeMajorant(const M& medium, const TreeLayout& layout, float scale = 1.f)
+        : tree_(medium, layout, detail::require_majorant_scale<B>(scale, "TreeMajorant scale"), "TreeMajorant"),
+          unit_(max_value(medium.extinction_per_density())) {}
+
+    detail::TreeSegmentIterator<M, float> iterate(const Ray& r, float tmin, float tmax,
+                                                  const typename M::Spectral::Wavelengths&) const noexcept {
+        return {&tree_, r, tmin, tmax, unit_};
+    }
+
+    /// The majorant at point p (its finest cell's; 0 outside the medium's bounds).
+    float value_at(const Vec3& p, const typename M::Spectral::Wavelengths&) const noexcept {
+        return tree_.at_point(p) * unit_;
+    }
+    TreeLayout layout() const noexcept { return tree_.layout(); }
+    /// Coarse cells in all, split (per level l), and empty (the rest are uniform).
+    std::size_t coarse_cells() const noexcept { return tree_.coarse_cells(); }
+    std::size_t split_cells(int l = 0) const noexcept { return tree_.split_cells(l); }
+    std::size_t empty_cells() const noexcept { return tree_.empty_cells(); }
+    std::size_t memory_bytes() const noexcept { return tree_.memory_bytes(); }
+
+private:
+    detail::MajorantTree<M> tree_;
+    float unit_;
+};
+
+/// A per-channel tree majorant: the tree's density bounds times each channel's extinction
+/// per unit density at the path's wavelengths (THEORY 5.3). `scale` as for TreeMajorant.
+template <RegionBoundedMedium M, BoundPolicy B = bound::Guaranteed>
+class ChannelTreeMajorant {
+public:
+    using Bound = B;
+    using Spectral = typename M::Spectral;
+    using Spectrum = typename Spectral::Spectrum;
+
+    /// The adaptive layout over the medium's bounds, as TreeMajorant's.
+    explicit ChannelTreeMajorant(const M& medium, float scale = 1.f)
+        : ChannelTreeMajorant(medium, detail::adaptive_layout(medium), scale) {}
+    ChannelTreeMajorant(const M& medium, std::array<int, 3> coarse, int brick, float scale = 1.f)
+        : ChannelTreeMajorant(medium, detail::layout_over_bounds(medium, coarse, brick), scale) {}
+    /// Throws as TreeMajorant does.
+    ChannelTreeMajorant(const M& medium, const TreeLayout& layout, float scale = 1.f)
+        : tree_(medium, layout, detail::require_majorant_scale<B>(scale, "ChannelTreeMajorant scale"),
+                "ChannelTreeMajorant"),
+          unit_(medium.extinction_per_density()) {}
+
+    detail::TreeSegmentIterator<M, Spectrum> iterate(const Ray& r, float tmin, float tmax,
+                                                     const typename Spectral::Wavelengths& l) const noexcept {
+        return {&tree_, r, tmin, tmax, Spectral::sample(unit_, l)};
+    }
+
+    /// Every channel's majorant at point p (its finest cell's; 0 outside the medium's bounds).
+    Spectrum value_at(const Vec3& p, const typename Spectral::Wavelengths& l) const noexcept {
+        return Spectral::sample(unit_, l) * tree_.at_point(p);
+    }
+    TreeLayout layout() const noexcept { return tree_.layout(); }
+    std::size_t coarse_cells() const noexcept { return tree_.coarse_cells(); }
+    std::size_t split_cells(int l = 0) const noexcept { return tree_.split_cells(l); }
+    std::size_t empty_cells() const noexcept { return tree_.empty_cells(); }
+    std::size_t memory_bytes() const noexcept { return tree_.memory_bytes(); }
+
+private:
+    detail::MajorantTree<M> tree_;
+    typename Spectral::Coefficient unit_;
+};
+
+}  // namespace nsp

@@ -1,0 +1,335 @@
+// tests/test_volume_files.cpp: NanoVDB media (nsp/io/nanovdb.hpp), .nvdb and .vdb files
+// (nsp/io/openvdb.hpp), and the tree majorant over them. Built only when CMake finds NanoVDB
+// (and the .vdb cases only with OpenVDB).
+//
+// - The cloud as a NanoVDB grid is the same medium as DenseGridMedium built from the same values
+//   (its outer voxel layer is 0): densities equal to float rounding at random points; the same
+//   image-plane mean of uni + NEE MIS (k = 5 SE, independent seeds) and lookups per sample within
+//   5 SE under the same tree majorant; written as .nvdb and .vdb and read back, the same grid to
+//   the bit.
+// - The tree majorant on the grid's nodes and the adaptive one bound every lookup along random
+//   rays through the cloud and the sparse plume (exactly), leave no density uncovered, and ratio
+//   and delta tracking match the closed-form transmittance through a grid of constant tiles
+//   (OpenVDB fills them as tiles): along an axis through voxel centres the density is piecewise
+//   linear between index points, so the optical depth is h mu sum(values), exact.
+// - Every bad file gets its message: a missing file, an unknown format, no grid of that name (the
+//   grids there are listed), not float, a level set, a negative or non-finite value, a truncated
+//   or corrupted file, an empty grid, a rotated transform.
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <nsp/io/nanovdb.hpp>
+#if NSP_HAVE_OPENVDB
+#include <nsp/io/openvdb.hpp>
+#include <openvdb/tools/LevelSetSphere.h>
+#endif
+
+#include "common.hpp"
+#include "volume_files.hpp"
+
+namespace {
+
+using namespace nsp_test;
+using doctest::Contains;
+using NM = nsp::io::NanoVdbMedium<Mono>;
+
+constexpr double kSigmas = 5.0;
+
+std::string temp_path(const std::string& name) {
+    const auto dir = std::filesystem::temp_directory_path() / "nsp_test_volume_files";
+    std::filesystem::create_directories(dir);
+    return (dir / name).string();
+}
+
+std::vector<char> read_bytes(const std::string& path) {
+    std::ifstream f(path, std::ios::binary);
+    return {std::istreambuf_iterator<char>(f), {}};
+}
+void write_bytes(const std::string& path, const std::vector<char>& b) {
+    std::ofstream f(path, std::ios::binary);
+    f.write(b.data(), std::streamsize(b.size()));
+}
+
+std::shared_ptr<const nsp::io::NanoDensityGrid> cloud_grid() {
+    return std::make_shared<const nsp::io::NanoDensityGrid>(nsp::io::to_nanovdb(nsp_examples::cloud_voxels()), "cloud");
+}
+
+/// Uni + NEE MIS radiance through the camera rays of a 16 x 16 image of the box, per path: the
+/// mean and its standard error, and lookups per path with theirs.
+template <class M, class Maj>
+std::pair<Stat, Stat> render_stats(const M& medium, const Maj& maj, std::uint64_t seed) {
+    Lights<Mono> lights;
+    lights.set(EnvironmentLight<Mono>{grey<Mono>(0.5f)});
+    lights.set(SphereLight<Mono>{Vec3(0.5f, 2.5f, -1.f), 0.3f, grey<Mono>(40.f)});
+    const auto scene = Scene(medium, maj, HenyeyGreensteinPhase(0.5f), lights);
+    const PathEstimator<strategy::NullScatteringMis, mis::Balance> est;
+    Stat value, lookups;
+    for (int p = 0; p < 256; ++p) {
+        Pcg32 rng(seed, std::uint64_t(p));
+        const Ray r{Vec3(-0.9f + 1.8f * (float(p % 16) + 0.5f) / 16.f, -0.9f + 1.8f * (float(p / 16) + 0.5f) / 16.f, -3.f),
+                    Vec3(0.f, 0.f, 1.f)};
+        for (int k = 0; k < 100; ++k) {
+            LookupCount c;
+            value.add(est.radiance(scene, r, {}, rng, c).value[0]);
+            lookups.add(double(c.count()));
+        }
+    }
+    return {value, lookups};
+}
+
+TEST_CASE("the cloud as a NanoVDB grid is the medium DenseGridMedium gives from the same values") {
+    const auto cloud = nsp_examples::cloud_voxels();
+    using DM = DenseGridMedium<Mono>;
+    const DM dense = nsp::io::to_dense_medium<Mono>(cloud, grey<Mono>(2.f), grey<Mono>(18.f));
+    const NM nano(cloud_grid(), grey<Mono>(2.f), grey<Mono>(18.f));
+    // The cloud's outer voxel layer is 0, so clamping (dense) and fading to 0 (NanoVDB) agree.
+    Pcg32 rng(3, 1);
+    double worst = 0.0;
+    for (int i = 0; i < 200000; ++i) {
+        const Vec3 p = random_point(rng, Box{Vec3(-1.05f), Vec3(1.05f)});
+        worst = std::max(worst, double(std::abs(dense.density(p) - nano.density(p))));
+    }
+    CHECK(worst <= 1e-6);  // the same trilinear weights, rounded in another order
+    CHECK(nano.max_extinction() == doctest::Approx(dense.max_extinction()).epsilon(1e-6));
+    // The same image mean (independent seeds: 5 combined SE), and under the same tree majorant
+    // (one layout over the dense grid's box, which holds the NanoVDB grid's bounds: the same
+    // density bounds in every cell) the same lookups per path within 5 SE.
+    const TreeLayout layout{dense.bounds(), {8, 8, 8}, {4, 4, 0}, 0.3f};
+    const TreeMajorant<NM> nano_tree(nano, layout);
+    const TreeMajorant<DM> dense_tree(dense, layout);
+    CHECK(nano_tree.split_cells(0) == dense_tree.split_cells(0));
+    CHECK(nano_tree.split_cells(1) == dense_tree.split_cells(1));
+    const auto [vn, ln] = render_stats(nano, nano_tree, 1);
+    const auto [vd, ld] = render_stats(dense, dense_tree, 2);
+    CAPTURE(vn.mean);
+    CAPTURE(vd.mean);
+    CHECK(std::abs(vn.mean - vd.mean) <= kSigmas * std::hypot(vn.se(), vd.se()));
+    CAPTURE(ln.mean);
+    CAPTURE(ld.mean);
+    CHECK(std::abs(ln.mean - ld.mean) <= kSigmas * std::hypot(ln.se(), ld.se()));
+    CHECK(vn.mean > 0.05);
+}
+
+template <class M, class Maj>
+void check_bounds_along_rays(const M& medium, const Maj& maj, const char* name) {
+    CAPTURE(name);
+    const Box b = medium.bounds();
+    const Box around{b.lo - 0.3f * (b.hi - b.lo), b.hi + 0.3f * (b.hi - b.lo)};
+    Pcg32 rng(41, 3);
+    int covered = 0;
+    for (int i = 0; i < 400; ++i) {
+        const Ray r{random_point(rng, around), random_direction(rng)};
+        std::vector<MajorantSegment<float>> segs;
+        auto it = maj.iterate(r, 0.f, kInf, {});
+        while (auto s = it.next()) segs.push_back(*s);
+        for (const auto& s : segs)
+            for (int k = 0; k < 8; ++k) {
+                const float t = k == 0 ? s.t0 : s.t0 + (s.t1 - s.t0) * rng.uniform();
+                CHECK(medium.coefficients(r.at(t), {}).sigma_t()[0] <= s.sigma_maj);  // exact
+            }
+        const Interval in = b.clip(r, 0.f, kInf);
+        for (int k = 0; k < 50 && !in.empty(); ++k) {
+            const float t = in.t0 + (in.t1 - in.t0) * rng.uniform();
+            if (!(medium.density(r.at(t)) > 0.f)) continue;
+            ++covered;
+            bool inside = false;
+            for (const auto& s : segs) inside = inside || (s.t0 <= t && t < s.t1);
+            CHECK(inside);
+        }
+    }
+    CHECK(covered > 100);
+}
+
+TEST_CASE("tree majorants over NanoVDB grids bound every lookup, dense cloud and sparse plume") {
+    const NM cloud(cloud_grid(), grey<Mono>(2.f), grey<Mono>(18.f));
+    check_bounds_along_rays(cloud, TreeMajorant<NM>(cloud), "cloud, adaptive");
+    check_bounds_along_rays(cloud, TreeMajorant<NM>(cloud, cloud.tree_layout()), "cloud, on the nodes");
+    check_bounds_along_rays(cloud, TreeMajorant<NM>(cloud, cloud.tree_layout(2)), "cloud, leaves split in 2");
+    const NM plume(std::make_shared<const nsp::io::NanoDensityGrid>(nsp_examples::plume_nanovdb(128), "plume"),
+                   grey<Mono>(20.f), grey<Mono>(180.f));
+    check_bounds_along_rays(plume, TreeMajorant<NM>(plume), "plume, adaptive");
+    check_bounds_along_rays(plume, TreeMajorant<NM>(plume, plume.tree_layout()), "plume, on the nodes");
+    // The plume is sparse: it fills a small part of its box, and the tree leaves coarse cells empty.
+    CHECK(double(plume.grid().active_voxels()) < 0.03 * 128.0 * 128.0 * 128.0);
+    CHECK(TreeMajorant<NM>(plume).empty_cells() > 0);
+}
+
+TEST_CASE(".nvdb files round-trip the grid to the bit, and bad ones are rejected with their problem") {
+    const std::string path = temp_path("cloud.nvdb");
+    nsp::io::write_nvdb(path, nsp::io::to_nanovdb(nsp_examples::cloud_voxels()));
+    const auto back = nsp::io::load_nvdb(path);
+    const auto direct = cloud_grid();
+    Pcg32 rng(9, 9);
+    for (int i = 0; i < 20000; ++i) {
+        const Vec3 p = random_point(rng, Box{Vec3(-1.f), Vec3(1.f)});
+        REQUIRE(back->density(p) == direct->density(p));
+    }
+    CHECK(nsp::io::nvdb_grid_names(path) == std::vector<std::string>{"density"});
+
+    CHECK_THROWS_WITH_AS(nsp::io::load_nvdb(temp_path("missing.nvdb")), Contains("no such file, or it cannot be read"),
+                         InvalidArgument);
+    CHECK_THROWS_WITH_AS(nsp::io::load_nvdb(path, "smoke"),
+                         Contains("has no grid named 'smoke'; its grids are 'density'"), InvalidArgument);
+    const std::string junk = temp_path("junk.nvdb");
+    write_bytes(junk, std::vector<char>(300, 'x'));
+    CHECK_THROWS_WITH_AS(nsp::io::load_nvdb(junk), Contains("is not a NanoVDB file"), InvalidArgument);
+    // Every truncation (at 60 points) and corrupted bytes: each is rejected or reads a valid grid,
+    // and a truncated file is never accepted.
+    const std::vector<char> bytes = read_bytes(path);
+    const std::string cut = temp_path("cut.nvdb");
+    for (int k = 0; k < 60; ++k) {
+        const std::size_t n = bytes.size() * std::size_t(k) / 60;
+        write_bytes(cut, std::vector<char>(bytes.begin(), bytes.begin() + std::ptrdiff_t(n)));
+        CAPTURE(n);
+        CHECK_THROWS_AS(nsp::io::load_nvdb(cut), InvalidArgument);
+    }
+    int rejected = 0;
+    for (std::size_t at = 200; at < bytes.size(); at += bytes.size() / 50) {
+        std::vector<char> bad = bytes;
+        bad[at] = char(bad[at] ^ 0x5a);
+        write_bytes(cut, bad);
+        try {
+            (void)nsp::io::load_nvdb(cut);
+        } catch (const InvalidArgument&) {
+            ++rejected;
+        }
+    }
+    CHECK(rejected > 40);  // nsp writes full checksums: they catch a flipped byte almost anywhere
+}
+
+TEST_CASE("NanoVDB grids nsp cannot render are rejected, naming the problem") {
+    auto build = [](float value, nanovdb::GridClass cls, float background = 0.f) {
+        nanovdb::GridBuilder<float> b(background, cls);
+        auto acc = b.getAccessor();
+        acc.setValue(nanovdb::Coord(1, 2, 3), 1.f);
+        acc.setValue(nanovdb::Coord(4, 2, 3), value);
+        return b.getHandle<nanovdb::AbsDiff>(0.1, nanovdb::Vec3d(0.0), "density");
+    };
+    auto make = [](nsp::io::NanoHandle h) { return nsp::io::NanoDensityGrid(std::move(h), "grid 'density' of 'x.nvdb'"); };
+    CHECK_THROWS_WITH_AS(make(build(-0.5f, nanovdb::GridClass::FogVolume)),
+                         Contains("the value -0.5 of the voxel at index (4, 2, 3) is not allowed"), InvalidArgument);
+    CHECK_THROWS_WITH_AS(make(build(std::nanf(""), nanovdb::GridClass::FogVolume)), Contains("nan of the voxel"),
+                         InvalidArgument);
+    CHECK_THROWS_WITH_AS(make(build(1.f, nanovdb::GridClass::LevelSet)), Contains("is a level set"), InvalidArgument);
+    CHECK_THROWS_WITH_AS(make(build(1.f, nanovdb::GridClass::FogVolume, 0.25f)),
+                         Contains("has background value 0.25, which is not allowed"), InvalidArgument);
+    nanovdb::GridBuilder<float> none(0.f, nanovdb::GridClass::FogVolume);
+    CHECK_THROWS_WITH_AS(make(none.getHandle<nanovdb::AbsDiff>(0.1, nanovdb::Vec3d(0.0), "density")),
+                         Contains("is empty: it has no active voxels"), InvalidArgument);
+    nanovdb::GridBuilder<nanovdb::Vec3f> vec(nanovdb::Vec3f(0.f));
+    vec.getAccessor().setValue(nanovdb::Coord(0), nanovdb::Vec3f(1.f));
+    CHECK_THROWS_WITH_AS(make(vec.getHandle<nanovdb::AbsDiff>(0.1, nanovdb::Vec3d(0.0), "velocity")),
+                         Contains("holds Vec3f values; nsp reads float density grids"), InvalidArgument);
+    nanovdb::Map rotated;
+    const double m[3][3] = {{0.0, -0.1, 0.0}, {0.1, 0.0, 0.0}, {0.0, 0.0, 0.1}}, inv[3][3] = {{0.0, 10.0, 0.0}, {-10.0, 0.0, 0.0}, {0.0, 0.0, 10.0}};
+    const double t[3] = {0.0, 0.0, 0.0};
+    rotated.set(m, inv, t, 1.0);
+    nanovdb::GridBuilder<float> rb(0.f, nanovdb::GridClass::FogVolume);
+    rb.getAccessor().setValue(nanovdb::Coord(0), 1.f);
+    CHECK_THROWS_WITH_AS(make(rb.getHandle<nanovdb::AbsDiff>(rotated, "density")), Contains("is rotated or sheared"),
+                         InvalidArgument);
+    CHECK_THROWS_WITH_AS(NM(nullptr, grey<Mono>(1.f), grey<Mono>(1.f)), Contains("the density grid is null"),
+                         InvalidArgument);
+}
+
+#if NSP_HAVE_OPENVDB
+TEST_CASE(".vdb files load through OpenVDB as the same grid; bad ones are rejected with their problem") {
+    const std::string path = temp_path("cloud.vdb");
+    nsp::io::write_vdb(path, {nsp_examples::voxels_vdb(nsp_examples::cloud_voxels())});
+    const auto vdb = nsp::io::load_vdb(path);
+    const auto direct = cloud_grid();
+    Pcg32 rng(5, 5);
+    for (int i = 0; i < 20000; ++i) {
+        const Vec3 p = random_point(rng, Box{Vec3(-1.f), Vec3(1.f)});
+        REQUIRE(vdb->density(p) == doctest::Approx(direct->density(p)).epsilon(1e-6));
+    }
+    openvdb::initialize();
+    // Several grids: a level set, a vector grid and a negative one beside the density.
+    auto sphere = openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(1.f, openvdb::Vec3f(0.f), 0.1f);
+    sphere->setName("surface");
+    auto negative = nsp_examples::empty_vdb_grid(0.1, openvdb::Vec3d(0.0));
+    negative->setName("negative");
+    negative->getAccessor().setValue(openvdb::Coord(2, 3, 4), -2.f);
+    auto empty = nsp_examples::empty_vdb_grid(0.1, openvdb::Vec3d(0.0));
+    empty->setName("empty");
+    auto rotated = nsp_examples::empty_vdb_grid(0.1, openvdb::Vec3d(0.0));
+    rotated->setName("rotated");
+    rotated->getAccessor().setValue(openvdb::Coord(0), 1.f);
+    rotated->transform().preRotate(0.3, openvdb::math::Y_AXIS);
+    auto vel = openvdb::Vec3SGrid::create();
+    vel->setName("vel");
+    vel->getAccessor().setValue(openvdb::Coord(0), openvdb::Vec3s(1.f));
+    const std::string many = temp_path("many.vdb");
+    openvdb::io::File(many).write({nsp_examples::voxels_vdb(nsp_examples::cloud_voxels()), sphere, negative, empty, rotated, vel});
+    CHECK(nsp::io::vdb_grids(many).size() == 6);
+    CHECK_NOTHROW(nsp::io::load_vdb(many));
+    CHECK_THROWS_WITH_AS(nsp::io::load_vdb(many, "smoke"),
+                         Contains("has no grid named 'smoke'; its grids are 'density' (float, fog volume), 'empty' (float, fog "
+                                  "volume), 'negative' (float, fog volume), 'rotated' (float, fog volume), 'surface' "
+                                  "(float, level set), 'vel' (vec3s, unknown)"),
+                         InvalidArgument);
+    CHECK_THROWS_WITH_AS(nsp::io::load_vdb(many, "surface"), Contains("is a level set"), InvalidArgument);
+    CHECK_THROWS_WITH_AS(nsp::io::load_vdb(many, "vel"), Contains("holds vec3s values"), InvalidArgument);
+    CHECK_THROWS_WITH_AS(nsp::io::load_vdb(many, "negative"),
+                         Contains("the value -2 of the voxel at index (2, 3, 4) is not allowed"), InvalidArgument);
+    CHECK_THROWS_WITH_AS(nsp::io::load_vdb(many, "empty"), Contains("is empty: it has no active voxels"), InvalidArgument);
+    CHECK_THROWS_WITH_AS(nsp::io::load_vdb(many, "rotated"), Contains("is rotated or sheared"), InvalidArgument);
+    CHECK_THROWS_WITH_AS(nsp::io::load_vdb(temp_path("missing.vdb")), Contains("no such file"), InvalidArgument);
+    const std::string junk = temp_path("junk.vdb");
+    write_bytes(junk, std::vector<char>(300, 'x'));
+    CHECK_THROWS_WITH_AS(nsp::io::load_vdb(junk), Contains("is not an OpenVDB file nsp can read"), InvalidArgument);
+    const std::vector<char> bytes = read_bytes(path);
+    const std::string cut = temp_path("cut.vdb");
+    for (const double f : {0.05, 0.3, 0.6, 0.9, 0.99}) {
+        write_bytes(cut, std::vector<char>(bytes.begin(), bytes.begin() + std::ptrdiff_t(double(bytes.size()) * f)));
+        CAPTURE(f);
+        CHECK_THROWS_AS(nsp::io::load_vdb(cut), InvalidArgument);
+    }
+}
+
+TEST_CASE("tracking through OpenVDB's constant tiles matches the closed-form transmittance") {
+    // Tiles of an OpenVDB grid (filled boxes become 8^3 and 128^3 tiles), voxel size 0.05:
+    // density 1 over index [0, 255] x [0, 127] x [0, 127] (two 128^3 tiles), 3 over [64, 71] x
+    // [8, 15] x [8, 15] (an 8^3 tile inside a leafless node) and 0.5 over [200, 215] x [0, 7] x
+    // [0, 7]. Along +x at index (j, k) the density is linear between index points and 0 one
+    // voxel beyond the last non-zero one, so tau = h mu sum_i v(i, j, k).
+    const double h = 0.05;
+    auto grid = nsp_examples::empty_vdb_grid(h, openvdb::Vec3d(0.0));
+    grid->tree().fill(openvdb::CoordBBox(openvdb::Coord(0, 0, 0), openvdb::Coord(255, 127, 127)), 1.f, true);
+    grid->tree().fill(openvdb::CoordBBox(openvdb::Coord(64, 8, 8), openvdb::Coord(71, 15, 15)), 3.f, true);
+    grid->tree().fill(openvdb::CoordBBox(openvdb::Coord(200, 0, 0), openvdb::Coord(215, 7, 7)), 0.5f, true);
+    CHECK(grid->tree().leafCount() == 0);  // all tiles
+    const std::string path = temp_path("tiles.vdb");
+    nsp::io::write_vdb(path, {grid});
+    const auto g = nsp::io::load_vdb(path);
+    const float mu = 0.5f;
+    const NM medium(g, grey<Mono>(0.1f * mu), grey<Mono>(0.9f * mu));
+    const auto acc = grid->getConstAccessor();
+    Pcg32 rng(17, 2);
+    for (const auto& [j, k] : {std::pair{10, 12}, std::pair{3, 3}, std::pair{100, 50}}) {
+        double sum = 0.0;
+        for (int i = -2; i < 260; ++i) sum += acc.getValue(openvdb::Coord(i, j, k));
+        const double want = std::exp(-h * double(mu) * sum);
+        const Ray r{Vec3(-1.f, float(j * h), float(k * h)), Vec3(1.f, 0.f, 0.f)};
+        for (const auto& maj : {TreeMajorant<NM>(medium), TreeMajorant<NM>(medium, medium.tree_layout())}) {
+            Stat ratio, delta;
+            LookupCount c;
+            for (int n = 0; n < 20000; ++n) {
+                ratio.add(transmittance_ratio(medium, maj, r, kInf, {}, rng, c)[0]);
+                delta.add(transmittance_delta(medium, maj, r, kInf, {}, rng, c)[0]);
+            }
+            CAPTURE(j);
+            CAPTURE(want);
+            CHECK(std::abs(ratio.mean - want) <= kSigmas * ratio.se() + kRoundingFloor);
+            CHECK(std::abs(delta.mean - want) <= kSigmas * delta.se() + kRoundingFloor);
+        }
+        CHECK(want < 0.9);
+    }
+}
+#endif
+
+}  // namespace
