@@ -7,7 +7,7 @@
 //
 //   nsp_volume FILE [--grid NAME] [--channel C] [--density-scale S] [--albedo A] [--g G]
 //              [--majorant global|grid|tree|tree-nodes] [--grid-res N] [--tree-step-cost C]
-//              [--tree-split N] [--compare-majorants]
+//              [--tree-split N] [--compare-majorants [--runs N]]
 //              [--res N] [--spp N] [--threads N] [--out DIR] [--no-png]
 //   nsp_volume --export-cloud FILE      (.vol, .nvdb or .vdb)
 //   nsp_volume --export-plume FILE [--plume-res N]
@@ -42,7 +42,7 @@ using nsp_examples::Row;
 
 struct Options {
     float g = 0.5f;
-    int res = 128, spp = 64, threads = 1;
+    int res = 128, spp = 64, threads = 1, runs = 1;
     std::string out = "out";
     bool no_png = false;
 };
@@ -156,9 +156,25 @@ std::uint64_t compare_majorants(const M& medium, const Options& o) {
         return std::pair{std::move(maj), ms};
     };
     std::uint64_t seed = 1;
+    // Each row o.runs times with other seeds; the row reports the median of each column (the
+    // variance of one run moves by tens of percent between seeds at these sizes).
     auto run = [&](const auto& maj, double ms, std::size_t bytes, const std::string& name) {
         const auto scene = Scene(medium, maj, HenyeyGreensteinPhase(o.g), cam.lights);
-        rows.push_back(nsp_examples::render_image(scene, est, name, o.res, o.spp, o.threads, seed++, cam));
+        std::vector<Row> runs;
+        for (int k = 0; k < o.runs; ++k)
+            runs.push_back(nsp_examples::render_image(scene, est, name, o.res, o.spp, o.threads, seed + 1000u * std::uint64_t(k), cam));
+        ++seed;
+        auto median = [&](double Row::*field) {
+            std::vector<double> v;
+            for (const Row& r : runs) v.push_back(r.*field);
+            std::sort(v.begin(), v.end());
+            return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+        };
+        Row row = runs.front();
+        for (double Row::*f : {&Row::seconds, &Row::cpu_seconds, &Row::lookups, &Row::steps, &Row::variance, &Row::mean, &Row::se})
+            row.*f = median(f);
+        for (std::size_t k = 1; k < runs.size(); ++k) row.failed += runs[k].failed;
+        rows.push_back(std::move(row));
         cost.emplace_back(bytes, ms);
     };
     {
@@ -235,6 +251,8 @@ int main(int argc, char** argv) {
         ->check(CLI::IsMember({1, 2, 4, 8}));
     app.add_option("--tree-step-cost", g_step_cost, "the tree's cost model: a DDA step's cost in lookups")
         ->check(CLI::Range(0.f, 100.f));
+    app.add_option("--runs", o.runs, "with --compare-majorants: runs per row (other seeds); each column their median")
+        ->check(CLI::Range(1, 99));
     app.add_flag("--compare-majorants", compare, "render uni-nee-mis under the global, grid 16^3 and 64^3 and tree majorants");
     app.add_option("--res", o.res, "image width and height in pixels")->check(CLI::Range(1, 4096));
     app.add_option("--spp", o.spp, "samples per pixel")->check(CLI::Range(2, 1 << 20));
@@ -262,7 +280,8 @@ int main(int argc, char** argv) {
         nsp_examples::require_format(file, ext);
         const auto sigma_a = nsp::Mono::Spectrum::Constant(density_scale * (1.f - albedo));
         const auto sigma_s = nsp::Mono::Spectrum::Constant(density_scale * albedo);
-        const std::string label = majorant_label(majorant, grid_res, compare);
+        std::string label = majorant_label(majorant, grid_res, compare);
+        if (compare && o.runs > 1) label += ", median of " + std::to_string(o.runs) + " runs per row";
         if (ext == ".vol") {
             const nsp::io::VoxelGrid grid = nsp::io::load_vol(file);
             using M = nsp::DenseGridMedium<nsp::Mono>;

@@ -44,8 +44,8 @@ inline std::vector<Puff> plume_puffs() {
 /// Calls f(i, j, k, density) once for every voxel of a smoke plume of res^3 voxels whose density
 /// is not 0, slice by slice in j. The plume is a union of puffs (plume_puffs) along a rising
 /// helix, each dense at its centre and falling off to 0 at its radius, thinning with height and
-/// broken into wisps by two octaves of value noise. It fills about 1% of its box and a few percent
-/// of its own bounding box: most of the space a ray crosses is empty, the case tree majorants are for.
+/// broken into wisps by two octaves of value noise. It fills about 0.5% of its box and 3% of its own
+/// bounding box: most of the space a ray crosses is empty, the case tree majorants are for.
 template <class F>
 void for_each_plume_voxel(int res, F&& f) {
     const double h = plume_voxel_size(res);

@@ -37,7 +37,8 @@ template <SpectralMode S>
 DenseGridMedium<S> test_volume(const Box& b, std::array<int, 3> res, bool dense, const typename S::Coefficient& sa,
                                const typename S::Coefficient& ss, std::uint64_t seed) {
     Pcg32 rng(seed, 7);
-    std::vector<float> d(std::size_t(res[0]) * std::size_t(res[1]) * std::size_t(res[2]), 0.f);
+    const std::size_t voxels = std::size_t(res[0]) * std::size_t(res[1]) * std::size_t(res[2]);
+    std::vector<float> d(voxels, 0.f);
     const Vec3 centres[] = {Vec3(0.2f, 0.3f, 0.25f), Vec3(0.7f, 0.6f, 0.8f), Vec3(0.8f, 0.15f, 0.3f)};
     std::size_t i = 0;
     for (int z = 0; z < res[2]; ++z)
@@ -127,8 +128,10 @@ TEST_CASE("every tree majorant segment bounds the lookup, and the segments leave
         const auto rgb = test_volume<Rgb>(b, {40, 24, 33}, dense, spec<Rgb>(0.3f, 0.1f, 2.f), spec<Rgb>(0.7f, 1.9f, 6.f), 3);
         using M = DenseGridMedium<Rgb>;
         // Coarse cells that do not align with the voxels, bricks of 1 to 8 fine cells.
-        for (const auto& [coarse, brick] : {std::pair{std::array<int, 3>{3, 2, 4}, 4}, std::pair{std::array<int, 3>{5, 3, 4}, 8},
-                                            std::pair{std::array<int, 3>{1, 1, 1}, 16}, std::pair{std::array<int, 3>{7, 5, 6}, 1}}) {
+        for (const auto& case_ : {std::pair{std::array<int, 3>{3, 2, 4}, 4}, std::pair{std::array<int, 3>{5, 3, 4}, 8},
+                                  std::pair{std::array<int, 3>{1, 1, 1}, 16}, std::pair{std::array<int, 3>{7, 5, 6}, 1}}) {
+            const auto& coarse = case_.first;
+            const int brick = case_.second;
             CAPTURE(brick);
             check_tree_bounds(rgb, TreeMajorant<M>(rgb, coarse, brick), "grey", dense ? 2000 : 200);
             check_tree_bounds(rgb, ChannelTreeMajorant<M>(rgb, coarse, brick), "per channel", dense ? 2000 : 200);
@@ -136,7 +139,7 @@ TEST_CASE("every tree majorant segment bounds the lookup, and the segments leave
         // Deeper trees: two and three splits below the coarse grid.
         for (const auto& split : {std::array<int, 3>{2, 3, 0}, std::array<int, 3>{3, 2, 2}, std::array<int, 3>{4, 4, 0}}) {
             CAPTURE(split[0]); CAPTURE(split[1]); CAPTURE(split[2]);
-            const TreeLayout layout{rgb.bounds(), {2, 1, 3}, split, 0.f};  // split wherever the bound varies
+            const TreeLayout layout{rgb.bounds(), {2, 1, 3}, split, 0.f, 0.f};  // split wherever the bound varies
             check_tree_bounds(rgb, TreeMajorant<M>(rgb, layout), "grey, deep", dense ? 2000 : 200);
             check_tree_bounds(rgb, ChannelTreeMajorant<M>(rgb, layout), "per channel, deep", dense ? 2000 : 200);
         }
@@ -157,8 +160,8 @@ TEST_CASE("an empty coarse cell costs one DDA step and no lookup; uniform coarse
             for (int x = 0; x < 8; ++x) d[std::size_t(x + 32 * (y + 32 * z))] = 2.f;
     using M = DenseGridMedium<Mono>;
     const M medium(Box{Vec3(0.f), Vec3(4.f)}, {32, 32, 32}, d, grey<Mono>(1.f), grey<Mono>(1.f));
-    // Split wherever the bound varies (step cost 0), to count the cells exactly.
-    const TreeMajorant<M> tree(medium, TreeLayout{medium.bounds(), {4, 4, 4}, {4, 0, 0}, 0.f});
+    // Split wherever the bound varies (step and descent cost 0), to count the cells exactly.
+    const TreeMajorant<M> tree(medium, TreeLayout{medium.bounds(), {4, 4, 4}, {4, 0, 0}, 0.f, 0.f});
     // The block's own coarse cell is uniform: every fine cell of it reads voxels of density 2.
     // Its seven face, edge and corner neighbours read the block's last voxel layer across their
     // faces: split, their first fine cells bound 2 and the rest 0. Every other cell is empty.
@@ -182,9 +185,10 @@ TEST_CASE("an empty coarse cell costs one DDA step and no lookup; uniform coarse
 TEST_CASE("a cell splits only where the cost model says the steps pay for the lookups they save") {
     // One dense voxel block (density 2, 2^3 voxels of 0.125) in the corner of a 1^3 coarse cell of
     // 32^3 voxels, split into 4^3: as one cell a ray meets mu_bar = 2 x 10 over a mean chord of
-    // 4 V / S = 2/3, 13.3 tentative collisions; split, the 63 empty parts cost a step each in
-    // proportion to their surface, about 1 + 4 steps in all. With steps at 0.3 lookups it splits;
-    // at 10 lookups per step (5 x 10 > 13.3) it does not.
+    // 4 V / S = 2/3, 13.3 tentative collisions; split, the descent (1 lookup) and the 64 parts in
+    // proportion to their surface (1/16 each: a step each, and the block's 20 x 1/6), about 1 +
+    // 4 steps + 1.4 in all. With steps at 0.3 lookups it splits; at 10 lookups per step
+    // (5 x 10 > 13.3) it does not.
     std::vector<float> d(32 * 32 * 32, 0.f);
     for (int z = 0; z < 2; ++z)
         for (int y = 0; y < 2; ++y)
@@ -238,7 +242,8 @@ TEST_CASE_TEMPLATE("tracking through a volume of constant blocks matches the clo
     Pcg32 rng(71, 1);
     LookupCount lookups;
     int rays = 0;
-    for (const auto& [y, z] : {std::pair{1, 2}, std::pair{6, 9}, std::pair{13, 3}, std::pair{10, 14}}) {
+    for (const auto& yz : {std::pair{1, 2}, std::pair{6, 9}, std::pair{13, 3}, std::pair{10, 14}}) {
+        const int y = yz.first, z = yz.second;
         CAPTURE(y);
         CAPTURE(z);
         const Ray r{Vec3(-2.f, float(y) + 0.5f, float(z) + 0.5f), Vec3(1.f, 0.f, 0.f)};
@@ -273,7 +278,7 @@ TEST_CASE("tree majorant constructors reject layouts and scales that are not all
     CHECK_THROWS_WITH_AS(TreeMajorant<M>(medium, {1, 1, 1}, 0), Contains("brick = 0 cells per coarse cell and axis is not allowed"),
                          InvalidArgument);
     CHECK_THROWS_WITH_AS(TreeMajorant<M>(medium, {1, 1, 1}, 65), Contains("it must lie in [1, 64]"), InvalidArgument);
-    CHECK_THROWS_WITH_AS(TreeMajorant<M>(medium, TreeLayout{Box{Vec3(0.f), Vec3(0.5f, 1.f, 1.f)}, {1, 1, 1}, 2}),
+    CHECK_THROWS_WITH_AS(TreeMajorant<M>(medium, TreeLayout{Box{Vec3(0.f), Vec3(0.5f, 1.f, 1.f)}, {1, 1, 1}, {2, 0, 0}}),
                          Contains("does not contain the medium's bounds [0, 1]"), InvalidArgument);
     CHECK_THROWS_WITH_AS(TreeMajorant<M>(medium, {1, 1, 1}, 2, 0.5f), Contains("TreeMajorant scale = 0.5 is below 1"),
                          InvalidArgument);
@@ -285,6 +290,8 @@ TEST_CASE("tree majorant constructors reject layouts and scales that are not all
                          Contains("split[1] = 65 cells per axis is not allowed"), InvalidArgument);
     CHECK_THROWS_WITH_AS(TreeMajorant<M>(medium, TreeLayout{medium.bounds(), {1, 1, 1}, {2, 0, 0}, -1.f}),
                          Contains("step_cost = -1 is not allowed"), InvalidArgument);
+    CHECK_THROWS_WITH_AS(TreeMajorant<M>(medium, TreeLayout{medium.bounds(), {1, 1, 1}, {2, 0, 0}, 0.3f, kInf}),
+                         Contains("descent_cost = inf is not allowed"), InvalidArgument);
     CHECK_NOTHROW(TreeMajorant<M, bound::Signed>(medium, {1, 1, 1}, 2, 0.5f));
 }
 

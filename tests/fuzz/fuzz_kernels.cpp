@@ -573,6 +573,11 @@ void drive_grey(FuzzRng& rng, const M& medium, const Maj& maj, const Ray& ray, f
             if ((d.end == SegmentEnd::Scattered || d.end == SegmentEnd::Absorbed) && maj_max > 0.f)
                 widen(double(d.event_density) / double(maj_max));
             widen(double(d.null_pdf_product));
+            // Under a subnormal majorant a null's weight mu_n / (mu_bar P_n) divides by a product
+            // rounded to the 2^-149 grid too (finding 17: mu_bar = 2.4e-41, P_n = 6e-5, mu_bar P_n one
+            // subnormal ulp, weight -1.0001): the smallest majorant times the nulls' product bounds
+            // every null's mu_bar P_n from below.
+            if (maj_min > 0.f) widen(double(maj_min) * double(d.null_pdf_product));
             if (d.end != SegmentEnd::Rejected) NSP_FUZZ_CHECK(std::abs(double(d.weight[0])) <= 1.0 + tol);
         }
         NSP_FUZZ_CHECK(d.null_pdf_product >= 0.f && d.null_pdf_product <= 1.f);

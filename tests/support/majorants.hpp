@@ -38,17 +38,18 @@ struct ChannelGridKind {
     template <class M> static type<M> make(const M& m) { return type<M>(m, kTestGridRes); }
 };
 /// The tree majorants over a layout that does not align with the test grids' voxels either:
-/// 2 x 2 x 1 coarse cells, each split into 2^3 where the density varies.
+/// 2 x 2 x 1 coarse cells, each split into 2^3 wherever the bound varies (costs 0: the test
+/// grids are too small for the cost model to split them).
 inline constexpr std::array<int, 3> kTestTreeCoarse{2, 2, 1};
 struct TreeKind {
     static constexpr const char* name = "tree";
     template <class M> using type = TreeMajorant<M>;
-    template <class M> static type<M> make(const M& m) { return type<M>(m, kTestTreeCoarse, 2); }
+    template <class M> static type<M> make(const M& m) { return type<M>(m, TreeLayout{m.bounds(), kTestTreeCoarse, {2, 0, 0}, 0.f, 0.f}); }
 };
 struct ChannelTreeKind {
     static constexpr const char* name = "channel-tree";
     template <class M> using type = ChannelTreeMajorant<M>;
-    template <class M> static type<M> make(const M& m) { return type<M>(m, kTestTreeCoarse, 2); }
+    template <class M> static type<M> make(const M& m) { return type<M>(m, TreeLayout{m.bounds(), kTestTreeCoarse, {2, 0, 0}, 0.f, 0.f}); }
 };
 /// Half the global bound, signed weights (policy a): unbiased; applies to every medium.
 struct SignedGlobalKind {

@@ -86,7 +86,7 @@ public:
             inv_[a] = inv[a];
             res_[a] = res[a];
             step_[a] = r.d[a] > 0.f ? 1 : (r.d[a] < 0.f ? -1 : 0);
-            locate(a, std::clamp(int((r.o[a] + r.d[a] * t_ - box.lo[a]) * inv_cell[a]), 0, res[a] - 1), r.o[a]);
+            locate_near(a, std::clamp(int((r.o[a] + r.d[a] * t_ - box.lo[a]) * inv_cell[a]), 0, res[a] - 1), r.o[a]);
         }
     }
 
@@ -143,6 +143,34 @@ private:
             next_[a] = std::numeric_limits<float>::infinity();
         }
         cell_[a] = i;
+    }
+
+    /// locate() for a guess at most one cell off (what the brick constructor computes), without
+    /// branches on the ray's direction: one correction by selects, then a check that falls back to
+    /// locate() where the guess was further off. Random directions made locate()'s loops a
+    /// mispredicted branch per axis, most of a brick's entry cost (measured: 114 ns against 22 ns
+    /// for repeated rays).
+    void locate_near(int a, int i, float o) noexcept {
+        const int n = res_[a];
+        if (step_[a] == 0 || n == 1) [[unlikely]] {
+            locate(a, i, o);
+            return;
+        }
+        const bool pos = step_[a] > 0;
+        const float ta = plane_t(a, i), tb = plane_t(a, i + 1);
+        // d > 0: cell i spans [t(i), t(i + 1)); d < 0: [t(i + 1), t(i)).
+        const int down = pos ? int(ta > t_) : int(ta <= t_);
+        const int up = pos ? int(tb <= t_) : int(tb > t_);
+        const int j = std::clamp(i + up - down, 0, n - 1);
+        const float lo = plane_t(a, j), hi = plane_t(a, j + 1);
+        const bool ok = pos ? ((j == 0) | (lo <= t_)) & ((j == n - 1) | (t_ < hi))
+                            : ((j == n - 1) | (hi <= t_)) & ((j == 0) | (t_ < lo));
+        if (!ok) [[unlikely]] {
+            locate(a, j, o);
+            return;
+        }
+        cell_[a] = j;
+        next_[a] = pos ? hi : lo;
     }
 
 public:

@@ -1,11 +1,11 @@
 // nsp/majorants/tree.hpp: majorants that follow a sparse volume's tree, walked hierarchically
 // (THEORY 4, step 1, over several levels).
 //
-// A coarse grid over the medium (by default 8 cells along its longest axis; on a NanoVDB grid's
+// A coarse grid over the medium (by default 16 cells along its longest axis; on a NanoVDB grid's
 // tree, optionally, its lower internal nodes of 128 voxels a side) whose cells are each empty, uniform (one value: a constant tile, or a cell whose
 // parts all bound the same) or split into n^3 cells of the next level where a surface-area cost
-// model says the steps pay for the lookups they save, down to the finest level (by default two
-// splits of 4^3; on a VDB tree 128 -> 32 -> 8 voxels, its leaves). Every
+// model says the steps pay for the lookups they save, down to the finest level (by default up to
+// two splits of 4^3; on a VDB tree 128 -> 32 -> 8 voxels, its leaves). Every
 // value is the medium's density bound over the cell (widened by the voxels a trilinear lookup
 // reads across the cell's faces, as RegionBoundedMedium promises), padded for rounding. Along a
 // ray one DDA per level walks the cells, entering a split cell's node only where the ray crosses
@@ -49,14 +49,16 @@ inline constexpr int kMaxTreeSplits = 3;
 /// hierarchies are built), a random ray crossing a cell costs one DDA step plus mu_bar times its
 /// mean chord (4 V / S) tentative collisions, each a lookup; split, it costs the step plus each
 /// part's cost weighted by the part's share of the cell's surface (the chance a ray through the
-/// cell crosses it). `step_cost` is a DDA step's cost in lookups (0: split wherever the bound
-/// varies); the default, 0.3, is what bench/bench_majorants measures on this machine (a step
-/// about 20 ns, a trilinear lookup 50 to 75 ns).
+/// cell crosses it), plus a descent into the cell's node. `step_cost` is a DDA step's cost in
+/// lookups and `descent_cost` a descent's (both 0: split wherever the bound varies); the
+/// defaults, 0.3 and 1, are what this machine measures (a step about 20 ns, a descent, which
+/// starts a new DDA, about 100 ns, a tracked trilinear lookup 75 to 150 ns).
 struct TreeLayout {
     Box box;
     std::array<int, 3> coarse{1, 1, 1};
     std::array<int, kMaxTreeSplits> split{8, 0, 0};
     float step_cost = 0.3f;
+    float descent_cost = 1.f;  ///< entering a split cell's node (a new DDA), in lookups
 
     /// The number of levels below the coarse grid.
     int splits() const noexcept {
@@ -118,6 +120,9 @@ public:
         }
         if (!std::isfinite(layout.step_cost) || layout.step_cost < 0.f)
             fail(what, " step_cost = ", layout.step_cost, " is not allowed: it must be finite and >= 0 (lookups per DDA step)");
+        if (!std::isfinite(layout.descent_cost) || layout.descent_cost < 0.f)
+            fail(what, " descent_cost = ", layout.descent_cost,
+                 " is not allowed: it must be finite and >= 0 (lookups per descent into a split cell)");
         require_coefficient(medium.extinction_per_density(),
                             (std::string(what) + ": the medium's extinction per unit density").c_str());
         unit_ = max_value(medium.extinction_per_density());
@@ -275,7 +280,9 @@ private:
         std::vector<float> vals(k);
         std::vector<std::int32_t> kids(k);
         bool uniform = true;
-        double as_split = step;  // the step into the cell, then each child in proportion to its surface
+        // The step into the cell and the descent into its node, then each child in proportion to
+        // its surface.
+        double as_split = step + double(layout_.descent_cost);
         const double area = surface(region);
         std::size_t j = 0;
         for (int z = 0; z < r[2]; ++z)
@@ -397,19 +404,20 @@ TreeLayout layout_over_bounds(const M& medium, std::array<int, 3> coarse, int br
     return {medium.bounds(), coarse, {brick, 0, 0}, 0.3f};
 }
 
-/// The default layout over a medium's bounds: cubic-ish coarse cells, 8 along the longest axis
-/// and proportionally fewer (at least 1) along the others, each splitting into 4^3 and again into
-/// 4^3 where the cost model says it pays: the finest cells are 1/128 of the longest extent.
-/// Measured on the sparse plume and the dense cloud (docs/volumes.md), this adapts better than
-/// cells on a VDB tree's nodes, which ignore where in a node the density lies.
+/// The default layout over a medium's bounds: cubic-ish coarse cells, 16 along the longest axis
+/// and proportionally fewer (at least 1) along the others (where the best grid majorant of
+/// docs/majorants.md lies), each splitting into 4^3 and again into 4^3 where the cost model says
+/// it pays (finest cells 1/256 of the longest extent). Measured on the sparse plume and the dense
+/// cloud (docs/volumes.md), this adapts better than cells on a VDB tree's nodes, which ignore
+/// where in a node the density lies, and than 8 coarse cells, which descend too often.
 template <RegionBoundedMedium M>
 TreeLayout adaptive_layout(const M& medium) {
     const Box b = medium.bounds();
     const Vec3 e = b.hi - b.lo;
     const float longest = std::max({e.x, e.y, e.z});
-    TreeLayout l{b, {1, 1, 1}, {4, 4, 0}, 0.3f};
+    TreeLayout l{b, {1, 1, 1}, {4, 4, 0}, 0.3f, 1.f};
     for (int a = 0; a < 3; ++a)
-        l.coarse[a] = longest > 0.f && std::isfinite(longest) ? std::clamp(int(std::lround(8.f * e[a] / longest)), 1, 8) : 1;
+        l.coarse[a] = longest > 0.f && std::isfinite(longest) ? std::clamp(int(std::lround(16.f * e[a] / longest)), 1, 16) : 1;
     return l;
 }
 
