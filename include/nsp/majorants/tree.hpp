@@ -1,16 +1,16 @@
 // nsp/majorants/tree.hpp: majorants that follow a sparse volume's tree, walked hierarchically
 // (THEORY 4, step 1, over several levels).
 //
-// A coarse grid over the medium (by default 16 cells along its longest axis; on a NanoVDB grid's
-// tree, optionally, its lower internal nodes of 128 voxels a side) whose cells are each empty, uniform (one value: a constant tile, or a cell whose
-// parts all bound the same) or split into n^3 cells of the next level where a surface-area cost
-// model says the steps pay for the lookups they save, down to the finest level (by default up to
-// two splits of 4^3; on a VDB tree 128 -> 32 -> 8 voxels, its leaves). Every
-// value is the medium's density bound over the cell (widened by the voxels a trilinear lookup
-// reads across the cell's faces, as RegionBoundedMedium promises), padded for rounding. Along a
-// ray one DDA per level walks the cells, entering a split cell's node only where the ray crosses
-// it: empty space costs one step per empty cell of the coarsest level that is empty, not one per
-// finest cell, and memory is what the split cells need. The iterator keeps one walk per level in
+// A coarse grid over the medium (by default 16 cells along its longest axis; on a NanoVDB grid,
+// optionally, its lower internal nodes of 128 voxels a side) whose cells are each empty, uniform
+// (one value: a constant tile, or a cell whose parts all bound the same) or split into n^3 cells
+// of the next level where a surface-area cost model says the steps pay for the lookups they
+// save, down to the finest level (by default up to two splits of 4^3; on a VDB tree 128 -> 32 ->
+// 8 voxels, its leaves). Every value is the medium's density bound over the cell (widened by the
+// voxels a trilinear lookup reads across the cell's faces, as RegionBoundedMedium promises),
+// padded for rounding. Along a ray one DDA per level walks the cells, entering a split cell's
+// node only where the ray crosses it: an empty cell costs one step however fine the levels below
+// it would be, and memory is what the split cells need. The iterator keeps one walk per level in
 // fixed arrays (no heap).
 //
 // A medium that knows its tree says where the nodes are (`tree_layout()`, e.g.
