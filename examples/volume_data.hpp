@@ -82,4 +82,14 @@ void for_each_plume_voxel(int res, F&& f) {
     }
 }
 
+/// The plume's temperature in kelvin at a voxel of slice j (of res) whose density is `density`: a
+/// flame at the source, up to 2600 K, cooling to 0 over the lower 0.9 of the plume's 1.7 rise,
+/// hotter where the smoke is denser (0.6 + 0.4 sqrt(density)). 0 where the density is 0, so the
+/// temperature grid's active voxels are a subset of the density's.
+inline float plume_temperature(int j, int res, float density) {
+    const double y = -1.0 + (j + 0.5) * plume_voxel_size(res);
+    const double h = std::clamp(1.0 - (y + 0.88) / 0.9, 0.0, 1.0);
+    return density > 0.f ? float(2600.0 * std::sqrt(h) * (0.6 + 0.4 * std::sqrt(double(density)))) : 0.f;
+}
+
 }  // namespace nsp_examples

@@ -77,14 +77,18 @@ inline nsp::io::VoxelGrid plume_voxels(int res) {
 }
 
 #if NSP_HAVE_NANOVDB
-/// The plume as a NanoVDB fog volume named "density" (the index-to-world map of to_nanovdb over [-1, 1]^3).
-inline nsp::io::NanoHandle plume_nanovdb(int res) {
+/// The plume as a NanoVDB fog volume named "density" (the index-to-world map of to_nanovdb over
+/// [-1, 1]^3), or with `temperature` its temperature grid in kelvin, named "temperature".
+inline nsp::io::NanoHandle plume_nanovdb(int res, bool temperature = false) {
     nanovdb::GridBuilder<float> builder(0.f, nanovdb::GridClass::FogVolume);
     builder.setChecksum(nanovdb::ChecksumMode::Full);
     auto acc = builder.getAccessor();
-    for_each_plume_voxel(res, [&](int i, int j, int k, float v) { acc.setValue(nanovdb::Coord(i, j, k), v); });
+    for_each_plume_voxel(res, [&](int i, int j, int k, float v) {
+        const float x = temperature ? plume_temperature(j, res, v) : v;
+        if (x > 0.f) acc.setValue(nanovdb::Coord(i, j, k), x);
+    });
     const double h = plume_voxel_size(res);
-    return builder.getHandle<nanovdb::AbsDiff>(h, nanovdb::Vec3d(-1.0 + 0.5 * h), "density");
+    return builder.getHandle<nanovdb::AbsDiff>(h, nanovdb::Vec3d(-1.0 + 0.5 * h), temperature ? "temperature" : "density");
 }
 #endif
 
@@ -114,12 +118,17 @@ inline openvdb::FloatGrid::Ptr voxels_vdb(const nsp::io::VoxelGrid& g) {
     return grid;
 }
 
-/// The plume as an OpenVDB fog volume named "density".
-inline openvdb::FloatGrid::Ptr plume_vdb(int res) {
+/// The plume as an OpenVDB fog volume named "density", or with `temperature` its temperature
+/// grid in kelvin, named "temperature".
+inline openvdb::FloatGrid::Ptr plume_vdb(int res, bool temperature = false) {
     const double h = plume_voxel_size(res);
     auto grid = empty_vdb_grid(h, openvdb::Vec3d(-1.0 + 0.5 * h));
+    if (temperature) grid->setName("temperature");
     auto acc = grid->getAccessor();
-    for_each_plume_voxel(res, [&](int i, int j, int k, float v) { acc.setValue(openvdb::Coord(i, j, k), v); });
+    for_each_plume_voxel(res, [&](int i, int j, int k, float v) {
+        const float x = temperature ? plume_temperature(j, res, v) : v;
+        if (x > 0.f) acc.setValue(openvdb::Coord(i, j, k), x);
+    });
     return grid;
 }
 #endif
@@ -131,10 +140,18 @@ void write_volume(const std::string& path, MakeVoxels&& voxels, int plume_res, b
     require_format(path, ext);
     if (ext == ".vol") return nsp::io::write_vol(path, voxels());
 #if NSP_HAVE_NANOVDB
-    if (ext == ".nvdb") return nsp::io::write_nvdb(path, plume ? plume_nanovdb(plume_res) : nsp::io::to_nanovdb(voxels()));
+    if (ext == ".nvdb") {
+        std::vector<nsp::io::NanoHandle> grids;
+        grids.push_back(plume ? plume_nanovdb(plume_res) : nsp::io::to_nanovdb(voxels()));
+        if (plume) grids.push_back(plume_nanovdb(plume_res, true));
+        return nsp::io::write_nvdb(path, grids);
+    }
 #endif
 #if NSP_HAVE_OPENVDB
-    if (ext == ".vdb") return nsp::io::write_vdb(path, {plume ? plume_vdb(plume_res) : voxels_vdb(voxels())});
+    if (ext == ".vdb") {
+        if (plume) return nsp::io::write_vdb(path, {plume_vdb(plume_res), plume_vdb(plume_res, true)});
+        return nsp::io::write_vdb(path, {voxels_vdb(voxels())});
+    }
 #endif
     (void)plume_res, (void)plume;
 }

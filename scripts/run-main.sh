@@ -18,7 +18,8 @@
 #     out/room_sheet.png, out/room_rgb_sheet.png, out/room.png;
 #  1c. nsp_volume: the smoke plume (512^3, .vdb) and the cloud (.vdb) exported and rendered under
 #     every majorant (global, grid 16^3 and 64^3, tree on the VDB nodes, adaptive tree), their
-#     tables and out/plume_vdb/volume.png, out/cloud_vdb/volume.png;
+#     tables and out/plume_vdb/volume.png, out/cloud_vdb/volume.png; then the plume glowing by its
+#     temperature grid (blackbody emission, Rgb) with every strategy, out/plume_fire/volume.png;
 # With --with-references it then also runs (about 90 s more, which would take the default run past
 # five minutes on 2 cores with the renderer's build; README's heavy-tail tables come from it):
 #  2. the heavy-tail comparison: the grey-majorant baseline against spectral MIS + NEE (per-channel
@@ -66,6 +67,9 @@ build/examples/nsp_volume --export-plume out/plume.vdb
 build/examples/nsp_volume out/plume.vdb --compare-majorants --runs 3 --res 96 --spp 64 --density-scale 100 --out out/plume_vdb
 build/examples/nsp_volume --export-cloud out/cloud.vdb
 build/examples/nsp_volume out/cloud.vdb --compare-majorants --runs 3 --res 96 --spp 64 --density-scale 20 --g 0.9 --out out/cloud_vdb
+# The plume's temperature grid: blackbody emission in Rgb, every strategy (about 5 s).
+build/examples/nsp_volume out/plume.vdb --temperature temperature --normalize-blackbody --emission-scale 60 \
+    --density-scale 100 --majorant tree --res 96 --spp 64 --out out/plume_fire
 if [ "$references" = 0 ]; then
     echo
     echo "main job: $((SECONDS - start)) s of rendering (scripts/run-main.sh --with-references adds the"

@@ -202,6 +202,68 @@ TEST_CASE(".nvdb files round-trip the grid to the bit, and bad ones are rejected
     CHECK(rejected > 40);  // nsp writes full checksums: they catch a flipped byte almost anywhere
 }
 
+TEST_CASE("a temperature grid from a file: blackbody emission equals the dense grid's, and renders the same") {
+    // The cloud's values x 2000 K as a NanoVDB temperature grid beside the same values as an
+    // EmissionGrid: the same temperatures (within 1e-6, as the densities above), so the same
+    // radiance in every mode; the plume's density and temperature written to one .nvdb file.
+    const auto cloud = nsp_examples::cloud_voxels();
+    const nsp::io::NanoScalarField nano_t(cloud_grid());
+    const EmissionGrid dense_t(cloud.bounds, cloud.resolution, cloud.values);
+    const BlackbodyEmission<Hero<4>, nsp::io::NanoScalarField> nano_h(nano_t, 2000.f);
+    const BlackbodyEmission<Hero<4>> dense_h(dense_t, 2000.f);
+    const BlackbodyEmission<Rgb, nsp::io::NanoScalarField> nano_rgb(nano_t, 2000.f, 1.f, true);
+    const BlackbodyEmission<Rgb> dense_rgb(dense_t, 2000.f, 1.f, true);
+    CHECK(nano_h.max_temperature() == doctest::Approx(dense_h.max_temperature()).epsilon(1e-6));
+    Pcg32 rng(17, 2);
+    for (int i = 0; i < 20000; ++i) {
+        const Vec3 p = random_point(rng, Box{Vec3(-1.f), Vec3(1.f)});
+        const auto l = HeroWavelengths<4>::sample(rng.uniform());
+        CAPTURE(p.x);
+        CHECK(std::abs(nano_h.temperature(p) - dense_h.temperature(p)) <= 2e-3f);  // 2000 K x 1e-6
+        // B changes by c2 / (lambda T) dT / T relative: below 1e-4 for dT = 2e-3 K above 100 K.
+        const auto a = nano_h.radiance(p, l), b = dense_h.radiance(p, l);
+        for (int c = 0; c < 4; ++c) REQUIRE(std::abs(a[c] - b[c]) <= 1e-4f * b[c] + 1e-30f);
+        const auto x = nano_rgb.radiance(p, {}), y = dense_rgb.radiance(p, {});
+        for (int c = 0; c < 3; ++c) REQUIRE(std::abs(x[c] - y[c]) <= 1e-4f * y[c] + 1e-12f);
+    }
+    // The emitting media, NanoVDB against dense (Rgb): the same image mean within 5 combined SE.
+    using NR = nsp::io::NanoVdbMedium<Rgb>;
+    using DR = DenseGridMedium<Rgb>;
+    const NR nano_m(cloud_grid(), grey<Rgb>(6.f), grey<Rgb>(4.f));
+    const DR dense_m = nsp::io::to_dense_medium<Rgb>(cloud, grey<Rgb>(6.f), grey<Rgb>(4.f));
+    const Emissive<NR, BlackbodyEmission<Rgb, nsp::io::NanoScalarField>> nano_e(nano_m, nano_rgb);
+    const Emissive<DR, BlackbodyEmission<Rgb>> dense_e(dense_m, dense_rgb);
+    auto stats = [](const auto& medium, std::uint64_t seed) {
+        const auto scene = Scene(medium, GridMajorant<std::decay_t<decltype(medium)>>(medium, 16), IsotropicPhase{}, Lights<Rgb>{});
+        const PathEstimator<strategy::NullScatteringMis, mis::Balance> est;
+        Stat v;
+        for (int p = 0; p < 256; ++p) {
+            Pcg32 r(seed, std::uint64_t(p));
+            const Ray ray{Vec3(-0.9f + 1.8f * (float(p % 16) + 0.5f) / 16.f, -0.9f + 1.8f * (float(p / 16) + 0.5f) / 16.f, -3.f),
+                          Vec3(0.f, 0.f, 1.f)};
+            LookupCount c;
+            for (int k = 0; k < 40; ++k) v.add(est.radiance(scene, ray, {}, r, c).value[0]);
+        }
+        return v;
+    };
+    const Stat vn = stats(nano_e, 3), vd = stats(dense_e, 4);
+    CAPTURE(vn.mean);
+    CAPTURE(vd.mean);
+    CHECK(vn.mean > 1e-3);
+    CHECK(std::abs(vn.mean - vd.mean) <= kSigmas * std::hypot(vn.se(), vd.se()));
+
+    const std::string path = temp_path("plume.nvdb");
+    std::vector<nsp::io::NanoHandle> grids;
+    grids.push_back(nsp_examples::plume_nanovdb(64));
+    grids.push_back(nsp_examples::plume_nanovdb(64, true));
+    nsp::io::write_nvdb(path, grids);
+    CHECK(nsp::io::nvdb_grid_names(path) == std::vector<std::string>{"density", "temperature"});
+    const auto density = nsp::io::load_nvdb(path), temperature = nsp::io::load_nvdb(path, "temperature");
+    CHECK(temperature->max_density() <= 2600.f);
+    CHECK(temperature->max_density() > 1000.f);
+    CHECK(temperature->active_voxels() <= density->active_voxels());  // hot only where there is smoke
+}
+
 TEST_CASE("NanoVDB grids nsp cannot render are rejected, naming the problem") {
     auto build = [](float value, nanovdb::GridClass cls, float background = 0.f) {
         nanovdb::GridBuilder<float> b(background, cls);

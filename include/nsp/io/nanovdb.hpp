@@ -7,7 +7,8 @@
 // a RegionBoundedMedium (so it takes every grid majorant) and a TreeLayoutMedium: TreeMajorant
 // puts its coarse cells on the grid's lower internal nodes (128 voxels a side), splits them into
 // 32-voxel cells and those into the leaves (8 voxels a side), with every bound widened by the voxel layer a trilinear
-// lookup reads across a node's faces.
+// lookup reads across a node's faces. Any float grid of the same checks (a temperature grid, say)
+// is a NanoScalarField too, for BlackbodyEmission (media/blackbody.hpp).
 //
 // Construction and loading validate everything and throw nsp::InvalidArgument with a message
 // that names the file or grid and what is wrong; lookups never throw and read no mutable state.
@@ -34,6 +35,7 @@
 
 #include "../core/error.hpp"
 #include "../majorants/tree.hpp"
+#include "../media/blackbody.hpp"
 #include "../media/validate.hpp"
 #include "../medium.hpp"
 #include "vol.hpp"
@@ -301,6 +303,26 @@ private:
 
 static_assert(TreeLayoutMedium<NanoVdbMedium<Mono>> && TreeLayoutMedium<NanoVdbMedium<Rgb>>);
 
+/// A NanoVDB float grid as a ScalarField (media/blackbody.hpp): e.g. a temperature grid, for
+/// Emissive<NanoVdbMedium<S>, BlackbodyEmission<S, NanoScalarField>>. Shares the grid.
+class NanoScalarField {
+public:
+    /// Throws InvalidArgument on a null grid.
+    explicit NanoScalarField(std::shared_ptr<const NanoDensityGrid> grid) : grid_(std::move(grid)) {
+        if (!grid_) nsp::detail::fail("NanoScalarField: the grid is null");
+    }
+    float value(const Vec3& p) const noexcept { return grid_->density(p); }
+    float bound(const Box& region) const noexcept { return grid_->density_bound(region); }
+    Box bounds() const noexcept { return grid_->bounds(); }
+    float max_value() const noexcept { return grid_->max_density(); }
+    const NanoDensityGrid& grid() const noexcept { return *grid_; }
+
+private:
+    std::shared_ptr<const NanoDensityGrid> grid_;
+};
+
+static_assert(ScalarField<NanoScalarField>);
+
 namespace detail_nvdb {
 inline void require_readable(const std::string& path) {
     std::error_code ec;
@@ -388,6 +410,16 @@ inline NanoHandle to_nanovdb(const VoxelGrid& g, int channel = 0, const std::str
 inline void write_nvdb(const std::string& path, const NanoHandle& handle) {
     try {
         nanovdb::io::writeGrid(path, handle);
+    } catch (const std::exception& e) {
+        nsp::detail::fail("cannot write '", path, "': ", e.what());
+    }
+    if (!std::filesystem::exists(path)) nsp::detail::fail("cannot write '", path, "'");
+}
+
+/// Writes several NanoVDB grids (e.g. density and temperature) into one .nvdb file.
+inline void write_nvdb(const std::string& path, const std::vector<NanoHandle>& handles) {
+    try {
+        nanovdb::io::writeGrids<nanovdb::HostBuffer, std::vector>(path, handles);
     } catch (const std::exception& e) {
         nsp::detail::fail("cannot write '", path, "': ", e.what());
     }

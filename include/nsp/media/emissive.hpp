@@ -19,6 +19,7 @@
 #include "../equiangular.hpp"
 #include "../majorant.hpp"
 #include "../majorants/grid.hpp"
+#include "../majorants/tree.hpp"
 #include "../medium.hpp"
 #include "grid.hpp"
 #include "validate.hpp"
@@ -107,6 +108,54 @@ private:
     Vec3 inv_extent_{1.f};
 };
 
+/// Where and how much a medium emits: the emission field an Emissive medium carries. It provides
+/// - `radiance(p, lambda)`: L_e(p) per channel at the path's wavelengths, finite and >= 0;
+/// - `may_emit(region)`: false only where radiance is 0 everywhere in the box `region` (the power
+///   grid gives every other cell a floor, so NEE toward the volume stays unbiased);
+/// - `bounds()`: a box outside which radiance is 0.
+template <class E, class S>
+concept EmissionField = requires(const E& e, const Vec3& p, const typename S::Wavelengths& l, const Box& b) {
+    { e.radiance(p, l) } -> std::same_as<typename S::Spectrum>;
+    { e.may_emit(b) } -> std::same_as<bool>;
+    { e.bounds() } -> std::same_as<Box>;
+};
+
+/// The default emission field: a grid of emission strength times a fixed spectrum,
+/// L_e(p) = grid.value(p) * radiance_scale (per channel, or at the path's wavelengths in Hero mode).
+template <SpectralMode S>
+class GridEmission {
+public:
+    using Spectrum = typename S::Spectrum;
+    using Coefficient = typename S::Coefficient;
+
+    /// Throws InvalidArgument on a negative or non-finite radiance_scale channel, or a largest
+    /// emission (grid max x radiance_scale max) that overflows.
+    GridEmission(EmissionGrid grid, const Coefficient& radiance_scale)
+        : grid_(std::move(grid)), scale_(radiance_scale) {
+        detail::require_coefficient(scale_, "Emissive radiance_scale");
+        const float le_max = grid_.max_value() * max_value(scale_);
+        if (!std::isfinite(le_max))
+            detail::fail("Emissive: the largest emission L_e = emission grid max ", grid_.max_value(),
+                         " x radiance_scale max ", max_value(scale_), " = ", le_max,
+                         " is not allowed: it must be finite (at most ", std::numeric_limits<float>::max(), ")");
+    }
+
+    Spectrum radiance(const Vec3& p, const typename S::Wavelengths& l) const noexcept {
+        const float v = grid_.value(p);
+        if (v == 0.f) return Spectrum::Zero();
+        return S::sample(scale_, l) * v;
+    }
+    bool may_emit(const Box& region) const noexcept { return max_value(scale_) > 0.f && grid_.bound(region) > 0.f; }
+    Box bounds() const noexcept { return grid_.bounds(); }
+
+    const EmissionGrid& grid() const noexcept { return grid_; }
+    const Coefficient& radiance_scale() const noexcept { return scale_; }
+
+private:
+    EmissionGrid grid_;
+    Coefficient scale_;
+};
+
 namespace detail {
 
 /// Power-grid build: sub-points per cell and axis (4 x 4 x 4 = 64 stratified lookups per cell).
@@ -119,12 +168,14 @@ inline constexpr double kPowerFloor = 1e-3;
 
 }  // namespace detail
 
-/// Medium M with emission: L_e(p) = emission.value(p) * radiance_scale per channel (at the path's
-/// wavelengths in Hero mode); M's coefficients, bounds and majorant support are forwarded
-/// unchanged, so every majorant that takes M takes Emissive<M> and tracks it identically.
+/// Medium M with emission L_e(p) from an emission field E: by default (GridEmission)
+/// emission.value(p) * radiance_scale per channel (at the path's wavelengths in Hero mode); a
+/// temperature grid's blackbody radiance with BlackbodyEmission. M's coefficients, bounds and
+/// majorant support are forwarded unchanged, so every majorant that takes M takes Emissive<M, E>
+/// and tracks it identically.
 ///
 /// At construction a coarse grid of emitted power is built over the intersection of the emission
-/// grid's box and the medium's bounds (`power_resolution` cells), for sample_emission. Per cell the
+/// field's box and the medium's bounds (`power_resolution` cells), for sample_emission. Per cell the
 /// estimate is the cell volume times the mean, over 4 x 4 x 4 stratified sub-points (sub-cell
 /// centres), of mean_c mu_a,c(p) L_e,c(p), the channel mean. Mono and Rgb evaluate it at their
 /// channels; Hero<N> averages it over ceil(16 / N) wavelength sets that together place 16 or more
@@ -133,32 +184,25 @@ inline constexpr double kPowerFloor = 1e-3;
 /// The estimate may miss emission between sub-points (or between those wavelengths), so every cell
 /// that may emit gets a floor added: 1e-3 of the mean estimate over the cells whose estimate is
 /// positive (or 1, i.e. uniform over such cells, when every estimate is 0). A cell may emit when
-/// the emission grid's bound over it is > 0, max over wavelengths of radiance_scale is > 0 and the
-/// medium may be non-zero there: its density bound over the cell is > 0 (a RegionBoundedMedium M)
+/// the field says it may (for GridEmission: the grid's bound over it is > 0 and max over
+/// wavelengths of radiance_scale is > 0) and the medium may be non-zero there: its density bound over the cell is > 0 (a RegionBoundedMedium M)
 /// or max_extinction() > 0 (any other M). So the pdf is > 0 wherever mu_a L_e can be > 0 and NEE
 /// toward emission stays unbiased. Cell probabilities are floats: one below 2^-24 (the resolution
 /// of a float uniform u0) is chosen with a rounded probability.
-template <Medium M>
+template <Medium M, EmissionField<typename M::Spectral> E = GridEmission<typename M::Spectral>>
 class Emissive {
 public:
     using Spectral = typename M::Spectral;
     using Spectrum = typename Spectral::Spectrum;
     using Wavelengths = typename Spectral::Wavelengths;
     using Coefficient = typename Spectral::Coefficient;
+    using Field = E;
 
-    /// Throws InvalidArgument on a negative or non-finite radiance_scale channel, a largest
-    /// emission (grid max x radiance_scale max) that overflows, a power_resolution outside
-    /// [1, 256] on some axis, or a power grid whose cells are too thin to be told apart in float.
-    Emissive(M medium, EmissionGrid emission, const Coefficient& radiance_scale,
-             std::array<int, 3> power_resolution = {16, 16, 16})
-        : medium_(std::move(medium)), emission_(std::move(emission)), radiance_scale_(radiance_scale),
-          res_(power_resolution) {
-        detail::require_coefficient(radiance_scale_, "Emissive radiance_scale");
-        const float le_max = emission_.max_value() * max_value(radiance_scale_);
-        if (!std::isfinite(le_max))
-            detail::fail("Emissive: the largest emission L_e = emission grid max ", emission_.max_value(),
-                         " x radiance_scale max ", max_value(radiance_scale_), " = ", le_max,
-                         " is not allowed: it must be finite (at most ", std::numeric_limits<float>::max(), ")");
+    /// Medium M emitting as `field` says (e.g. BlackbodyEmission, media/blackbody.hpp). Throws
+    /// InvalidArgument on a power_resolution outside [1, 256] on some axis, or a power grid whose
+    /// cells are too thin to be told apart in float.
+    Emissive(M medium, E field, std::array<int, 3> power_resolution = {16, 16, 16})
+        : medium_(std::move(medium)), field_(std::move(field)), res_(power_resolution) {
         for (int a = 0; a < 3; ++a)
             if (res_[a] < 1 || res_[a] > 256)
                 detail::fail("Emissive power_resolution[", a, "] = ", res_[a],
@@ -166,12 +210,29 @@ public:
         build_power_grid();
     }
 
+    /// The default field: L_e(p) = emission.value(p) * radiance_scale. Throws InvalidArgument on a
+    /// negative or non-finite radiance_scale channel, a largest emission (grid max x
+    /// radiance_scale max) that overflows, or as the constructor above.
+    Emissive(M medium, EmissionGrid emission, const Coefficient& radiance_scale,
+             std::array<int, 3> power_resolution = {16, 16, 16})
+        requires std::same_as<E, GridEmission<Spectral>>
+        : Emissive(std::move(medium), E(std::move(emission), radiance_scale), power_resolution) {}
+
     /// The wrapped medium.
     const M& base() const noexcept { return medium_; }
-    /// The emission grid.
-    const EmissionGrid& emission_grid() const noexcept { return emission_; }
-    /// L_e per unit emission grid value, per channel or wavelength.
-    const Coefficient& radiance_scale() const noexcept { return radiance_scale_; }
+    /// The emission field.
+    const E& emission_field() const noexcept { return field_; }
+    /// The emission grid and L_e per unit grid value (the default field).
+    const EmissionGrid& emission_grid() const noexcept
+        requires std::same_as<E, GridEmission<Spectral>>
+    {
+        return field_.grid();
+    }
+    const Coefficient& radiance_scale() const noexcept
+        requires std::same_as<E, GridEmission<Spectral>>
+    {
+        return field_.radiance_scale();
+    }
 
     // The Medium API, forwarded.
     Box bounds() const noexcept { return medium_.bounds(); }
@@ -197,13 +258,17 @@ public:
     {
         return medium_.extinction_per_density();
     }
+    /// The layout of M's own tree (TreeLayoutMedium), with whatever arguments M takes.
+    template <class... A>
+        requires requires(const M& m, A... a) {
+            { m.tree_layout(a...) } -> std::same_as<TreeLayout>;
+        }
+    TreeLayout tree_layout(A... a) const noexcept {
+        return medium_.tree_layout(a...);
+    }
 
     /// The emitted radiance L_e(p) at wavelengths l, per channel (0 outside the emission grid).
-    Spectrum emission(const Vec3& p, const Wavelengths& l) const noexcept {
-        const float v = emission_.value(p);
-        if (v == 0.f) return Spectrum::Zero();
-        return Spectral::sample(radiance_scale_, l) * v;
-    }
+    Spectrum emission(const Vec3& p, const Wavelengths& l) const noexcept { return field_.radiance(p, l); }
 
     /// A point y drawn in proportion to the power grid: a cell chosen by its probability (u0),
     /// then a uniform point in it (u1, u2, u3), all in [0, 1). pdf = P(cell) / cell volume, per
@@ -316,9 +381,10 @@ private:
 
     /// The scalar the power grid integrates at p: mean_c mu_a,c(p) L_e,c(p), in double (THEORY 5.7).
     double power_density(const Vec3& p) const {
-        if (emission_.value(p) == 0.f) return 0.0;
         auto at = [&](const Wavelengths& l) {
-            const Spectrum sa = medium_.coefficients(p, l).sigma_a, le = emission(p, l);
+            const Spectrum le = field_.radiance(p, l);
+            if (!(le > 0.f).any()) return 0.0;
+            const Spectrum sa = medium_.coefficients(p, l).sigma_a;
             double s = 0.0;
             for (int c = 0; c < Spectral::channels; ++c) s += double(sa[c]) * double(le[c]);
             return s / double(Spectral::channels);
@@ -344,7 +410,7 @@ private:
     }
 
     void build_power_grid() {
-        const Box mb = medium_.bounds(), eb = emission_.bounds();
+        const Box mb = medium_.bounds(), eb = field_.bounds();
         for (int a = 0; a < 3; ++a) {
             box_.lo[a] = std::max(mb.lo[a], eb.lo[a]);
             box_.hi[a] = std::min(mb.hi[a], eb.hi[a]);
@@ -368,7 +434,6 @@ private:
         const std::size_t n = std::size_t(res_[0]) * std::size_t(res_[1]) * std::size_t(res_[2]);
         std::vector<double> estimate(n, 0.0);
         std::vector<char> may_emit(n, 0);
-        const bool scale_positive = max_value(radiance_scale_) > 0.f;
         constexpr int s = detail::kPowerSubpoints;
         std::size_t i = 0;
         for (int z = 0; z < res_[2]; ++z)
@@ -380,7 +445,7 @@ private:
                         cell.lo[a] = plane(a, c[a]);
                         cell.hi[a] = plane(a, c[a] + 1);
                     }
-                    may_emit[i] = scale_positive && emission_.bound(cell) > 0.f && medium_may_absorb(cell);
+                    may_emit[i] = field_.may_emit(cell) && medium_may_absorb(cell);
                     if (!may_emit[i]) continue;
                     double sum = 0.0;
                     for (int k = 0; k < s * s * s; ++k) {
@@ -423,8 +488,7 @@ private:
     }
 
     M medium_;
-    EmissionGrid emission_;
-    Coefficient radiance_scale_;
+    E field_;
     std::array<int, 3> res_;
     Box box_;                      ///< the power grid's box
     Vec3 cell_{1.f};               ///< its cell size per axis
