@@ -79,20 +79,15 @@ const std::vector<nsp::Ray>& plume_rays() {
     return rays;
 }
 
-template <class Maj>
-const Maj& majorant();
-template <>
-const nsp::GlobalMajorant<NM>& majorant() {
+const nsp::GlobalMajorant<NM>& global() {
     static const nsp::GlobalMajorant<NM> m(plume());
     return m;
 }
 template <int R>
-struct Grid {
-    static const nsp::GridMajorant<NM>& get() {
-        static const nsp::GridMajorant<NM> m(plume(), R);
-        return m;
-    }
-};
+const nsp::GridMajorant<NM>& grid() {
+    static const nsp::GridMajorant<NM> m(plume(), R);
+    return m;
+}
 const nsp::TreeMajorant<NM>& tree() {
     static const nsp::TreeMajorant<NM> m(plume());
     return m;
@@ -179,9 +174,9 @@ void register_all(const std::string& name, Get get) {
 }
 
 const bool registered = [] {
-    register_all("global", [] { return &majorant<nsp::GlobalMajorant<NM>>(); });
-    register_all("grid16", [] { return &Grid<16>::get(); });
-    register_all("grid64", [] { return &Grid<64>::get(); });
+    register_all("global", [] { return &global(); });
+    register_all("grid16", [] { return &grid<16>(); });
+    register_all("grid64", [] { return &grid<64>(); });
     register_all("tree-nodes", [] { return &tree_nodes(); });
     register_all("tree", [] { return &tree(); });
     benchmark::RegisterBenchmark("BM_VolumeBuild/grid16", [](benchmark::State& s) {
