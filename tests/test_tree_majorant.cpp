@@ -168,7 +168,7 @@ TEST_CASE("an empty coarse cell costs one DDA step and no lookup; uniform coarse
     CHECK(tree.coarse_cells() == 64);
     CHECK(tree.empty_cells() == 64 - 8);
     CHECK(tree.split_cells() == 7);
-    CHECK(tree.memory_bytes() == 64 * 8 + 7 * 64 * 4);  // a float and a node per coarse cell, a float per fine one
+    CHECK(tree.memory_bytes() == 64 * 4 + 7 * 64 * 4);  // 4 bytes per cell: a bound or a node
     Pcg32 rng(3, 3);
     LookupCount empty;
     for (int i = 0; i < 200; ++i) {
@@ -199,7 +199,7 @@ TEST_CASE("a cell splits only where the cost model says the steps pay for the lo
     const TreeMajorant<M> dear(medium, TreeLayout{medium.bounds(), {1, 1, 1}, {4, 0, 0}, 10.f});
     CHECK(cheap.split_cells() == 1);
     CHECK(dear.split_cells() == 0);
-    CHECK(dear.memory_bytes() == 8);  // the coarse cell alone
+    CHECK(dear.memory_bytes() == 4);  // the coarse cell alone
     // The bound of the unsplit cell is the block's; the split one is 0 away from the block.
     CHECK(dear.value_at(Vec3(0.9f), {}) == doctest::Approx(20.0).epsilon(1e-4));
     CHECK(cheap.value_at(Vec3(0.9f), {}) == 0.f);

@@ -41,6 +41,80 @@ namespace detail {
 /// this is 2^-16, about 500 ulps, so the bound holds for what the lookup actually returns).
 inline constexpr float kGridMajorantPad = 1.f + 1.f / 65536.f;
 
+/// One axis of a DDA: the planes lo + k h (k = 0 .. res) crossed by the ray o + t d, with inv =
+/// 1 / d where that is finite (0 where d is 0 or denormal: the division is kept there) and step
+/// the sign of d. Shared by GridWalk and the tree majorant's walk, so that both cross every plane
+/// at the same t.
+struct DdaAxis {
+    float lo, h, o, d, inv;
+    int res, step;
+
+    /// Plane k, lo + k h: a cell face.
+    float plane(int k) const noexcept { return lo + float(k) * h; }
+    /// Where the ray crosses plane k (d != 0).
+    float plane_t(int k) const noexcept { return inv != 0.f ? (plane(k) - o) * inv : (plane(k) - o) / d; }
+    /// Where the ray leaves cell k, walking in the direction of d.
+    float exit_t(int k) const noexcept { return plane_t(step > 0 ? k + 1 : k); }
+
+    /// From a first guess i, the cell the walk is in at t (by the same plane crossings every walk
+    /// of the ray computes) and the t at which it leaves it.
+    void locate(int i, float t, int& cell, float& next) const noexcept {
+        if (step > 0) {  // cell i spans [plane(i), plane(i + 1)) in t
+            while (i > 0 && plane_t(i) > t) --i;
+            while (i < res - 1 && plane_t(i + 1) <= t) ++i;
+            next = plane_t(i + 1);
+        } else if (step < 0) {  // cell i spans [plane(i + 1), plane(i)) in t
+            while (i < res - 1 && plane_t(i + 1) > t) ++i;
+            while (i > 0 && plane_t(i) <= t) --i;
+            next = plane_t(i);
+        } else {  // parallel: the cell holding o; a ray on a face takes the higher cell
+            while (i < res - 1 && o >= plane(i + 1)) ++i;
+            while (i > 0 && o < plane(i)) --i;
+            next = std::numeric_limits<float>::infinity();
+        }
+        cell = i;
+    }
+
+    /// locate() for a guess at most one cell off (what a brick's entry computes), without
+    /// branches on the ray's direction: one correction by selects, then a check that falls back to
+    /// locate() where the guess was further off. Random directions made locate()'s loops a
+    /// mispredicted branch per axis, most of a brick's entry cost (measured: 114 ns against 22 ns
+    /// for repeated rays).
+    void locate_near(int i, float t, int& cell, float& next) const noexcept {
+        if (step == 0 || res == 1) [[unlikely]] {
+            locate(i, t, cell, next);
+            return;
+        }
+        const bool pos = step > 0;
+        const float ta = plane_t(i), tb = plane_t(i + 1);
+        // d > 0: cell i spans [t(i), t(i + 1)); d < 0: [t(i + 1), t(i)).
+        const int down = pos ? int(ta > t) : int(ta <= t);
+        const int up = pos ? int(tb <= t) : int(tb > t);
+        const int j = std::clamp(i + up - down, 0, res - 1);
+        const float lo_t = plane_t(j), hi_t = plane_t(j + 1);
+        const bool ok = pos ? ((j == 0) | (lo_t <= t)) & ((j == res - 1) | (t < hi_t))
+                            : ((j == res - 1) | (hi_t <= t)) & ((j == 0) | (t < lo_t));
+        if (!ok) [[unlikely]] {
+            locate(j, t, cell, next);
+            return;
+        }
+        cell = j;
+        next = pos ? hi_t : lo_t;
+    }
+};
+
+/// 1 / d for a DDA (DdaAxis::inv): 0 where d is 0 or denormal (1 / d would be inf). Multiplying
+/// by it instead of dividing saves a third of a DDA step.
+inline float dda_inverse(float d) noexcept { return std::abs(d) >= std::numeric_limits<float>::min() ? 1.f / d : 0.f; }
+/// The sign of d as a DDA's step.
+inline int dda_step(float d) noexcept { return d > 0.f ? 1 : (d < 0.f ? -1 : 0); }
+
+/// The index of the first of the three next-plane crossings (ties to the later axis, as the walk
+/// has always stepped).
+inline int dda_axis(const float* next) noexcept {
+    return next[0] < next[1] ? (next[0] < next[2] ? 0 : 2) : (next[1] < next[2] ? 1 : 2);
+}
+
 /// The cells of a regular grid of `res` cells over `box` that a ray crosses within [t0, t1] (the
 /// part of the ray inside the box), in increasing t (Amanatides and Woo 1987). Every cell face is
 /// crossed at t = (plane - o) / d for its plane, whichever cell the walk starts in, so walks of
@@ -58,57 +132,27 @@ public:
             h_[a] = cell[a];
             o_[a] = r.o[a];
             d_[a] = r.d[a];
-            // 1 / d is finite for a normal d: multiply then (a division per cell crossed was a
-            // third of a DDA step); a denormal d keeps the division (1 / d would be inf).
-            inv_[a] = std::abs(r.d[a]) >= std::numeric_limits<float>::min() ? 1.f / r.d[a] : 0.f;
+            inv_[a] = dda_inverse(r.d[a]);
             res_[a] = res[a];
+            step_[a] = dda_step(r.d[a]);
             const float p = r.o[a] + r.d[a] * t_;
-            int i = int(std::floor((p - box.lo[a]) / cell[a]));
-            i = std::clamp(i, 0, res[a] - 1);
-            step_[a] = r.d[a] > 0.f ? 1 : (r.d[a] < 0.f ? -1 : 0);
-            locate(a, i, r.o[a]);
-        }
-    }
-
-    /// A walk through the cells of one cell of a coarser walk (a tree majorant's brick) over
-    /// [in.t0, in.t1], with the ray's inverse direction `inv` as the coarser walk has it (0 where
-    /// the component is 0 or denormal) and 1 / cell size `inv_cell`: no division but where `inv`
-    /// is 0, so entering a brick costs a few multiplications per axis.
-    GridWalk(const Box& box, const std::array<int, 3>& res, const Vec3& cell, const Vec3& inv_cell, const Ray& r,
-             const float* inv, Interval in) noexcept
-        : t_(in.t0), t_end_(in.t1), done_(!(in.t0 < in.t1)) {
-        if (done_) return;
-        for (int a = 0; a < 3; ++a) {
-            lo_[a] = box.lo[a];
-            h_[a] = cell[a];
-            o_[a] = r.o[a];
-            d_[a] = r.d[a];
-            inv_[a] = inv[a];
-            res_[a] = res[a];
-            step_[a] = r.d[a] > 0.f ? 1 : (r.d[a] < 0.f ? -1 : 0);
-            locate_near(a, std::clamp(int((r.o[a] + r.d[a] * t_ - box.lo[a]) * inv_cell[a]), 0, res[a] - 1), r.o[a]);
+            const int i = std::clamp(int(std::floor((p - box.lo[a]) / cell[a])), 0, res[a] - 1);
+            axis(a).locate(i, t_, cell_[a], next_[a]);
         }
     }
 
     /// The next cell crossed (flat index x + nx (y + ny z)) and its stretch [t0, t1); false at the end.
     bool next(std::size_t& index, float& t0, float& t1) noexcept {
-        int c[3];
-        return next(index, t0, t1, c);
-    }
-
-    /// As next(index, t0, t1), and the cell's coordinates c.
-    bool next(std::size_t& index, float& t0, float& t1, int (&c)[3]) noexcept {
         if (done_) return false;
         ++steps_;
-        int a = next_[0] < next_[1] ? (next_[0] < next_[2] ? 0 : 2) : (next_[1] < next_[2] ? 1 : 2);
+        int a = dda_axis(next_);
         // A step that would leave the grid before t_end is rounding (t_end is where the ray leaves
         // the grid's box): the cell covers the rest on that axis, so no stretch of [t0, t_end) is
         // left without a majorant, and the cell is not repeated.
         while (next_[a] < t_end_ && (cell_[a] + step_[a] < 0 || cell_[a] + step_[a] >= res_[a])) [[unlikely]] {
             next_[a] = std::numeric_limits<float>::infinity();
-            a = next_[0] < next_[1] ? (next_[0] < next_[2] ? 0 : 2) : (next_[1] < next_[2] ? 1 : 2);
+            a = dda_axis(next_);
         }
-        c[0] = cell_[0], c[1] = cell_[1], c[2] = cell_[2];
         index = std::size_t(cell_[0]) + std::size_t(res_[0]) * (std::size_t(cell_[1]) + std::size_t(res_[1]) * std::size_t(cell_[2]));
         t0 = t_;
         t1 = std::max(t_, std::min(next_[a], t_end_));
@@ -117,7 +161,7 @@ public:
             done_ = true;
         } else {
             cell_[a] += step_[a];
-            next_[a] = plane_t(a, step_[a] > 0 ? cell_[a] + 1 : cell_[a]);
+            next_[a] = axis(a).exit_t(cell_[a]);
         }
         return true;
     }
@@ -126,64 +170,7 @@ public:
     std::uint32_t steps() const noexcept { return steps_; }
 
 private:
-    /// From a first guess i, the cell of axis a the walk is in at t_ (by the same plane crossings
-    /// every walk of the ray computes), and its exit.
-    void locate(int a, int i, float o) noexcept {
-        if (step_[a] > 0) {  // cell i spans [plane(i), plane(i + 1)) in t
-            while (i > 0 && plane_t(a, i) > t_) --i;
-            while (i < res_[a] - 1 && plane_t(a, i + 1) <= t_) ++i;
-            next_[a] = plane_t(a, i + 1);
-        } else if (step_[a] < 0) {  // cell i spans [plane(i + 1), plane(i)) in t
-            while (i < res_[a] - 1 && plane_t(a, i + 1) > t_) ++i;
-            while (i > 0 && plane_t(a, i) <= t_) --i;
-            next_[a] = plane_t(a, i);
-        } else {  // parallel: the cell holding o; a ray on a face takes the higher cell
-            while (i < res_[a] - 1 && o >= plane(a, i + 1)) ++i;
-            while (i > 0 && o < plane(a, i)) --i;
-            next_[a] = std::numeric_limits<float>::infinity();
-        }
-        cell_[a] = i;
-    }
-
-    /// locate() for a guess at most one cell off (what the brick constructor computes), without
-    /// branches on the ray's direction: one correction by selects, then a check that falls back to
-    /// locate() where the guess was further off. Random directions made locate()'s loops a
-    /// mispredicted branch per axis, most of a brick's entry cost (measured: 114 ns against 22 ns
-    /// for repeated rays).
-    void locate_near(int a, int i, float o) noexcept {
-        const int n = res_[a];
-        if (step_[a] == 0 || n == 1) [[unlikely]] {
-            locate(a, i, o);
-            return;
-        }
-        const bool pos = step_[a] > 0;
-        const float ta = plane_t(a, i), tb = plane_t(a, i + 1);
-        // d > 0: cell i spans [t(i), t(i + 1)); d < 0: [t(i + 1), t(i)).
-        const int down = pos ? int(ta > t_) : int(ta <= t_);
-        const int up = pos ? int(tb <= t_) : int(tb > t_);
-        const int j = std::clamp(i + up - down, 0, n - 1);
-        const float lo = plane_t(a, j), hi = plane_t(a, j + 1);
-        const bool ok = pos ? ((j == 0) | (lo <= t_)) & ((j == n - 1) | (t_ < hi))
-                            : ((j == n - 1) | (hi <= t_)) & ((j == 0) | (t_ < lo));
-        if (!ok) [[unlikely]] {
-            locate(a, j, o);
-            return;
-        }
-        cell_[a] = j;
-        next_[a] = pos ? hi : lo;
-    }
-
-public:
-    /// 1 / d per axis (0 where d is 0 or denormal), as a brick walk takes it.
-    const float* inverse_direction() const noexcept { return inv_; }
-
-private:
-    /// Plane k of axis a, lo + k h: the grid's cell faces.
-    float plane(int a, int k) const noexcept { return lo_[a] + float(k) * h_[a]; }
-    /// Where the ray crosses plane k of axis a (d[a] != 0).
-    float plane_t(int a, int k) const noexcept {
-        return inv_[a] != 0.f ? (plane(a, k) - o_[a]) * inv_[a] : (plane(a, k) - o_[a]) / d_[a];
-    }
+    DdaAxis axis(int a) const noexcept { return {lo_[a], h_[a], o_[a], d_[a], inv_[a], res_[a], step_[a]}; }
 
     float lo_[3]{}, h_[3]{}, o_[3]{}, d_[3]{}, inv_[3]{}, next_[3]{};
     int res_[3]{}, cell_[3]{}, step_[3]{};

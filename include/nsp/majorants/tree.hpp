@@ -21,6 +21,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -128,20 +129,15 @@ public:
         unit_ = max_value(medium.extinction_per_density());
         pad_ = kGridMajorantPad * scale;
         scale_ = scale;
-        values_[0].assign(n, 0.f);
-        if (levels_ > 1) child_[0].assign(n, -1);
+        cells_[0].assign(n, 0u);
         std::size_t i = 0;
         for (int z = 0; z < layout.coarse[2]; ++z)
             for (int y = 0; y < layout.coarse[1]; ++y)
                 for (int x = 0; x < layout.coarse[0]; ++x, ++i) {
                     const int c[3] = {x, y, z};
-                    const Built b = build(medium, 0, cell_box(box, 0, c, layout.coarse), c, what);
-                    values_[0][i] = b.value;
-                    if (levels_ > 1) child_[0][i] = b.node;
-                    cost_ += b.cost;
+                    cells_[0][i] = build(medium, 0, cell_box(box, 0, c, layout.coarse), c, what).packed();
                 }
-        for (auto& v : values_) v.shrink_to_fit();
-        for (auto& v : child_) v.shrink_to_fit();
+        for (auto& v : cells_) v.shrink_to_fit();
         for (int l = 0; l < levels_; ++l) {
             res_[l] = res(l);
             stride_[l] = per_node(l);
@@ -164,29 +160,17 @@ public:
         return {k, k, k};
     }
 
-    /// The coarse walk of the ray over the part of [tmin, tmax] inside the medium's bounds.
-    GridWalk walk(const Ray& r, float tmin, float tmax) const noexcept {
-        return {layout_.box, layout_.coarse, cell_[0], r, bounds_.clip(r, tmin, tmax)};
-    }
-    /// The walk through cell c (box `cell`) of level l - 1 over [t0, t1], whose node is of level l.
-    GridWalk child_walk(int l, const Box& cell, const Ray& r, const float* inv_d, float t0, float t1) const noexcept {
-        return {cell, res_[l], cell_[l], inv_cell_[l], r, inv_d, Interval{t0, t1}};
-    }
+    /// The medium's bounds (the walk clips the ray to them) and the cells' extent per level.
+    const Box& bounds() const noexcept { return bounds_; }
+    const Vec3& cell_size(int l) const noexcept { return cell_[l]; }
+    const Vec3& inverse_cell_size(int l) const noexcept { return inv_cell_[l]; }
 
-    /// Cell i of node `node` of level l (the coarse grid: node 0 of level 0).
-    float value(int l, std::int32_t node, std::size_t i) const noexcept {
-        return values_[l][std::size_t(node) * stride_[l] + i];
-    }
-    /// The node cell i of node `node` of level l splits into, or -1 (the finest level has none).
-    std::int32_t child(int l, std::int32_t node, std::size_t i) const noexcept {
-        return l + 1 < levels_ ? child_[l][std::size_t(node) * stride_[l] + i] : -1;
-    }
-    /// The values and children (null at the finest level) of node `node` of level l.
-    const float* node_values(int l, std::int32_t node) const noexcept {
-        return values_[l].data() + std::size_t(node) * stride_[l];
-    }
-    const std::int32_t* node_children(int l, std::int32_t node) const noexcept {
-        return l + 1 < levels_ ? child_[l].data() + std::size_t(node) * stride_[l] : nullptr;
+    /// The cells of node `node` of level l (the coarse grid: node 0 of level 0), packed: a split
+    /// cell is kSplit | the node it splits into (of level l + 1), any other its bound's bits (a
+    /// float >= 0, so the sign bit is free). One load per step tells the walk both.
+    static constexpr std::uint32_t kSplit = 0x80000000u;
+    const std::uint32_t* node_cells(int l, std::int32_t node) const noexcept {
+        return cells_[l].data() + std::size_t(node) * stride_[l];
     }
     /// The cells per axis of level l's nodes (precomputed).
     const std::array<int, 3>& level_res(int l) const noexcept { return res_[l]; }
@@ -201,30 +185,26 @@ public:
             int c[3];
             for (int a = 0; a < 3; ++a) c[a] = std::clamp(int((p[a] - b.lo[a]) * inv_cell_[l][a]), 0, r[a] - 1);
             const std::size_t i = std::size_t(c[0]) + std::size_t(r[0]) * (std::size_t(c[1]) + std::size_t(r[1]) * std::size_t(c[2]));
-            const std::int32_t ch = child(l, node, i);
-            if (ch < 0) return value(l, node, i);
+            const std::uint32_t cell = node_cells(l, node)[i];
+            if (!(cell & kSplit)) return std::bit_cast<float>(cell);
             b = cell_box(b, l, c, r);
-            node = ch;
+            node = std::int32_t(cell & ~kSplit);
         }
     }
 
-    int levels() const noexcept { return levels_; }
-    /// The cost model's expected cost, in lookups, of rays crossing every coarse cell once.
-    double expected_cost() const noexcept { return cost_; }
     TreeLayout layout() const noexcept { return layout_; }
-    std::size_t coarse_cells() const noexcept { return values_[0].size(); }
+    std::size_t coarse_cells() const noexcept { return cells_[0].size(); }
     /// Split cells of level l (nodes of level l + 1).
-    std::size_t split_cells(int l = 0) const noexcept { return l + 1 < levels_ ? values_[l + 1].size() / per_node(l + 1) : 0; }
+    std::size_t split_cells(int l = 0) const noexcept { return l + 1 < levels_ ? cells_[l + 1].size() / per_node(l + 1) : 0; }
     std::size_t empty_cells() const noexcept {
         std::size_t k = 0;
-        for (std::size_t i = 0; i < values_[0].size(); ++i) k += child(0, 0, i) < 0 && !(values_[0][i] > 0.f);
+        for (const std::uint32_t c : cells_[0]) k += !(c & kSplit) && !(std::bit_cast<float>(c) > 0.f);
         return k;
     }
-    /// Bytes of storage: a float per cell of every level, and a node index per cell of every level
-    /// but the finest.
+    /// Bytes of storage: 4 per cell of every level.
     std::size_t memory_bytes() const noexcept {
         std::size_t b = 0;
-        for (int l = 0; l < levels_; ++l) b += values_[l].size() * sizeof(float) + child_[l].size() * sizeof(std::int32_t);
+        for (int l = 0; l < levels_; ++l) b += cells_[l].size() * sizeof(std::uint32_t);
         return b;
     }
 
@@ -235,13 +215,13 @@ private:
         return k * k * k;
     }
 
-    /// The padded bound of cell `region` of level l and the node it splits into (-1: none).
     /// What build() decides for a cell: its padded bound, the node it splits into (-1: none) and
     /// its expected cost per crossing in lookups (the surface-area cost model of TreeLayout).
     struct Built {
         float value;
         std::int32_t node;
         double cost;
+        std::uint32_t packed() const noexcept { return node >= 0 ? kSplit | std::uint32_t(node) : std::bit_cast<std::uint32_t>(value); }
     };
 
     /// A random line's mean chord through box b, 4 V / S (Cauchy), and b's surface.
@@ -276,9 +256,9 @@ private:
         const std::size_t k = per_node(l + 1);
         // Nodes the children add below: dropped again if the cell stays whole.
         std::size_t mark[kMaxTreeSplits + 1];
-        for (int m = l + 1; m < levels_; ++m) mark[m] = values_[m].size();
-        std::vector<float> vals(k);
-        std::vector<std::int32_t> kids(k);
+        for (int m = l + 1; m < levels_; ++m) mark[m] = cells_[m].size();
+        std::vector<std::uint32_t> parts(k);
+        float first = 0.f;
         bool uniform = true;
         // The step into the cell and the descent into its node, then each child in proportion to
         // its surface.
@@ -291,21 +271,19 @@ private:
                     const int g[3] = {x, y, z};
                     const Box part = cell_box(region, l + 1, g, r);
                     const Built b = build(medium, l + 1, part, g, what);
-                    vals[j] = b.value;
-                    kids[j] = b.node;
+                    parts[j] = b.packed();
+                    if (j == 0) first = b.value;
                     as_split += surface(part) / area * b.cost;
-                    uniform = uniform && b.node < 0 && b.value == vals[0];
+                    uniform = uniform && b.node < 0 && b.value == first;
                 }
         if (uniform || !(as_split < as_leaf)) {  // a constant tile, or a split that does not pay
-            for (int m = l + 1; m < levels_; ++m) {
-                values_[m].resize(mark[m]);
-                if (m + 1 < levels_) child_[m].resize(mark[m]);
-            }
-            return uniform ? Built{vals[0], -1, step + double(vals[0]) * double(unit_) * chord(region)} : Built{v, -1, as_leaf};
+            for (int m = l + 1; m < levels_; ++m) cells_[m].resize(mark[m]);
+            return uniform ? Built{first, -1, step + double(first) * double(unit_) * chord(region)} : Built{v, -1, as_leaf};
         }
-        const auto node = std::int32_t(values_[l + 1].size() / k);
-        values_[l + 1].insert(values_[l + 1].end(), vals.begin(), vals.end());
-        if (l + 2 < levels_) child_[l + 1].insert(child_[l + 1].end(), kids.begin(), kids.end());
+        if (cells_[l + 1].size() / k >= std::size_t(kSplit))
+            fail(what, ": more than 2^31 nodes at level ", l + 1, "; a coarser layout is needed");
+        const auto node = std::int32_t(cells_[l + 1].size() / k);
+        cells_[l + 1].insert(cells_[l + 1].end(), parts.begin(), parts.end());
         return {v, node, as_split};
     }
 
@@ -314,9 +292,8 @@ private:
     int levels_;
     Vec3 cell_[kMaxTreeSplits + 1]{}, inv_cell_[kMaxTreeSplits + 1]{};
     float unit_ = 1.f, pad_ = 1.f, scale_ = 1.f;
-    double cost_ = 0.0;
-    std::vector<float> values_[kMaxTreeSplits + 1];
-    std::vector<std::int32_t> child_[kMaxTreeSplits + 1];
+    /// Per level, its nodes' cells one after another, packed (node_cells).
+    std::vector<std::uint32_t> cells_[kMaxTreeSplits + 1];
     // What the walk reads per step, precomputed.
     std::array<int, 3> res_[kMaxTreeSplits + 1]{};
     std::size_t stride_[kMaxTreeSplits + 1]{};
@@ -324,76 +301,125 @@ private:
 
 /// Walks a MajorantTree depth first: a DDA per level, entering a split cell's node where the
 /// walk crosses it; yields the segments with a non-zero bound, each with value bound * unit.
+/// The ray's part of every level's DDA (origin, direction, 1 / direction, steps) is stored once
+/// and the walk's t is shared: a level holds only its node's origin, cells and next crossings, so
+/// entering a node costs a few multiplications per axis (the walk held a full GridWalk per level
+/// before, and cost twice a grid's walk per step).
 template <RegionBoundedMedium M, class V>
 class TreeSegmentIterator {
 public:
     TreeSegmentIterator() = default;
     TreeSegmentIterator(const MajorantTree<M>* tree, const Ray& r, float tmin, float tmax, const V& unit) noexcept
-        : tree_(tree), ray_(r), unit_(unit) {
-        std::construct_at(&walks_[0].w, tree->walk(r, tmin, tmax));
-        boxes_[0] = tree->layout().box;
-        vals_[0] = tree->node_values(0, 0);
-        kids_[0] = tree->node_children(0, 0);
+        : tree_(tree), unit_(unit) {
+        const Interval in = tree->bounds().clip(r, tmin, tmax);
+        if (!(in.t0 < in.t1)) return;  // depth_ = -1: nothing to walk
+        t_ = in.t0;
+        for (int a = 0; a < 3; ++a) {
+            o_[a] = r.o[a];
+            d_[a] = r.d[a];
+            inv_[a] = dda_inverse(r.d[a]);
+            step_[a] = dda_step(r.d[a]);
+        }
+        Level& L = level_[0];
+        const Box& box = tree->layout().box;
+        const Vec3& h = tree->cell_size(0);
+        const auto& res = tree->level_res(0);
+        for (int a = 0; a < 3; ++a) {
+            L.lo[a] = box.lo[a];
+            L.h[a] = h[a];
+            L.res[a] = res[a];
+            const int i = std::clamp(int(std::floor((r.o[a] + r.d[a] * t_ - box.lo[a]) / h[a])), 0, res[a] - 1);
+            axis(L, a).locate(i, t_, L.cell[a], L.next[a]);
+        }
+        L.t_end = in.t1;
+        L.done = false;
+        L.cells = tree->node_cells(0, 0);
+        depth_ = 0;
     }
 
     std::optional<MajorantSegment<V>> next() noexcept {
-        std::size_t i;
-        float t0, t1;
-        int c[3];
-        for (;;) {
-            GridWalk& w = walks_[depth_].w;
-            const float* vals = vals_[depth_];
-            const std::int32_t* kids = kids_[depth_];
-            bool descended = false;
-            while (w.next(i, t0, t1, c)) {
-                if (kids && kids[i] >= 0) {  // a split cell: walk its node
-                    if (!(t1 > t0)) continue;
-                    const std::int32_t child = kids[i];
-                    const Box cell = tree_->cell_box(boxes_[depth_], depth_, c, tree_->level_res(depth_));
-                    ++depth_;
-                    boxes_[depth_] = cell;
-                    vals_[depth_] = tree_->node_values(depth_, child);
-                    kids_[depth_] = tree_->node_children(depth_, child);
-                    std::construct_at(&walks_[depth_].w,
-                                      tree_->child_walk(depth_, cell, ray_, walks_[0].w.inverse_direction(), t0, t1));
-                    descended = true;
-                    break;
-                }
-                const float v = vals[i];
-                if (v > 0.f && t1 > t0) return MajorantSegment<V>{t0, t1, V(unit_ * v)};
+        while (depth_ >= 0) {
+            Level& L = level_[depth_];
+            if (L.done) {
+                --depth_;
+                continue;
             }
-            if (descended) continue;
-            if (depth_ == 0) return std::nullopt;
-            done_steps_ += w.steps();
-            --depth_;
+            ++steps_;
+            int a = dda_axis(L.next);
+            // A step that would leave the node before t_end is rounding (as in GridWalk).
+            while (L.next[a] < L.t_end && (L.cell[a] + step_[a] < 0 || L.cell[a] + step_[a] >= L.res[a])) [[unlikely]] {
+                L.next[a] = std::numeric_limits<float>::infinity();
+                a = dda_axis(L.next);
+            }
+            const int c[3] = {L.cell[0], L.cell[1], L.cell[2]};
+            const std::size_t i = std::size_t(c[0]) + std::size_t(L.res[0]) * (std::size_t(c[1]) + std::size_t(L.res[1]) * std::size_t(c[2]));
+            const float t0 = t_, t1 = std::max(t_, std::min(L.next[a], L.t_end));
+            t_ = t1;
+            if (!(t1 < L.t_end)) {
+                L.done = true;
+            } else {
+                L.cell[a] += step_[a];
+                L.next[a] = axis(L, a).exit_t(L.cell[a]);
+            }
+            const std::uint32_t cell = L.cells[i];
+            if (cell & MajorantTree<M>::kSplit) {  // a split cell: walk its node over [t0, t1]
+                if (t1 > t0) enter(c, std::int32_t(cell & ~MajorantTree<M>::kSplit), t0, t1);
+                continue;
+            }
+            const float v = std::bit_cast<float>(cell);
+            if (v > 0.f && t1 > t0) return MajorantSegment<V>{t0, t1, V(unit_ * v)};
         }
+        return std::nullopt;
     }
 
     /// DDA steps taken so far, at every level (empty cells included).
-    std::uint32_t steps() const noexcept {
-        std::uint32_t s = done_steps_;
-        for (int l = 0; l <= depth_; ++l) s += walks_[l].w.steps();
-        return s;
-    }
+    std::uint32_t steps() const noexcept { return steps_; }
 
 private:
-    const MajorantTree<M>* tree_ = nullptr;
-    Ray ray_{};
-    V unit_{};
-    int depth_ = 0;
-    std::uint32_t done_steps_ = 0;
-    /// A walk's storage, left unconstructed until the walk enters that level: an iterator is made
-    /// per flight, and zeroing every level's walk each time cost more than the walk (measured).
-    union Slot {
-        Slot() noexcept {}
-        GridWalk w;
+    /// One level's walk: its node's origin, cell size and cells per axis, the cell the walk is in
+    /// and where it leaves it per axis, and where the walk of this node ends.
+    struct Level {
+        float lo[3], h[3], next[3];
+        int res[3], cell[3];
+        float t_end;
+        bool done;
+        const std::uint32_t* cells;  ///< the node's cells, packed (MajorantTree::node_cells)
     };
-    static_assert(std::is_trivially_destructible_v<GridWalk> && std::is_trivially_copyable_v<GridWalk>);
 
-    const float* vals_[kMaxTreeSplits + 1];          ///< per level: the values of the node walked
-    const std::int32_t* kids_[kMaxTreeSplits + 1];  ///< per level: its children (null: finest level)
-    Box boxes_[kMaxTreeSplits + 1];
-    Slot walks_[kMaxTreeSplits + 1];
+    DdaAxis axis(const Level& L, int a) const noexcept { return {L.lo[a], L.h[a], o_[a], d_[a], inv_[a], L.res[a], step_[a]}; }
+
+    /// Enters node `node` of the next level, which splits cell c of the current one, over [t0, t1].
+    void enter(const int* c, std::int32_t node, float t0, float t1) noexcept {
+        const Level& P = level_[depth_];
+        const int l = depth_ + 1;
+        Level& L = level_[l];
+        const Vec3& h = tree_->cell_size(l);
+        const Vec3& inv_h = tree_->inverse_cell_size(l);
+        const auto& res = tree_->level_res(l);
+        t_ = t0;
+        for (int a = 0; a < 3; ++a) {
+            L.lo[a] = P.lo[a] + float(c[a]) * P.h[a];  // the cell's corner, as MajorantTree::cell_box
+            L.h[a] = h[a];
+            L.res[a] = res[a];
+            const int guess = std::clamp(int((o_[a] + d_[a] * t0 - L.lo[a]) * inv_h[a]), 0, res[a] - 1);
+            axis(L, a).locate_near(guess, t0, L.cell[a], L.next[a]);
+        }
+        L.t_end = t1;
+        L.done = false;
+        L.cells = tree_->node_cells(l, node);
+        depth_ = l;
+    }
+
+    const MajorantTree<M>* tree_ = nullptr;
+    V unit_{};
+    float o_[3]{}, d_[3]{}, inv_[3]{};
+    int step_[3]{};
+    float t_ = 0.f;
+    int depth_ = -1;
+    std::uint32_t steps_ = 0;
+    /// Left uninitialised until the walk enters that level: an iterator is made per flight, and
+    /// zeroing every level each time cost more than the walk (measured).
+    Level level_[kMaxTreeSplits + 1];
 };
 
 /// A layout over a medium's own bounds: `coarse` cells, each split once into brick^3.
