@@ -52,8 +52,9 @@ inline constexpr int kMaxTreeSplits = 3;
 /// part's cost weighted by the part's share of the cell's surface (the chance a ray through the
 /// cell crosses it), plus a descent into the cell's node. `step_cost` is a DDA step's cost in
 /// lookups and `descent_cost` a descent's (both 0: split wherever the bound varies); the
-/// defaults, 0.3 and 1, are what this machine measures (a step about 20 ns, a descent, which
-/// starts a new DDA, about 100 ns, a tracked trilinear lookup 75 to 150 ns).
+/// defaults, 0.3 and 1, are what this machine measured (a step about 20 ns, a descent, which
+/// starts a new DDA, about 100 ns before the walk kept the ray's part once, a tracked trilinear
+/// lookup 75 to 150 ns).
 struct TreeLayout {
     Box box;
     std::array<int, 3> coarse{1, 1, 1};
