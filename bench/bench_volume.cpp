@@ -34,29 +34,8 @@ const NM& plume() {
 }
 
 /// nsp_volume's camera and lights around the plume's bounds.
-struct Framing {
-    Framing() {
-        const nsp::Box b = plume().bounds();
-        centre = 0.5f * (b.lo + b.hi);
-        radius = 0.5f * glm::length(b.hi - b.lo);
-        lights.set(nsp::EnvironmentLight<nsp::Mono>{nsp::Mono::Spectrum::Constant(0.1f)});
-        lights.set(nsp::SphereLight<nsp::Mono>{centre + radius * nsp::Vec3(0.6f, 2.f, -0.8f), 0.15f * radius,
-                                               nsp::Mono::Spectrum::Constant(250.f)});
-        eye = centre + radius * nsp::Vec3(0.f, 0.6f, -2.1f);
-        f = glm::normalize(centre - eye);
-        r = glm::normalize(glm::cross(nsp::Vec3(0.f, 1.f, 0.f), f));
-        up = glm::cross(f, r);
-    }
-    nsp::Ray ray(float u, float v) const {
-        return nsp::Ray{eye, glm::normalize(f + (2.f * u - 1.f) * tan_half * r + (2.f * v - 1.f) * tan_half * up)};
-    }
-    nsp::Vec3 centre, eye, f, r, up;
-    float radius = 1.f, tan_half = std::tan(0.5f * 40.f * nsp::kPi / 180.f);
-    nsp::Lights<nsp::Mono> lights;
-};
-
-const Framing& framing() {
-    static const Framing f;
+const nsp_examples::VolumeFraming<NM>& framing() {
+    static const nsp_examples::VolumeFraming<NM> f(plume());
     return f;
 }
 
@@ -67,7 +46,7 @@ const std::vector<nsp::Ray>& plume_rays() {
         std::vector<nsp::Ray> out;
         out.reserve(kSetSize);
         while (out.size() < kSetSize) {
-            const nsp::Ray ray = framing().ray(rng.uniform(), rng.uniform());
+            const nsp::Ray ray = framing()(rng.uniform(), rng.uniform());
             const nsp::Interval in = plume().bounds().clip(ray, 0.f, kTmax);
             bool hits = false;
             for (int k = 0; k < 512 && !in.empty() && !hits; ++k)

@@ -49,32 +49,6 @@ struct Options {
     bool no_png = false;
 };
 
-/// The scene's lights and camera around medium `m`: a dim white sky and a small sphere light
-/// above (radius 0.15 half-diagonals, 2.2 away: every strategy reaches it); 40 degrees vertical
-/// field of view from 2.2 half-diagonals in front of the centre, a little above it.
-template <class M>
-struct Framing {
-    using S = typename M::Spectral;
-    explicit Framing(const M& m) {
-        const nsp::Box b = m.bounds();
-        centre = 0.5f * (b.lo + b.hi);
-        radius = 0.5f * glm::length(b.hi - b.lo);
-        lights.set(nsp::EnvironmentLight<S>{nsp::constant_coefficient<S>(0.1f)});
-        lights.set(nsp::SphereLight<S>{centre + radius * nsp::Vec3(0.6f, 2.f, -0.8f), 0.15f * radius,
-                                       nsp::constant_coefficient<S>(250.f)});
-        eye = centre + radius * nsp::Vec3(0.f, 0.6f, -2.1f);
-        f = glm::normalize(centre - eye);
-        r = glm::normalize(glm::cross(nsp::Vec3(0.f, 1.f, 0.f), f));
-        up = glm::cross(f, r);
-    }
-    nsp::Ray operator()(float u, float v) const {
-        return nsp::Ray{eye, glm::normalize(f + (2.f * u - 1.f) * tan_half * r + (2.f * v - 1.f) * tan_half * up)};
-    }
-    nsp::Vec3 centre, eye, f, r, up;
-    float radius = 1.f, tan_half = std::tan(0.5f * 40.f * nsp::kPi / 180.f);
-    nsp::Lights<S> lights;
-};
-
 /// Prints the table of `rows` (time x variance against the best row) with `extra(row)` columns.
 template <class Extra>
 std::uint64_t print_rows(const std::vector<Row>& rows, double samples, const char* extra_head, Extra&& extra) {
@@ -107,7 +81,7 @@ void write_picture(const Row& row, const Options& o) {
 template <class M, class Maj>
 std::uint64_t run_strategies(const M& medium, const Maj& majorant, const Options& o) {
     using namespace nsp;
-    const Framing<M> cam(medium);
+    const nsp_examples::VolumeFraming<M> cam(medium);
     const auto scene = Scene(medium, majorant, HenyeyGreensteinPhase(o.g), cam.lights);
     std::vector<Row> rows;
     rows.push_back(nsp_examples::render_image(scene, PathEstimator<strategy::Unidirectional>{}, "unidirectional", o.res,
@@ -148,7 +122,7 @@ nsp::TreeMajorant<M> tree_majorant(const M& m, bool on_nodes = false) {
 template <class M>
 std::uint64_t compare_majorants(const M& medium, const Options& o) {
     using namespace nsp;
-    const Framing<M> cam(medium);
+    const nsp_examples::VolumeFraming<M> cam(medium);
     const PathEstimator<strategy::NullScatteringMis, mis::Balance> est;
     std::vector<Row> rows;
     std::vector<std::pair<std::size_t, double>> cost;  // bytes, build milliseconds

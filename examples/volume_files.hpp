@@ -5,6 +5,7 @@
 // that says which package to install.
 #pragma once
 
+#include <cmath>
 #include <memory>
 #include <string>
 #include <vector>
@@ -155,5 +156,31 @@ void write_volume(const std::string& path, MakeVoxels&& voxels, int plume_res, b
 #endif
     (void)plume_res, (void)plume;
 }
+
+/// nsp_volume's lights and camera around medium `m` (bench_volume times the same): a dim white sky and a small sphere light
+/// above (radius 0.15 half-diagonals, 2.2 away: every strategy reaches it); 40 degrees vertical
+/// field of view from 2.2 half-diagonals in front of the centre, a little above it.
+template <class M>
+struct VolumeFraming {
+    using S = typename M::Spectral;
+    explicit VolumeFraming(const M& m) {
+        const nsp::Box b = m.bounds();
+        centre = 0.5f * (b.lo + b.hi);
+        radius = 0.5f * glm::length(b.hi - b.lo);
+        lights.set(nsp::EnvironmentLight<S>{nsp::constant_coefficient<S>(0.1f)});
+        lights.set(nsp::SphereLight<S>{centre + radius * nsp::Vec3(0.6f, 2.f, -0.8f), 0.15f * radius,
+                                       nsp::constant_coefficient<S>(250.f)});
+        eye = centre + radius * nsp::Vec3(0.f, 0.6f, -2.1f);
+        f = glm::normalize(centre - eye);
+        r = glm::normalize(glm::cross(nsp::Vec3(0.f, 1.f, 0.f), f));
+        up = glm::cross(f, r);
+    }
+    nsp::Ray operator()(float u, float v) const {
+        return nsp::Ray{eye, glm::normalize(f + (2.f * u - 1.f) * tan_half * r + (2.f * v - 1.f) * tan_half * up)};
+    }
+    nsp::Vec3 centre, eye, f, r, up;
+    float radius = 1.f, tan_half = std::tan(0.5f * 40.f * nsp::kPi / 180.f);
+    nsp::Lights<S> lights;
+};
 
 }  // namespace nsp_examples
