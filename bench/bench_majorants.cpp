@@ -41,7 +41,10 @@
 //                                  difference in standard errors (|mean_z| > 4: not noise)
 //   bad/sample                     samples whose status was not Ok (aborted, non-finite, rejected)
 // BM_MajorantBuild/<medium>/<R> times the construction of a GridMajorant at R and reports its
-// memory_bytes(). bench/run_majorants.sh runs this binary and bench/plot_majorants.py plots it.
+// memory_bytes(). BM_MajorantChoice/<medium> (cloud, sparse, the fog of F1 and F3) times
+// choose_grid_resolution and reports the cost model's pick and its cost of every candidate
+// (docs/majorants.md: build/bench/nsp_bench_majorants --benchmark_filter=Choice).
+// bench/run_majorants.sh runs this binary and bench/plot_majorants.py plots it.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -427,6 +430,22 @@ void BM_MajorantBuild(benchmark::State& state, MediumId id, int res) {
     state.counters["cells"] = double(res) * res * res;
 }
 
+/// The cost model's pick (nsp/majorants/choose.hpp, one choose_grid_resolution per iteration)
+/// over `medium`, with its cost per random line of every candidate as counters (docs/majorants.md
+/// compares them with the sweep): cost_global, cost_grid2, ..., cost_grid64, and chosen_cells (0:
+/// the global majorant).
+void BM_MajorantChoice(benchmark::State& state, const GreyMedium* medium) {
+    nsp::MajorantCost best;
+    for (auto _ : state) {
+        best = nsp::choose_grid_resolution(*medium);
+        benchmark::DoNotOptimize(best.cost);
+    }
+    state.counters["chosen_cells"] = best.global ? 0.0 : double(best.resolution[0]);
+    state.counters["cost_global"] = nsp::global_majorant_cost(*medium).cost;
+    for (int r = 2; r <= 64; r *= 2)
+        state.counters["cost_grid" + std::to_string(r)] = nsp::grid_majorant_cost(*medium, {r, r, r}).cost;
+}
+
 const bool registered = [] {
     for (MediumId id : {MediumId::Cloud, MediumId::Sparse}) {
         add_grey_global<nsp::bound::Guaranteed>(id, "global", 0.f);
@@ -447,6 +466,13 @@ const bool registered = [] {
                                          BM_MajorantBuild, id, r)
                 ->MinTime(kMinTime)
                 ->Unit(benchmark::kMicrosecond);
+    static const GreyMedium fog_f1 = nsp_examples::make_fog_medium<Mono>(nsp_examples::FogSetup::F1);
+    static const GreyMedium fog_f3 = nsp_examples::make_fog_medium<Mono>(nsp_examples::FogSetup::F3);
+    for (const auto& [n, m] : {std::pair<const char*, const GreyMedium*>{"cloud", &grey_medium(MediumId::Cloud)},
+                               {"sparse", &grey_medium(MediumId::Sparse)}, {"fog-F1", &fog_f1}, {"fog-F3", &fog_f3}})
+        benchmark::RegisterBenchmark((std::string("BM_MajorantChoice/") + n).c_str(), BM_MajorantChoice, m)
+            ->MinTime(kMinTime)
+            ->Unit(benchmark::kMillisecond);
     return true;
 }();
 

@@ -16,6 +16,7 @@
 #include "majorant.hpp"
 #include "majorants/grid.hpp"
 #include "majorants/tree.hpp"
+#include "majorants/choose.hpp"
 #include "media/blackbody.hpp"
 #include "media/emissive.hpp"
 #include "media/exponential.hpp"

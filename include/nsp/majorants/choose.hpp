@@ -1,0 +1,115 @@
+// nsp/majorants/choose.hpp: the grid resolution a medium pays for, from a cost model, before any
+// rendering (THEORY 4, step 1; issue 19's "the majorant's cost too").
+//
+// A grid majorant trades DDA steps for lookups: finer cells bound the density more tightly, so a
+// flight meets fewer null collisions (each a density lookup), but it crosses more cells. Over
+// random lines through the medium's bounds (isotropic, uniform: the Crofton measure, as a BVH's
+// surface-area heuristic assumes), a line that meets the bounds B crosses a convex cell c with
+// probability S_c / S_B (surfaces), along a mean chord 4 V_c / S_c. So per line
+//   steps   = sum_c S_c / S_B                      (cells crossed, empty ones included)
+//   lookups = sum_c (S_c / S_B) mu_bar_c 4 V_c / S_c = (4 / S_B) sum_c mu_bar_c V_c
+// (tentative collisions of a flight that tracks the whole chord), and a resolution costs
+// lookups + step_cost x steps, step_cost a step's cost in lookups. The global majorant takes no
+// step. The model ignores where flights start and stop (inside the medium, at real collisions),
+// which scales steps and lookups alike where the medium is uniform, and the variance a majorant
+// changes (none for delta tracking's weights; ratio-tracked NEE varies a little more under tighter
+// bounds): it ranks resolutions, measured against the renders in docs/majorants.md.
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <string>
+
+#include "../core/error.hpp"
+#include "../majorant.hpp"
+#include "../medium.hpp"
+#include "grid.hpp"
+
+namespace nsp {
+
+/// A DDA step's cost in density lookups that choose_grid_resolution assumes by default: a step
+/// about 20 ns, a tracked trilinear lookup about 60 ns on this machine (docs/majorants.md).
+inline constexpr float kDefaultStepCost = 0.3f;
+
+/// What the cost model expects of a majorant per random line through the medium's bounds.
+struct MajorantCost {
+    bool global = false;                 ///< the GlobalMajorant (no grid, no steps)
+    std::array<int, 3> resolution{1, 1, 1};  ///< the grid's cells per axis (global: {1, 1, 1})
+    double steps = 0.0;                  ///< DDA steps (cells crossed)
+    double lookups = 0.0;                ///< tentative collisions, each a density lookup
+    double cost = 0.0;                   ///< lookups + step_cost x steps
+};
+
+namespace detail {
+
+inline double box_surface(const Box& b) noexcept {
+    const double x = double(b.hi.x) - b.lo.x, y = double(b.hi.y) - b.lo.y, z = double(b.hi.z) - b.lo.z;
+    return 2.0 * (x * y + y * z + z * x);
+}
+
+inline void require_step_cost(float step_cost) {
+    if (!std::isfinite(step_cost) || step_cost < 0.f)
+        detail::fail("majorant cost model: step_cost = ", step_cost,
+             " is not allowed: it must be finite and >= 0 (a DDA step's cost in density lookups)");
+}
+
+}  // namespace detail
+
+/// The cost model's steps and lookups per random line for the GlobalMajorant of `medium`.
+template <RegionBoundedMedium M>
+MajorantCost global_majorant_cost(const M& medium) {
+    const Box b = medium.bounds();
+    const double s = detail::box_surface(b);
+    if (!std::isfinite(s) || !(s > 0.0))
+        detail::fail("global_majorant_cost: the medium's bounds have surface ", s, "; they must be finite and non-empty");
+    const double volume = (double(b.hi.x) - b.lo.x) * (double(b.hi.y) - b.lo.y) * (double(b.hi.z) - b.lo.z);
+    MajorantCost c;
+    c.global = true;
+    c.lookups = 4.0 * double(GlobalMajorant<M>(medium).value()) * volume / s;
+    c.cost = c.lookups;
+    return c;
+}
+
+/// The cost model's steps and lookups per random line for a GridMajorant of `res` cells over
+/// `medium`'s bounds (its cells as GridMajorant builds them, padding included). Throws as
+/// GridMajorant does, and on a step_cost that is negative or not finite.
+template <RegionBoundedMedium M>
+MajorantCost grid_majorant_cost(const M& medium, std::array<int, 3> res, float step_cost = kDefaultStepCost) {
+    detail::require_step_cost(step_cost);
+    const GridMajorant<M> grid(medium, res);
+    const Box b = medium.bounds();
+    const double s = detail::box_surface(b);
+    const Vec3 h = grid.cell_size();
+    const double cell_surface = 2.0 * (double(h.x) * h.y + double(h.y) * h.z + double(h.z) * h.x);
+    const double cell_volume = double(h.x) * h.y * h.z;
+    double mu_volume = 0.0;
+    for (int z = 0; z < res[2]; ++z)
+        for (int y = 0; y < res[1]; ++y)
+            for (int x = 0; x < res[0]; ++x) mu_volume += double(grid.cell(x, y, z));
+    MajorantCost c;
+    c.resolution = res;
+    c.steps = double(res[0]) * res[1] * res[2] * cell_surface / s;
+    c.lookups = 4.0 * mu_volume * cell_volume / s;
+    c.cost = c.lookups + double(step_cost) * c.steps;
+    return c;
+}
+
+/// The majorant the cost model prefers for `medium`: the GlobalMajorant, or a GridMajorant of
+/// 2, 4, 8, ... up to max_res cells per axis (as GridMajorant(medium, R) builds it), whichever
+/// costs least per random line (ties to the coarser). Builds each candidate grid once (at 64,
+/// 262144 density bounds). Throws on max_res outside [1, 4096] or a bad step_cost.
+template <RegionBoundedMedium M>
+MajorantCost choose_grid_resolution(const M& medium, int max_res = 64, float step_cost = kDefaultStepCost) {
+    if (max_res < 1 || max_res > 4096)
+        detail::fail("choose_grid_resolution: max_res = ", max_res, " is not allowed: it must lie in [1, 4096]");
+    detail::require_step_cost(step_cost);
+    MajorantCost best = global_majorant_cost(medium);
+    for (int r = 2; r <= max_res; r *= 2) {
+        const MajorantCost c = grid_majorant_cost(medium, {r, r, r}, step_cost);
+        if (c.cost < best.cost) best = c;
+    }
+    return best;
+}
+
+}  // namespace nsp
