@@ -158,9 +158,21 @@ std::uint64_t compare_majorants(const M& medium, const Options& o) {
         auto [maj, ms] = timed([&] { return GlobalMajorant<M>(medium); });
         run(maj, ms, sizeof(float), "global");
     }
+    // The cost model's pick (nsp/majorants/choose.hpp), rendered as a row of its own when it is
+    // a grid the comparison does not already hold.
+    const auto [pick, pick_ms] = timed([&] { return nsp::choose_grid_resolution(medium); });
+    const int picked = pick.global ? 0 : pick.resolution[0];
+    std::printf("cost model (choose_grid_resolution, %.0f ms): %s, %.3g lookups + 0.3 x %.3g steps per random line "
+                "(global: %.3g lookups)\n",
+                pick_ms, picked ? ("grid " + std::to_string(picked) + "^3").c_str() : "global", pick.lookups, pick.steps,
+                nsp::global_majorant_cost(medium).lookups);
     for (const int n : {16, 64}) {
         auto [maj, ms] = timed([&] { return GridMajorant<M>(medium, n); });
         run(maj, ms, maj.memory_bytes(), "grid " + std::to_string(n) + "^3");
+    }
+    if (picked && picked != 16 && picked != 64) {
+        auto [maj, ms] = timed([&] { return GridMajorant<M>(medium, picked); });
+        run(maj, ms, maj.memory_bytes(), "grid " + std::to_string(picked) + "^3 (model)");
     }
     auto describe = [](const char* name, const TreeMajorant<M>& t) {
         const auto l = t.layout();
