@@ -43,11 +43,6 @@ struct MajorantCost {
 
 namespace detail {
 
-inline double box_surface(const Box& b) noexcept {
-    const double x = double(b.hi.x) - b.lo.x, y = double(b.hi.y) - b.lo.y, z = double(b.hi.z) - b.lo.z;
-    return 2.0 * (x * y + y * z + z * x);
-}
-
 inline void require_step_cost(float step_cost) {
     if (!std::isfinite(step_cost) || step_cost < 0.f)
         detail::fail("majorant cost model: step_cost = ", step_cost,
@@ -63,10 +58,9 @@ MajorantCost global_majorant_cost(const M& medium) {
     const double s = detail::box_surface(b);
     if (!std::isfinite(s) || !(s > 0.0))
         detail::fail("global_majorant_cost: the medium's bounds have surface ", s, "; they must be finite and non-empty");
-    const double volume = (double(b.hi.x) - b.lo.x) * (double(b.hi.y) - b.lo.y) * (double(b.hi.z) - b.lo.z);
     MajorantCost c;
     c.global = true;
-    c.lookups = 4.0 * double(GlobalMajorant<M>(medium).value()) * volume / s;
+    c.lookups = double(GlobalMajorant<M>(medium).value()) * detail::mean_chord(b);
     c.cost = c.lookups;
     return c;
 }

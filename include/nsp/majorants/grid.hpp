@@ -41,6 +41,17 @@ namespace detail {
 /// this is 2^-16, about 500 ulps, so the bound holds for what the lookup actually returns).
 inline constexpr float kGridMajorantPad = 1.f + 1.f / 65536.f;
 
+/// The surface of box b, and a random line's mean chord through it, 4 V / S (Cauchy): what the
+/// surface-area cost models of the tree majorant and of choose_grid_resolution weigh cells by.
+inline double box_surface(const Box& b) noexcept {
+    const double x = double(b.hi.x) - b.lo.x, y = double(b.hi.y) - b.lo.y, z = double(b.hi.z) - b.lo.z;
+    return 2.0 * (x * y + y * z + z * x);
+}
+inline double mean_chord(const Box& b) noexcept {
+    const double x = double(b.hi.x) - b.lo.x, y = double(b.hi.y) - b.lo.y, z = double(b.hi.z) - b.lo.z;
+    return 2.0 * x * y * z / (x * y + y * z + z * x);
+}
+
 /// One axis of a DDA: the planes lo + k h (k = 0 .. res) crossed by the ray o + t d, with inv =
 /// 1 / d where that is finite (0 where d is 0 or denormal: the division is kept there) and step
 /// the sign of d. Shared by GridWalk and the tree majorant's walk, so that both cross every plane

@@ -225,16 +225,6 @@ private:
         std::uint32_t packed() const noexcept { return node >= 0 ? kSplit | std::uint32_t(node) : std::bit_cast<std::uint32_t>(value); }
     };
 
-    /// A random line's mean chord through box b, 4 V / S (Cauchy), and b's surface.
-    static double chord(const Box& b) noexcept {
-        const double x = double(b.hi.x) - b.lo.x, y = double(b.hi.y) - b.lo.y, z = double(b.hi.z) - b.lo.z;
-        return 2.0 * x * y * z / (x * y + y * z + z * x);
-    }
-    static double surface(const Box& b) noexcept {
-        const double x = double(b.hi.x) - b.lo.x, y = double(b.hi.y) - b.lo.y, z = double(b.hi.z) - b.lo.z;
-        return 2.0 * (x * y + y * z + z * x);
-    }
-
     /// Builds cell `region` of level l: its bound and, where that pays, its split (children first).
     Built build(const M& medium, int l, const Box& region, const int* c, const char* what) {
         const float d = medium.density_bound(region);
@@ -251,7 +241,7 @@ private:
                  "; it must be > 0 there");
         // As one cell: a step, and mu_bar times the mean chord tentative collisions.
         const double step = double(layout_.step_cost);
-        const double as_leaf = step + double(v) * double(unit_) * chord(region);
+        const double as_leaf = step + double(v) * double(unit_) * mean_chord(region);
         if (!(v > 0.f) || l + 1 >= levels_) return {v, -1, as_leaf};  // empty, or a finest cell
         const auto r = res(l + 1);
         const std::size_t k = per_node(l + 1);
@@ -264,7 +254,7 @@ private:
         // The step into the cell and the descent into its node, then each child in proportion to
         // its surface.
         double as_split = step + double(layout_.descent_cost);
-        const double area = surface(region);
+        const double area = box_surface(region);
         std::size_t j = 0;
         for (int z = 0; z < r[2]; ++z)
             for (int y = 0; y < r[1]; ++y)
@@ -274,12 +264,12 @@ private:
                     const Built b = build(medium, l + 1, part, g, what);
                     parts[j] = b.packed();
                     if (j == 0) first = b.value;
-                    as_split += surface(part) / area * b.cost;
+                    as_split += box_surface(part) / area * b.cost;
                     uniform = uniform && b.node < 0 && b.value == first;
                 }
         if (uniform || !(as_split < as_leaf)) {  // a constant tile, or a split that does not pay
             for (int m = l + 1; m < levels_; ++m) cells_[m].resize(mark[m]);
-            return uniform ? Built{first, -1, step + double(first) * double(unit_) * chord(region)} : Built{v, -1, as_leaf};
+            return uniform ? Built{first, -1, step + double(first) * double(unit_) * mean_chord(region)} : Built{v, -1, as_leaf};
         }
         if (cells_[l + 1].size() / k >= std::size_t(kSplit))
             fail(what, ": more than 2^31 nodes at level ", l + 1, "; a coarser layout is needed");
