@@ -170,3 +170,56 @@ TEST_CASE("lights: a directional light is a delta light from one direction, neve
 }
 
 }  // namespace
+
+namespace {
+
+TEST_CASE("lights: emission sampling (light subpaths) matches emission_pdf and emits the light's power") {
+    // For every EmittingLight model: the densities a sample reports equal emission_pdf() of its
+    // point and direction (and the sampler's, selection included), the direction leaves the
+    // emitting side, and E[radiance cos / (pdf_pos pdf_dir)] is the emitted power in closed form:
+    // pi L A for a quad, pi L 4 pi r^2 for a sphere, 4 pi I for a point light (5 SE, fixed seed).
+    using M = Mono;
+    const QuadLight<M> quad{Vec3(-1.f, 2.f, 0.f), Vec3(2.f, 0.f, 0.f), Vec3(0.f, 0.f, 0.5f), M::Spectrum::Constant(3.f)};
+    const SphereLight<M> sphere{Vec3(0.f, 1.f, 2.f), 0.4f, M::Spectrum::Constant(2.f)};
+    const PointLight<M> point{Vec3(1.f, 1.f, 1.f), M::Spectrum::Constant(5.f)};
+    const LightSampler<M, QuadLight<M>, SphereLight<M>, PointLight<M>, EnvironmentLight<M>> sampler(
+        LightSelection::Uniform, 10.f, {quad}, {sphere}, {point}, {EnvironmentLight<M>{M::Spectrum::Constant(1.f)}});
+    const double powers[3] = {kPi * 3.0 * 1.0, kPi * 2.0 * 4.0 * kPi * 0.16, 4.0 * kPi * 5.0};
+    CHECK(sampler.emission_selection_pdf(0) == doctest::Approx(1.f / 3.f));
+    CHECK(sampler.emission_selection_pdf(3) == 0.f);  // the environment starts no light subpaths
+    Pcg32 rng(5, 9);
+    auto check_model = [&](const auto& light, double power, int index) {
+        Stat s;
+        for (int i = 0; i < 20000; ++i) {
+            const float u[4] = {rng.uniform(), rng.uniform(), rng.uniform(), rng.uniform()};
+            const LightEmission<M> e = light.sample_emission(u[0], u[1], u[2], u[3]);
+            REQUIRE(e.pdf_pos > 0.f);
+            REQUIRE(e.pdf_dir > 0.f);
+            const EmissionDensity d = light.emission_pdf(e.p, e.w);
+            CHECK(d.pdf_pos == doctest::Approx(e.pdf_pos).epsilon(1e-4));
+            CHECK(d.pdf_dir == doctest::Approx(e.pdf_dir).epsilon(1e-3));
+            CHECK(d.cos == doctest::Approx(e.cos).epsilon(1e-3));
+            CHECK(glm::dot(e.n, e.w) > 0.f);
+            const EmissionDensity ds = sampler.emission_pdf(index, e.p, e.w);
+            CHECK(ds.pdf_pos == doctest::Approx(e.pdf_pos / 3.f).epsilon(1e-4));
+            s.add(double(e.radiance[0]) * e.cos / (double(e.pdf_pos) * e.pdf_dir));
+        }
+        CAPTURE(index);
+        CAPTURE(s.mean);
+        CHECK(std::abs(s.mean - power) <= kSigmas * s.se() + 1e-5 * power);
+    };
+    check_model(quad, powers[0], 0);
+    check_model(sphere, powers[1], 1);
+    check_model(point, powers[2], 2);
+    // The sampler picks each emitter with its probability and reports it.
+    int picked[4] = {0, 0, 0, 0};
+    for (int i = 0; i < 3000; ++i) {
+        const EmittedLight<M> e = sampler.sample_emission(rng.uniform(), rng.uniform(), rng.uniform(), rng.uniform(), rng.uniform());
+        REQUIRE(e.light >= 0);
+        ++picked[e.light];
+    }
+    CHECK(picked[3] == 0);
+    for (int i = 0; i < 3; ++i) CHECK(std::abs(picked[i] - 1000) < 5 * std::sqrt(3000 * (1.0 / 3) * (2.0 / 3)));
+}
+
+}  // namespace

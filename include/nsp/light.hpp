@@ -4,6 +4,7 @@
 // angle at the shading point).
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <concepts>
 #include <limits>
@@ -31,6 +32,33 @@ struct LightSample {
     float pdf = 0.f;                  ///< solid-angle pdf including light selection (delta: selection only); 0: no sample
     bool delta = false;               ///< a point light: no other strategy can sample it
     bool occludable_by_sphere = false;///< Lights<S>: the sphere light may block this sample
+};
+
+/// A point and direction of emission drawn from a light, for light subpaths (THEORY 5.5): the
+/// point by `pdf_pos` (area measure; 1 for a point light's delta position), the direction leaving
+/// it by `pdf_dir` (solid angle), the radiance (a point light: its intensity) sent along `w`, and
+/// `cos` = |n . w| at the point (1 for a point light). pdf_pos 0: no sample.
+template <SpectralMode S>
+struct LightEmission {
+    Vec3 p{0.f}, n{0.f, 0.f, 1.f}, w{0.f, 0.f, 1.f};  ///< the point, its unit normal (a point light: w), the direction
+    typename S::Spectrum radiance = S::Spectrum::Zero();
+    float pdf_pos = 0.f, pdf_dir = 0.f, cos = 0.f;
+    bool delta_position = false;  ///< a point light: no path can hit it
+};
+
+/// The densities with which a light's `sample_emission` produces point p (on the light) and a
+/// direction w leaving it, and |n . w| there (see LightEmission).
+struct EmissionDensity {
+    float pdf_pos = 0.f, pdf_dir = 0.f, cos = 0.f;
+};
+
+/// A light from which light subpaths start (BdptEstimator): `sample_emission(u1, u2, u3, u4,
+/// lambda)` and `emission_pdf(p, w)` as above. Lights at infinity and DirectionalLight have none;
+/// bidirectional estimators reach them by hitting and by NEE alone.
+template <class L, class S>
+concept EmittingLight = SpectralMode<S> && requires(const L& l, const Vec3& v, float u, const typename S::Wavelengths& lambda) {
+    { l.sample_emission(u, u, u, u, lambda) } -> std::same_as<LightEmission<S>>;
+    { l.emission_pdf(v, v) } -> std::same_as<EmissionDensity>;
 };
 
 /// A light a host's loop samples for NEE and may hit (THEORY 5.8). `sample(x, u1, u2, lambda,
@@ -74,6 +102,13 @@ struct PointLight {
         return S::Spectrum::Zero();  // a point is never hit
     }
     float power(float = 1.f) const noexcept { return 4.f * kPi * max_value(intensity); }
+
+    /// Its position and a uniform direction: intensity along w, pdf_dir 1 / (4 pi).
+    LightEmission<S> sample_emission(float u1, float u2, float, float, const typename S::Wavelengths& l = {}) const noexcept {
+        const Vec3 w = uniform_sphere(u1, u2);
+        return {position, w, w, S::sample(intensity, l), 1.f, kInv4Pi, 1.f, true};
+    }
+    EmissionDensity emission_pdf(const Vec3&, const Vec3&) const noexcept { return {1.f, kInv4Pi, 1.f}; }
 };
 
 /// A sphere emitting radiance `radiance` from its surface, outward. Opaque: it blocks light.
@@ -123,6 +158,20 @@ struct SphereLight {
     }
     /// pi L x area: what a Lambertian emitter of radiance L sends out.
     float power(float = 1.f) const noexcept { return kPi * max_value(radiance) * 4.f * kPi * radius * radius; }
+
+    /// A uniform point on the sphere, a cosine-weighted direction around its outward normal.
+    LightEmission<S> sample_emission(float u1, float u2, float u3, float u4,
+                                     const typename S::Wavelengths& l = {}) const noexcept {
+        const Vec3 n = uniform_sphere(u1, u2);
+        const float c = std::sqrt(std::max(0.f, 1.f - u3));
+        if (!(c > 0.f)) return {};
+        return {center + radius * n, n, direction_around(n, c, 2.f * kPi * u4), S::sample(radiance, l),
+                1.f / (4.f * kPi * radius * radius), c / kPi, c, false};
+    }
+    EmissionDensity emission_pdf(const Vec3& p, const Vec3& w) const noexcept {
+        const float c = glm::dot(glm::normalize(p - center), w);
+        return {1.f / (4.f * kPi * radius * radius), c > 0.f ? c / kPi : 0.f, std::max(c, 0.f)};
+    }
 };
 
 /// A one-sided rectangle at `corner` spanned by `edge_u` and `edge_v`, emitting `radiance` toward
@@ -177,6 +226,20 @@ struct QuadLight {
                                            : typename S::Spectrum(S::Spectrum::Zero());
     }
     float power(float = 1.f) const noexcept { return kPi * max_value(radiance) * area(); }
+
+    /// A uniform point on the rectangle, a cosine-weighted direction on its emitting side.
+    LightEmission<S> sample_emission(float u1, float u2, float u3, float u4,
+                                     const typename S::Wavelengths& l = {}) const noexcept {
+        const Vec3 n = normal();
+        const float c = std::sqrt(std::max(0.f, 1.f - u3));
+        if (!(c > 0.f)) return {};
+        return {corner + u1 * edge_u + u2 * edge_v, n, direction_around(n, c, 2.f * kPi * u4), S::sample(radiance, l),
+                1.f / area(), c / kPi, c, false};
+    }
+    EmissionDensity emission_pdf(const Vec3&, const Vec3& w) const noexcept {
+        const float c = glm::dot(normal(), w);
+        return {1.f / area(), c > 0.f ? c / kPi : 0.f, std::max(c, 0.f)};
+    }
 };
 
 /// Constant radiance arriving from every direction at infinity, sampled uniformly.

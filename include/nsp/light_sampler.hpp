@@ -23,6 +23,13 @@
 
 namespace nsp {
 
+/// A light subpath's first vertex and the light it came from (LightSampler::sample_emission).
+template <SpectralMode S>
+struct EmittedLight {
+    LightEmission<S> emission;  ///< pdf_pos includes the selection probability; 0: no sample
+    int light = -1;             ///< the light's index, or -1
+};
+
 /// How LightSampler chooses a light.
 enum class LightSelection : std::uint8_t {
     Uniform,  ///< every light with probability 1 / count
@@ -83,6 +90,60 @@ public:
             t.cdf = aim_total > 0.0 ? float(aim_cdf / aim_total) : 0.f;
         }
         if (!targets_.empty()) targets_.back().cdf = 1.f;
+        // The lights light subpaths start from (EmittingLight models), by the same selection
+        // probabilities renormalised over them.
+        double emit_total = 0.0;
+        for (std::size_t i = 0; i < entries_.size(); ++i)
+            if (emits(entries_[i])) emit_total += double(entries_[i].pmf);
+        emit_pmf_.assign(entries_.size(), 0.f);
+        double emit_cdf = 0.0;
+        for (std::size_t i = 0; i < entries_.size(); ++i)
+            if (emits(entries_[i]) && emit_total > 0.0) {
+                emit_cdf += double(entries_[i].pmf);
+                emit_pmf_[i] = float(double(entries_[i].pmf) / emit_total);
+                emitters_.push_back({int(i), float(emit_cdf / emit_total)});
+            }
+        if (!emitters_.empty()) emitters_.back().cdf = 1.f;
+    }
+
+    /// Whether every light model can start light subpaths, or is reached from infinity (hit or
+    /// NEE only): what a bidirectional estimator needs of its lights.
+    static constexpr bool bidirectional_ready() noexcept {
+        return ((EmittingLight<Ls, S> || is_infinite<Ls>() || bool(Ls::is_delta)) && ...);
+    }
+
+    /// The probability with which sample_emission() starts at light `light` (0 for lights at
+    /// infinity, directional lights and indices outside the table).
+    float emission_selection_pdf(int light) const noexcept {
+        return light >= 0 && light < count() ? emit_pmf_[std::size_t(light)] : 0.f;
+    }
+
+    /// Chooses a light that emits from a point (an EmittingLight) with u0, and a point on it and a
+    /// direction leaving it with (u1, u2) and (u3, u4). pdf_pos 0 when there is none.
+    EmittedLight<S> sample_emission(float u0, float u1, float u2, float u3, float u4,
+                                    const typename S::Wavelengths& lambda = {}) const noexcept {
+        if (emitters_.empty()) return {};
+        const auto it = std::upper_bound(emitters_.begin(), emitters_.end(), u0,
+                                         [](float u, const Emitter& e) { return u < e.cdf; });
+        const int light = std::min(it, emitters_.end() - 1)->light;
+        EmittedLight<S> out{{}, light};
+        visit(entries_[std::size_t(light)], [&](const auto& l) {
+            if constexpr (EmittingLight<std::decay_t<decltype(l)>, S>) out.emission = l.sample_emission(u1, u2, u3, u4, lambda);
+        });
+        out.emission.pdf_pos *= emit_pmf_[std::size_t(light)];
+        return out;
+    }
+
+    /// The densities with which sample_emission() starts at point p of light `light` (selection
+    /// included in pdf_pos) and leaves along w; all 0 for a light it never starts from.
+    EmissionDensity emission_pdf(int light, const Vec3& p, const Vec3& w) const noexcept {
+        EmissionDensity d;
+        if (!(emission_selection_pdf(light) > 0.f)) return d;
+        visit(entries_[std::size_t(light)], [&](const auto& l) {
+            if constexpr (EmittingLight<std::decay_t<decltype(l)>, S>) d = l.emission_pdf(p, w);
+        });
+        d.pdf_pos *= emit_pmf_[std::size_t(light)];
+        return d;
     }
 
     /// The equiangular strategies' targets (THEORY 5.4): one per light with a point to aim at
@@ -156,6 +217,12 @@ private:
         float pmf, cdf;
     };
 
+    bool emits(const Entry& e) const noexcept {
+        bool r = false;
+        visit(e, [&](const auto& l) { r = EmittingLight<std::decay_t<decltype(l)>, S>; });
+        return r;
+    }
+
     template <class F>
     void for_each_light(F&& f) const {
         [&]<std::size_t... K>(std::index_sequence<K...>) {
@@ -205,6 +272,12 @@ private:
         float pmf, cdf;
     };
     std::vector<Target> targets_;
+    struct Emitter {
+        int light;
+        float cdf;
+    };
+    std::vector<Emitter> emitters_;  ///< the EmittingLight entries, with their cdf for sample_emission
+    std::vector<float> emit_pmf_;    ///< by light index: sample_emission's probability of it
 };
 
 }  // namespace nsp

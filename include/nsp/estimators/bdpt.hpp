@@ -1,0 +1,617 @@
+// nsp/estimators/bdpt.hpp: volumetric bidirectional path tracing over a SurfaceScene with full
+// null-vertex MIS (THEORY 5.5), grey (one pdf for every channel, as PathEstimator).
+//
+// A camera subpath and a light subpath are delta-tracked through the scene's media and surfaces
+// (the same VertexKernels and interface crossings as estimators/surface_path.hpp). Every real
+// vertex stores the density with which its own subpath drew it and the density with which the
+// other side would have drawn it, in area measure on surfaces and volume measure in media, each
+// with the segment's null-scattering factors: prod P_n(n_j) of the nulls on the segment it was
+// drawn along, and mu_bar P_s at a medium vertex (the Tbar and mu_bar(n_j) factors appear in
+// every strategy's pdf of a segment and cancel). Strategies (s, t), s light vertices and t camera
+// vertices, t >= 2:
+// - s = 0: the camera subpath hits an emitter (a surface light, or the lights at infinity);
+// - s = 1: next-event estimation from the camera vertex (the scene's light sampler);
+// - s >= 2: a connection between light vertex s-1 and camera vertex t-1, its transmittance and its
+//   nulls' P_n product by ratio tracking across the media and null interfaces between them.
+// Each is weighted against every other strategy that could have drawn the same path (bdpt::
+// strategy_weight). Light tracing (t = 1, splatting onto the image) is not among them: the
+// weights leave it out consistently, so every path's weights still sum to 1.
+//
+// Policies: bdpt::NullScattering (the paper's full null-scattering MIS) or bdpt::Directional
+// (the baseline: direction pdfs and geometry only, the tracking factors left out, as pbrt's BDPT
+// weighs medium vertices), the heuristic (mis::Balance or mis::Power), the absorption policy of
+// the tracked segments, and MaxDepth, the longest subpath the fixed-size vertex arrays hold (no
+// heap allocation in the kernel). Lights at infinity and DirectionalLight start no light subpaths:
+// paths to them are weighted among s = 0 and s = 1 alone. Russian roulette divides the subpaths'
+// throughputs as in PathEstimator, but the weights leave it out (the same for every strategy, so
+// they still sum to 1; the survival probability of a subpath read backwards is not defined).
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <type_traits>
+
+#include "../core/counter.hpp"
+#include "../core/rng.hpp"
+#include "../geometry.hpp"
+#include "../media/emissive.hpp"
+#include "../mis.hpp"
+#include "../surface_scene.hpp"
+#include "../vertex.hpp"
+#include "common.hpp"
+#include "surface_walk.hpp"
+
+namespace nsp {
+
+namespace bdpt {
+
+/// Full null-scattering MIS over the (s, t) strategies (THEORY 5.5).
+struct NullScattering {
+    static constexpr const char* name = "bdpt-null-mis";
+    static constexpr bool null_pdfs = true;
+};
+/// The baseline: the strategies weighted by direction pdfs and geometry alone (THEORY 5.2, 5.5).
+struct Directional {
+    static constexpr const char* name = "bdpt-directional-mis";
+    static constexpr bool null_pdfs = false;
+};
+
+template <class T>
+concept MisPolicy = requires {
+    { T::name } -> std::convertible_to<const char*>;
+    { T::null_pdfs } -> std::convertible_to<bool>;
+};
+
+/// The densities of one path x_0 (on a light, or at infinity) .. x_k (the camera) under every
+/// strategy, as the weights need them (k <= N - 1):
+/// - from_light[i], i in 1..k-1: the density of x_i drawn from x_{i-1} on the light side;
+/// - from_camera[i], i in 0..k-1: the density of x_i drawn from x_{i+1} on the camera side
+///   (from_camera[k-1] = 1: the camera's own, the same in every strategy with t >= 2);
+/// - emit: the density of x_0 under light subpaths (the light sampler's emission, selection
+///   included; 0 for lights at infinity); nee: its density under NEE from x_1 (solid angle at
+///   infinity, area measure otherwise, a point light's selection probability);
+/// - connectible[i]: x_i is not a delta vertex (a mirror), so a connection may end there.
+/// Strategy s draws x_0..x_{s-1} from the light and x_s..x_k from the camera.
+template <int N>
+struct PathPdfs {
+    int k = 0;
+    float emit = 0.f, nee = 0.f;
+    float from_light[N] = {};
+    float from_camera[N] = {};
+    bool connectible[N] = {};
+};
+
+/// Strategy s's pdf of the path relative to the largest of all strategies' (each in [0, 1]; 0
+/// where s cannot draw it), written into q[0..k-1]. Each vertex's two densities are scaled by
+/// their larger one and the products taken in double, so long paths neither overflow nor
+/// underflow. Returns false when no strategy can draw the path.
+template <int N>
+bool strategy_pdfs(const PathPdfs<N>& p, double* q) noexcept {
+    const int k = p.k;
+    if (k < 1 || k >= N) return false;
+    double l[N], c[N];
+    for (int i = 1; i < k; ++i) {
+        const double a = double(p.from_light[i]), b = double(p.from_camera[i]), m = std::max(a, b);
+        l[i] = m > 0.0 ? a / m : 0.0;
+        c[i] = m > 0.0 ? b / m : 0.0;
+    }
+    // suffix[j] = prod_{i=j}^{k-1} c_i
+    double suffix[N + 1];
+    suffix[k] = 1.0;
+    for (int i = k - 1; i >= 1; --i) suffix[i] = suffix[i + 1] * c[i];
+    const double m0 = std::max({double(p.from_camera[0]), double(p.nee), double(p.emit)});
+    if (!(m0 > 0.0)) return false;
+    double prefix = 1.0, largest = 0.0;  // prefix = prod_{i=1}^{s-1} l_i
+    for (int s = 0; s < k; ++s) {
+        if (s >= 2) prefix *= l[s - 1];
+        double v = 0.0;
+        if (s == 0) v = double(p.from_camera[0]) / m0 * suffix[1];
+        else if (s == 1) v = p.connectible[1] ? double(p.nee) / m0 * suffix[1] : 0.0;
+        else if (p.connectible[s - 1] && p.connectible[s]) v = double(p.emit) / m0 * prefix * suffix[s];
+        q[s] = v;
+        largest = std::max(largest, v);
+    }
+    if (!(largest > 0.0)) return false;
+    for (int s = 0; s < k; ++s) q[s] /= largest;
+    return true;
+}
+
+/// The MIS weight of strategy s for the path: power(p_s) / sum_s' power(p_s') over the strategies
+/// that can draw it (THEORY 5.5). The weights of all strategies of one path sum to 1; 0 where s
+/// cannot draw it. NaN densities give NaN (the estimator reports Status::NonFinite).
+template <mis::CombiningHeuristic H, int N>
+float strategy_weight(const H& h, const PathPdfs<N>& p, int s) noexcept {
+    if (s < 0 || s >= p.k) return 0.f;
+    double q[N];
+    if (!strategy_pdfs(p, q)) return 0.f;
+    if (!(q[s] > 0.0)) return std::isnan(q[s]) ? q[s] : 0.f;
+    double sum = 0.0;
+    for (int i = 0; i < p.k; ++i) sum += double(h.power(float(q[i])));
+    return float(double(h.power(float(q[s]))) / sum);
+}
+
+/// What one vertex of a subpath is.
+enum class VertexKind : std::uint8_t { Camera, Light, Surface, Medium };
+
+/// A real vertex of a camera or light subpath.
+template <SpectralMode S>
+struct Vertex {
+    Vec3 p{0.f};
+    Vec3 ng{0.f, 0.f, 1.f}, ns{0.f, 0.f, 1.f};  ///< normals (surfaces; a light vertex: its emitting normal)
+    Vec3 wo{0.f, 0.f, 1.f};                      ///< the subpath's direction of travel arriving at p
+    typename S::Spectrum beta = S::Spectrum::Zero();  ///< the subpath's throughput up to p
+    float pdf_fwd = 0.f;   ///< density of p drawn by its own subpath (area / volume measure, with N and E)
+    float pdf_rev = 0.f;   ///< density of p drawn from the other side, from the next vertex of its subpath
+    float nulls_in = 1.f;  ///< N: prod P_n of the segment arriving at p (1 under Directional)
+    float event = 1.f;     ///< E: mu_bar P_s at a medium vertex (1 on surfaces and under Directional)
+    int material = -1, medium = -1, medium_front = -1, medium_back = -1, light = -1;
+    VertexKind kind = VertexKind::Camera;
+    bool delta = false;           ///< a delta lobe was sampled here: no connection may end at p
+    bool delta_position = false;  ///< a point light: no path hits it
+
+    /// The medium a ray leaving p along w travels in.
+    int medium_toward(const Vec3& w) const noexcept {
+        if (kind != VertexKind::Surface) return medium;
+        return glm::dot(w, ng) > 0.f ? medium_front : medium_back;
+    }
+};
+
+/// The vertices of one strategy's path, for an observer (BdptEstimator::radiance_observed): the
+/// light subpath's first s vertices (s >= 2), the camera subpath's first t (z_0 the camera; for
+/// s = 0 the emitter hit is not among them), and x_0's position (the light point; for a light at
+/// infinity the last camera vertex's).
+template <SpectralMode S>
+struct PathVertices {
+    const Vertex<S>* light = nullptr;
+    int s = 0;
+    const Vertex<S>* camera = nullptr;
+    int t = 0;
+    Vec3 x0{0.f};
+};
+
+/// Converts a solid-angle density at `from` toward vertex `to` into `to`'s measure: |n . w| / d^2
+/// on a surface or light, 1 / d^2 in a medium; 0 for a point light and the camera.
+template <SpectralMode S>
+float to_vertex_measure(float pdf_dir, const Vec3& from, const Vertex<S>& to) noexcept {
+    const Vec3 d = to.p - from;
+    const float d2 = glm::dot(d, d);
+    if (!(d2 > 0.f)) return 0.f;
+    switch (to.kind) {
+        case VertexKind::Medium: return pdf_dir / d2;
+        case VertexKind::Surface: return pdf_dir * std::abs(glm::dot(to.ng, d)) / (d2 * std::sqrt(d2));
+        case VertexKind::Light:
+            return to.delta_position ? 0.f : pdf_dir * std::abs(glm::dot(to.ng, d)) / (d2 * std::sqrt(d2));
+        default: return 0.f;
+    }
+}
+
+}  // namespace bdpt
+
+/// Volumetric BDPT (see the header comment): MIS policy Mis, heuristic H, absorption policy A of
+/// the tracked segments, subpaths of at most MaxDepth real vertices (EstimatorOptions::max_depth
+/// must not exceed it). radiance() has PathEstimator's signature, so a host's pixel loop calls
+/// either the same way. Grey: exact for Mono and grey media, as PathEstimator.
+template <bdpt::MisPolicy Mis = bdpt::NullScattering, mis::CombiningHeuristic H = mis::Balance,
+          AbsorptionPolicy A = absorption::Weight, int MaxDepth = 32>
+class BdptEstimator {
+    static_assert(MaxDepth >= 1 && MaxDepth <= 256, "nsp::BdptEstimator: MaxDepth must lie in [1, 256]");
+
+public:
+    using MisType = Mis;
+    using HeuristicType = H;
+    using Absorption = A;
+    static constexpr int kMaxDepth = MaxDepth;
+    static constexpr int kMaxPath = 2 * MaxDepth + 3;  ///< most vertices of a path x_0..x_k
+    using Pdfs = bdpt::PathPdfs<kMaxPath>;
+
+    /// EstimatorOptions' defaults with max_depth = MaxDepth (theirs, 1000, would not fit).
+    static EstimatorOptions default_options() noexcept {
+        EstimatorOptions o;
+        o.max_depth = MaxDepth;
+        return o;
+    }
+
+    /// Throws InvalidArgument on invalid roulette settings (see EstimatorOptions) or a max_depth
+    /// above MaxDepth (the vertex arrays' size).
+    explicit BdptEstimator(EstimatorOptions opts = default_options(), H heuristic = H{})
+        : kernels_(checked(opts), heuristic) {}
+
+    const EstimatorOptions& options() const noexcept { return kernels_.options(); }
+
+    /// An estimate of the radiance arriving at `ray.o` from direction -ray.d: every strategy
+    /// (s, t >= 2) of one camera subpath and one light subpath, MIS-weighted. Never throws.
+    template <class Sc, UniformRng R, LookupCounter C>
+    RadianceSample<typename Sc::Spectral> radiance(const Sc& scene, const Ray& camera_ray,
+                                                   const typename Sc::Spectral::Wavelengths& lambda, R& rng,
+                                                   C& counter) const {
+        NoObserver none;
+        return radiance_observed(scene, camera_ray, lambda, rng, counter, none);
+    }
+
+    /// radiance(), calling `observe(s, t, contribution, weight, pdfs, vertices)` for every
+    /// strategy's sample: its unweighted contribution (weight 1), the MIS weight it got, the path's
+    /// densities (bdpt::PathPdfs) and its vertices (bdpt::PathVertices). What the tests measure
+    /// each strategy alone with.
+    template <class Sc, UniformRng R, LookupCounter C, class Observe>
+    RadianceSample<typename Sc::Spectral> radiance_observed(const Sc& sc, const Ray& camera_ray,
+                                                            const typename Sc::Spectral::Wavelengths& lambda, R& rng,
+                                                            C& counter, Observe& observe) const;
+
+private:
+    struct NoObserver {
+        template <class... T>
+        void operator()(const T&...) const noexcept {}
+    };
+    using Kernels = VertexKernels<std::conditional_t<Mis::null_pdfs, strategy::NullScatteringMis, strategy::DirectionalMis>,
+                                  H, A>;
+
+    static EstimatorOptions checked(EstimatorOptions o) {
+        validate(o);
+        if (o.max_depth > MaxDepth)
+            detail::fail("BdptEstimator max_depth = ", o.max_depth, " is not allowed: it must be <= ", MaxDepth,
+                         " (the estimator's MaxDepth template argument, the size of its vertex arrays)");
+        return o;
+    }
+
+    template <class Sc>
+    static constexpr void check_scene() {
+        static_assert(is_surface_scene_v<Sc>, "nsp::BdptEstimator renders a SurfaceScene (NoSurfaces for media alone)");
+        static_assert(!is_per_channel_majorant_v<typename Sc::MajorantType, typename Sc::MediumType>,
+                      "nsp::BdptEstimator drives every channel with one pdf and needs a grey majorant");
+        static_assert(!EmissiveMedium<typename Sc::MediumType>,
+                      "nsp::BdptEstimator: emissive media are not light vertices yet; use PathEstimator");
+        static_assert(std::remove_cvref_t<decltype(std::declval<Sc>().lights)>::bidirectional_ready(),
+                      "nsp::BdptEstimator: every light model must start light subpaths (EmittingLight: "
+                      "sample_emission, emission_pdf) or lie at infinity / be a delta light");
+    }
+
+    template <class Sc>
+    using VertexT = bdpt::Vertex<typename Sc::Spectral>;
+
+    template <class Sc, UniformRng R, LookupCounter C, class OnHit>
+    int walk(const Sc& sc, VertexT<Sc>* path, int count, int max_vertices, Ray ray, int medium, float pdf_dir,
+             typename Sc::Spectrum beta, const typename Sc::Spectral::Wavelengths& lambda, R& rng, C& counter,
+             OnHit on_hit, Status& status) const;
+
+    Kernels kernels_;
+};
+
+// ---------------------------------------------------------------------------------------------
+
+template <bdpt::MisPolicy Mis, mis::CombiningHeuristic H, AbsorptionPolicy A, int MaxDepth>
+template <class Sc, UniformRng R, LookupCounter C, class OnHit>
+int BdptEstimator<Mis, H, A, MaxDepth>::walk(const Sc& sc, VertexT<Sc>* path, int count, int max_vertices, Ray ray,
+                                             int medium, float pdf_dir, typename Sc::Spectrum beta,
+                                             const typename Sc::Spectral::Wavelengths& lambda, R& rng, C& counter,
+                                             OnHit on_hit, Status& status) const {
+    using namespace bdpt;
+    using V = VertexT<Sc>;
+    constexpr int kUnknownMedium = -2;  // a light subpath's start: the medium its first hit says it left
+    const float beta_scale = float(beta.abs().maxCoeff());
+    float nulls = 1.f;
+    int crossings = 0;
+    while (count < max_vertices) {
+        const SurfaceHit hit = sc.geometry.intersect(ray, kInf);
+        if (!detail::usable_hit(sc, hit)) {
+            status = Status::InvalidInput;
+            return count;
+        }
+        if (medium == kUnknownMedium) medium = hit.found() ? hit.medium_left(ray.d) : -1;
+        V v;
+        bool scattered = false;
+        if (sc.has_medium(medium)) {
+            const auto& m = sc.media[std::size_t(medium)];
+            const auto seg = kernels_.track(m.medium, m.majorant, ray, hit.t, lambda, rng, counter);
+            if (const Status fs = flight_status(seg.end); fs != Status::Ok) {
+                status = fs;
+                return count;
+            }
+            beta *= seg.weight;
+            if constexpr (Mis::null_pdfs) nulls *= seg.null_pdf_product;
+            if (seg.end == SegmentEnd::Scattered) {
+                scattered = true;
+                v.kind = VertexKind::Medium;
+                v.p = ray.at(seg.t);
+                v.medium = medium;
+                if constexpr (Mis::null_pdfs) v.event = seg.event_density;
+            } else if (seg.end != SegmentEnd::Passed) {
+                return count;  // absorbed
+            }
+        }
+        if (!scattered) {
+            if (!hit.found()) {
+                on_hit(path, count, hit, ray, nulls, beta);  // the lights at infinity
+                return count;
+            }
+            if (hit.light >= 0) on_hit(path, count, hit, ray, nulls, beta);
+            if (detail::crosses(sc, hit)) {
+                if (++crossings > detail::kMaxInterfaceCrossings) {
+                    status = Status::InvalidInput;
+                    return count;
+                }
+                medium = hit.medium_entered(ray.d);
+                ray.o = hit.p;
+                continue;
+            }
+            if (hit.material < 0 || sc.materials.passes_through(hit.material)) return count;  // an emitter alone
+            v.kind = VertexKind::Surface;
+            v.p = hit.p;
+            v.ng = hit.ng;
+            v.ns = hit.ns;
+            v.material = hit.material;
+            v.medium_front = hit.medium_front;
+            v.medium_back = hit.medium_back;
+        }
+        V& prev = path[count - 1];
+        v.wo = ray.d;
+        v.beta = beta;
+        v.nulls_in = nulls;
+        v.pdf_fwd = prev.kind == VertexKind::Camera ? 1.f : to_vertex_measure(pdf_dir, prev.p, v) * nulls * v.event;
+        path[count] = v;
+        V& cur = path[count++];
+        if (count >= max_vertices) return count;
+        // Roulette on the throughput relative to the subpath's start (a light subpath starts at
+        // Le / pdf, not 1).
+        const float q = kernels_.survival(count - 1, beta / (beta_scale > 0.f ? beta_scale : 1.f));
+        if (q < 1.f) {
+            if (!(rng.uniform() < q)) return count;
+            beta /= q;
+        }
+        const detail::SceneVertex sv{cur.material, cur.medium, cur.ns};
+        const float u1 = rng.uniform(), u2 = rng.uniform();
+        const auto next = detail::sample_vertex(sc, sv, ray.d, u1, u2, lambda);
+        if (!(next.pdf > 0.f)) return count;
+        cur.delta = next.delta;
+        // The density with which the other side, arriving along -next.wi, draws prev from cur.
+        const float rev = next.delta ? next.pdf : detail::eval_vertex(sc, sv, -next.wi, -ray.d, lambda).pdf;
+        prev.pdf_rev = to_vertex_measure(rev, cur.p, prev) * nulls * prev.event;
+        beta *= next.value / next.pdf;
+        if (!(beta != 0.f).any()) return count;
+        if (cur.kind == VertexKind::Surface) medium = cur.medium_toward(next.wi);
+        pdf_dir = next.pdf;
+        nulls = 1.f;
+        crossings = 0;
+        ray = Ray{cur.p, next.wi};
+    }
+    return count;
+}
+
+template <bdpt::MisPolicy Mis, mis::CombiningHeuristic H, AbsorptionPolicy A, int MaxDepth>
+template <class Sc, UniformRng R, LookupCounter C, class Observe>
+RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::radiance_observed(
+    const Sc& sc, const Ray& camera_ray, const typename Sc::Spectral::Wavelengths& lambda, R& rng, C& counter,
+    Observe& observe) const {
+    check_scene<Sc>();
+    using namespace bdpt;
+    using Spectrum = typename Sc::Spectrum;
+    using V = VertexT<Sc>;
+    const int depth = kernels_.options().max_depth;
+    Spectrum L = Spectrum::Zero();
+    Status status = Status::Ok;
+    V camera[MaxDepth + 2];  // z_0 .. z_{depth+1}
+    V light[MaxDepth];       // y_0 .. y_{depth-1}
+    Pdfs pdfs;
+    auto add = [&](int s, int t, const Spectrum& f, const Pdfs& p, const Vec3& x0) {
+        const float w = strategy_weight(kernels_.heuristic(), p, s);
+        observe(s, t, f, w, p, PathVertices<typename Sc::Spectral>{light, s, camera, s == 0 ? t - 1 : t, x0});
+        L += f * w;
+    };
+    auto eval_at = [&](const V& v, const Vec3& wo, const Vec3& wi) {
+        return detail::eval_vertex(sc, detail::SceneVertex{v.material, v.medium, v.ns}, wo, wi, lambda);
+    };
+
+    // Fills pdfs with the path of k + 1 vertices made of light[0..s-1] (x_0..x_{s-1}) and
+    // camera[0..nz-1] (x_k..x_{k-nz+1}) from the subpaths' stored densities; the caller then sets
+    // x_0's and the densities that its connection changes.
+    auto gather = [&](int s, int nz, int k) {
+        pdfs.k = k;
+        for (int i = 0; i < s; ++i) {
+            pdfs.from_light[i] = light[i].pdf_fwd;
+            pdfs.from_camera[i] = light[i].pdf_rev;
+            pdfs.connectible[i] = !light[i].delta;
+        }
+        for (int j = 0; j < nz; ++j) {
+            const int i = k - j;
+            pdfs.from_camera[i] = camera[j].pdf_fwd;
+            pdfs.from_light[i] = camera[j].pdf_rev;
+            pdfs.connectible[i] = !camera[j].delta;
+        }
+        pdfs.from_camera[k - 1] = 1.f;
+        pdfs.connectible[0] = true;
+    };
+
+    // s = 0: the camera subpath reaches an emitter after camera[0..t-2]; and the lights at infinity.
+    auto on_camera_hit = [&](V* path, int count, const SurfaceHit& hit, const Ray& ray, float nulls,
+                             const Spectrum& beta) {
+        const int t = count + 1;  // the emitter is z_{t-1}
+        if (t - 2 > depth) return;
+        const V& z = path[count - 1];  // the vertex the segment left (x_1)
+        auto one_light = [&](int light_index, const Spectrum& Le, float dist) {
+            if (!(Le != 0.f).any()) return;
+            const Spectrum f = beta * Le;
+            if (t == 2) {  // the camera sees the emitter: the only strategy
+                pdfs.k = 1;
+                pdfs.from_camera[0] = 1.f;
+                pdfs.nee = pdfs.emit = 0.f;
+                add(0, 2, f, pdfs, std::isfinite(dist) ? hit.p : z.p);
+                return;
+            }
+            gather(0, t - 1, t - 1);  // camera[0..t-2]; the emitter is x_0
+            const Vec3 w = ray.d;  // from x_1 toward x_0
+            const float pdf_dir_z = z.kind == VertexKind::Camera ? 0.f : eval_at(z, z.wo, w).pdf;
+            if (std::isfinite(dist)) {
+                const Vec3 d = hit.p - z.p;
+                const float d2 = glm::dot(d, d);
+                const EmissionDensity e = sc.lights.emission_pdf(light_index, hit.p, -w);
+                const float cos0 = std::abs(glm::dot(hit.ng, w));
+                pdfs.from_camera[0] = z.delta ? 1.f * cos0 / d2 * nulls : pdf_dir_z * cos0 / d2 * nulls;
+                pdfs.emit = e.pdf_pos;
+                pdfs.nee = sc.lights.pdf(light_index, z.p, w) * cos0 / d2;
+                pdfs.from_light[1] = to_vertex_measure(e.pdf_dir, hit.p, z) * nulls * z.event;
+            } else {
+                pdfs.from_camera[0] = (z.delta ? 1.f : pdf_dir_z) * nulls;
+                pdfs.emit = 0.f;
+                pdfs.nee = sc.lights.pdf(light_index, z.p, w);
+                pdfs.from_light[1] = 0.f;
+            }
+            // z's own density from the light side: from x_1 toward x_2, arriving along -w.
+            if (t >= 4) {
+                const V& z2 = camera[t - 3];  // x_2
+                const float pd = z.delta ? 1.f : eval_at(z, -w, -z.wo).pdf;
+                pdfs.from_light[2] = to_vertex_measure(pd, z.p, z2) * z.nulls_in * z2.event;
+            }
+            add(0, t, f, pdfs, std::isfinite(dist) ? hit.p : z.p);
+        };
+        if (!hit.found()) {
+            for (const int i : sc.lights.infinite())
+                one_light(i, sc.lights.emitted(i, ray.d, lambda), kInf);
+        } else {
+            one_light(hit.light, sc.lights.emitted(hit.light, ray.d, lambda), hit.t);
+        }
+    };
+
+    // The camera subpath.
+    camera[0].kind = VertexKind::Camera;
+    camera[0].p = camera_ray.o;
+    camera[0].beta = Spectrum::Ones();
+    camera[0].medium = sc.camera_medium;
+    const int nc = walk(sc, camera, 1, depth + 2, camera_ray, sc.camera_medium, 0.f, Spectrum::Ones(), lambda, rng,
+                        counter, on_camera_hit, status);
+
+    // The light subpath.
+    int nl = 0;
+    float nee_y0 = 0.f;  // NEE's density of y_0 from y_1
+    if (depth >= 2) {
+        const float u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform(), u3 = rng.uniform(), u4 = rng.uniform();
+        const EmittedLight<typename Sc::Spectral> e = sc.lights.sample_emission(u0, u1, u2, u3, u4, lambda);
+        if (e.emission.pdf_pos > 0.f && e.emission.pdf_dir > 0.f && (e.emission.radiance != 0.f).any()) {
+            V& y0 = light[0];
+            y0.kind = VertexKind::Light;
+            y0.p = e.emission.p;
+            y0.ng = y0.ns = e.emission.n;
+            y0.light = e.light;
+            y0.delta_position = e.emission.delta_position;
+            y0.beta = e.emission.radiance / e.emission.pdf_pos;
+            y0.pdf_fwd = e.emission.pdf_pos;
+            nl = walk(sc, light, 1, depth, Ray{e.emission.p, e.emission.w}, -2, e.emission.pdf_dir,
+                      Spectrum(y0.beta * (e.emission.cos / e.emission.pdf_dir)), lambda, rng, counter,
+                      [](auto&&...) {}, status);
+            if (nl >= 2) {
+                const Vec3 d = y0.p - light[1].p;
+                const float d2 = glm::dot(d, d);
+                nee_y0 = y0.delta_position ? sc.lights.selection_pdf(y0.light)
+                                           : sc.lights.pdf(y0.light, light[1].p, d / std::sqrt(d2)) *
+                                                 std::abs(glm::dot(y0.ng, d)) / (d2 * std::sqrt(d2));
+            }
+        }
+    }
+
+    // Transmittance of the segment a -> b through the scene, with its nulls' P_n product.
+    auto transmit = [&](const V& a, const V& b, float& nulls) -> Spectrum {
+        const Vec3 d = b.p - a.p;
+        const float dist = glm::length(d);
+        if (!(dist > 0.f)) return Spectrum::Zero();
+        const Vec3 w = d / dist;
+        const auto sh = detail::shadow_through(kernels_, sc, Ray{a.p, w}, detail::shadow_distance(dist),
+                                               a.medium_toward(w), lambda, rng, counter);
+        if (sh.status != Status::Ok) {
+            status = sh.status;
+            return Spectrum::Zero();
+        }
+        nulls = Mis::null_pdfs ? sh.null_pdf_product : 1.f;
+        return sh.transmittance;
+    };
+
+    for (int t = 2; t <= std::min(nc, depth + 1); ++t) {
+        const V& z = camera[t - 1];
+        if (z.delta) continue;
+        // s = 1: next-event estimation from z.
+        {
+            const float u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
+            const SampledLight<typename Sc::Spectral> ls = sc.lights.sample(z.p, u0, u1, u2, lambda);
+            if (ls.sample.pdf > 0.f) {
+                const Vec3 w = ls.sample.wi;
+                const auto fz = eval_at(z, z.wo, w);
+                if ((fz.value != 0.f).any()) {
+                    V y0;
+                    y0.kind = VertexKind::Light;
+                    y0.delta_position = ls.sample.delta;
+                    const bool at_infinity = !std::isfinite(ls.sample.distance);
+                    y0.p = at_infinity ? z.p : z.p + ls.sample.distance * w;
+                    const auto sh = detail::shadow_through(kernels_, sc, Ray{z.p, w},
+                                                           detail::shadow_distance(ls.sample.distance),
+                                                           z.medium_toward(w), lambda, rng, counter);
+                    if (sh.status != Status::Ok) status = sh.status;
+                    if (sh.status == Status::Ok && (sh.transmittance != 0.f).any()) {
+                        const float nulls = Mis::null_pdfs ? sh.null_pdf_product : 1.f;
+                        const Spectrum f = z.beta * fz.value * sh.transmittance * ls.sample.radiance / ls.sample.pdf;
+                        gather(0, t, t);  // camera[0..t-1]; the light point is x_0
+                        const float d2 = ls.sample.distance * ls.sample.distance;
+                        if (ls.sample.delta) {  // a point or directional light: NEE alone reaches it
+                            pdfs.from_camera[0] = 0.f;
+                            pdfs.nee = ls.sample.pdf;
+                            pdfs.emit = at_infinity ? 0.f : sc.lights.emission_pdf(ls.light, y0.p, -w).pdf_pos;
+                            pdfs.from_light[1] = at_infinity ? 0.f
+                                                             : to_vertex_measure(sc.lights.emission_pdf(ls.light, y0.p, -w).pdf_dir,
+                                                                                 y0.p, z) * nulls * z.event;
+                        } else if (at_infinity) {
+                            pdfs.from_camera[0] = fz.pdf * nulls;
+                            pdfs.nee = ls.sample.pdf;
+                            pdfs.emit = 0.f;
+                            pdfs.from_light[1] = 0.f;
+                        } else {
+                            const EmissionDensity e = sc.lights.emission_pdf(ls.light, y0.p, -w);
+                            pdfs.from_camera[0] = fz.pdf * e.cos / d2 * nulls;
+                            pdfs.nee = ls.sample.pdf * e.cos / d2;
+                            pdfs.emit = e.pdf_pos;
+                            pdfs.from_light[1] = to_vertex_measure(e.pdf_dir, y0.p, z) * nulls * z.event;
+                        }
+                        if (t >= 3) {
+                            const V& z2 = camera[t - 2];
+                            pdfs.from_light[2] = to_vertex_measure(eval_at(z, w * -1.f, -z.wo).pdf, z.p, z2) *
+                                                 z.nulls_in * z2.event;
+                        }
+                        add(1, t, f, pdfs, y0.p);
+                    }
+                }
+            }
+        }
+        // s >= 2: connect light vertex s-1 to z.
+        for (int s = 2; s <= nl && s + t - 2 <= depth; ++s) {
+            const V& y = light[s - 1];
+            if (y.delta) continue;
+            const Vec3 d = z.p - y.p;
+            const float d2 = glm::dot(d, d);
+            if (!(d2 > 0.f)) continue;
+            const Vec3 w = d / std::sqrt(d2);
+            const auto fy = eval_at(y, y.wo, w);
+            if (!(fy.value != 0.f).any()) continue;
+            const auto fz = eval_at(z, z.wo, -w);
+            if (!(fz.value != 0.f).any()) continue;
+            float nulls = 1.f;
+            const Spectrum tr = transmit(y, z, nulls);
+            if (!(tr != 0.f).any()) continue;
+            const Spectrum f = y.beta * fy.value * tr * fz.value * z.beta / d2;
+            gather(s, t, s + t - 1);
+            pdfs.emit = light[0].pdf_fwd;
+            pdfs.nee = nee_y0;
+            // The four densities the connection changes.
+            pdfs.from_light[s] = to_vertex_measure(fy.pdf, y.p, z) * nulls * z.event;
+            pdfs.from_camera[s - 1] = to_vertex_measure(fz.pdf, z.p, y) * nulls * y.event;
+            if (t >= 3) {
+                const V& z2 = camera[t - 2];
+                pdfs.from_light[s + 1] = to_vertex_measure(eval_at(z, w, -z.wo).pdf, z.p, z2) * z.nulls_in * z2.event;
+            }
+            {
+                const V& y2 = light[s - 2];
+                pdfs.from_camera[s - 2] = to_vertex_measure(eval_at(y, -w, -y.wo).pdf, y.p, y2) * y.nulls_in * y2.event;
+            }
+            add(s, t, f, pdfs, light[0].p);
+        }
+    }
+    if (!all_finite(L)) return {Spectrum::Zero(), Status::NonFinite};
+    return {L, status};
+}
+
+}  // namespace nsp
