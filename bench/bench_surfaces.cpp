@@ -7,6 +7,10 @@
 //   nsp::NoSurfaces (the camera in the cloud's medium, a LightSampler of the one environment
 //   light): the same estimator, so the ratio of the two times is the price of the surface walk
 //   (its geometry queries and handle checks, the light sampler) for a host that uses it anyway.
+// - BM_Lantern/<estimator>: one radiance sample of the lantern (room_scene.hpp: the lamp boxed
+//   above the cloud, issue 18's scene), the path tracers against BdptEstimator; for BDPT the
+//   strategy families' counts per sample (hits s = 0, NEE s = 1, connections s >= 2, each one
+//   evaluated path) and the stack its subpaths take (bytes, MaxDepth = 32).
 #include <string>
 
 #include <benchmark/benchmark.h>
@@ -79,6 +83,40 @@ void BM_CloudUnderSky_NoSurfaces(benchmark::State& state) {
     run<E>(state, scene, camera_rays());
 }
 
+template <class E>
+void BM_Lantern(benchmark::State& state) {
+    static const auto scene = nsp_examples::make_lantern_scene(
+        nsp_examples::make_default_medium<nsp::Mono>(),
+        nsp::GlobalMajorant<Cloud>(nsp_examples::make_default_medium<nsp::Mono>()));
+    const E estimator;
+    nsp::Pcg32 rng(6, 66);
+    nsp::LookupCount counter;
+    double hits = 0, nee = 0, connections = 0;
+    auto count = [&](int s, int, const auto&, float, const auto&, const auto&) {
+        (s == 0 ? hits : s == 1 ? nee : connections) += 1.0;
+    };
+    std::size_t i = 0;
+    for (auto _ : state) {
+        if constexpr (requires { E::kMaxPath; }) {
+            auto r = estimator.radiance_observed(scene, room_rays()[i], {}, rng, counter, count);
+            benchmark::DoNotOptimize(r);
+        } else {
+            auto r = estimator.radiance(scene, room_rays()[i], {}, rng, counter);
+            benchmark::DoNotOptimize(r);
+        }
+        i = (i + 1) & kSetMask;
+    }
+    report_lookups(state, counter, "lookups/sample");
+    if constexpr (requires { E::kMaxPath; }) {
+        const double n = double(state.iterations());
+        state.counters["hits/sample"] = hits / n;
+        state.counters["nee/sample"] = nee / n;
+        state.counters["connections/sample"] = connections / n;
+        state.counters["subpath_bytes"] =
+            double(sizeof(nsp::bdpt::Vertex<nsp::Mono>) * (2 * E::kMaxDepth + 2) + sizeof(typename E::Pdfs));
+    }
+}
+
 using Uni = nsp::PathEstimator<nsp::strategy::Unidirectional>;
 using Nee = nsp::PathEstimator<nsp::strategy::NextEvent>;
 using Dmis = nsp::PathEstimator<nsp::strategy::DirectionalMis, nsp::mis::Balance>;
@@ -88,6 +126,10 @@ BENCHMARK_TEMPLATE(BM_Room, Uni)->Name("BM_Room/unidirectional");
 BENCHMARK_TEMPLATE(BM_Room, Nee)->Name("BM_Room/ratio-nee");
 BENCHMARK_TEMPLATE(BM_Room, Dmis)->Name("BM_Room/directional-mis:balance");
 BENCHMARK_TEMPLATE(BM_Room, Nsmis)->Name("BM_Room/uni-nee-mis:balance");
+BENCHMARK_TEMPLATE(BM_Lantern, Uni)->Name("BM_Lantern/unidirectional");
+BENCHMARK_TEMPLATE(BM_Lantern, Nsmis)->Name("BM_Lantern/uni-nee-mis:balance");
+BENCHMARK_TEMPLATE(BM_Lantern, nsp::BdptEstimator<nsp::bdpt::Directional>)->Name("BM_Lantern/bdpt-directional-mis:balance");
+BENCHMARK_TEMPLATE(BM_Lantern, nsp::BdptEstimator<nsp::bdpt::NullScattering>)->Name("BM_Lantern/bdpt-null-mis:balance");
 BENCHMARK_TEMPLATE(BM_CloudUnderSky_Scene, Uni)->Name("BM_CloudUnderSky/Scene/unidirectional");
 BENCHMARK_TEMPLATE(BM_CloudUnderSky_NoSurfaces, Uni)->Name("BM_CloudUnderSky/NoSurfaces/unidirectional");
 BENCHMARK_TEMPLATE(BM_CloudUnderSky_Scene, Nsmis)->Name("BM_CloudUnderSky/Scene/uni-nee-mis:balance");

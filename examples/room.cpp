@@ -2,15 +2,18 @@
 // a diffuse floor in an open room under a small rectangular light and a dim sky, rendered over an
 // nsp::SurfaceScene with the efficiency tables the other scenes have (docs/surfaces.md reads
 // them): the grey cloud (Mono, 96x96 by default) with every strategy of nsp::PathEstimator that
-// renders surfaces (the equiangular ones aimed at the lamp's centre), then the chromatic cloud
+// renders surfaces (the equiangular ones aimed at the lamp's centre) and nsp::BdptEstimator, then the chromatic cloud
 // (Rgb, half the size and spp) with the grey-majorant PathEstimator against
 // nsp::SpectralPathEstimator's per-channel pdfs, then the glowing plume (the cloud's smoke with a
-// flame in it, an emissive medium; Mono, half the size and spp) with emission and lights in one MIS.
+// flame in it, an emissive medium; Mono, half the size and spp) with emission and lights in one MIS,
+// then the lantern (the lamp boxed above the cloud, opening into it: issue 18's scene; half the
+// size and spp) with the path tracers against BdptEstimator's directional and null-scattering MIS.
 //
 //   nsp_room [--res N] [--spp N] [--threads N] [--out DIR] [--no-png] [--picture-res N]
+//            [--tables grey,rgb,plume,lantern]
 //
-// Writes DIR/room_sheet.png, DIR/room_rgb_sheet.png and DIR/room_plume_sheet.png (each table's
-// rows at one exposure) and
+// Writes DIR/room_sheet.png, DIR/room_rgb_sheet.png, DIR/room_plume_sheet.png and
+// DIR/lantern_sheet.png (each table's rows at one exposure) and
 // DIR/room.png (the grey room, uni-nee-mis balance, 128 spp, --picture-res pixels square) unless
 // --no-png. Exits 1 if any path ended with a status other than Ok.
 #include <algorithm>
@@ -50,12 +53,11 @@ double cost(const std::vector<Row>& rows, std::size_t i) { return rows[i].cpu_se
 /// Prints one efficiency table; `reference` is the row the z column compares with. Returns the
 /// number of paths with a failed status.
 std::uint64_t print_table(const char* title, const std::vector<Row>& rows, std::size_t reference, int res, int spp,
-                          int threads) {
+                          int threads, const char* scene = "the cloud over a floor, a quad light and a sky") {
     const double samples = double(res) * res * spp;
     double best = nsp::kInf;
     for (const Row& r : rows) best = std::min(best, r.cpu_seconds / samples * r.variance);
-    std::printf("\n%s, %dx%d, %d spp, %d threads): the cloud over a floor, a quad light and a sky\n", title, res, res,
-                spp, threads);
+    std::printf("\n%s, %dx%d, %d spp, %d threads): %s\n", title, res, res, spp, threads, scene);
     std::printf("%-38s %8s %11s %11s %11s %11s %10s %9s %6s\n", "estimator", "seconds", "lookups/spl", "var/spl",
                 "LTUV", "cpu-s*var", "cpu/best", "mean", "z");
     std::uint64_t failed = 0;
@@ -88,7 +90,12 @@ int main(int argc, char** argv) {
     app.add_option("--out", out, "directory for the PNG pictures");
     app.add_option("--picture-res", picture_res, "size of room.png")->check(CLI::Range(16, 4096));
     app.add_flag("--no-png", no_png, "write no pictures");
+    std::vector<std::string> tables{"grey", "rgb", "plume", "lantern"};
+    app.add_option("--tables", tables, "which tables to render (default: all)")
+        ->check(CLI::IsMember({"grey", "rgb", "plume", "lantern"}))
+        ->delimiter(',');
     CLI11_PARSE(app, argc, argv);
+    auto want = [&](const char* t) { return std::find(tables.begin(), tables.end(), t) != tables.end(); };
 
     using namespace nsp;
     std::uint64_t seed = 1;
@@ -99,67 +106,102 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "  room: %-44s %6.2f s\n", name, rows.back().seconds);
     };
 
+    std::uint64_t failed = 0;
     // Table 1: the grey cloud, Mono, one global majorant, every grey strategy.
     const auto grey = nsp_examples::make_room_scene();
-    run(grey, PathEstimator<strategy::Unidirectional>{}, "unidirectional");
-    run(grey, PathEstimator<strategy::NextEvent>{}, "ratio-nee");
-    run(grey, PathEstimator<strategy::DirectionalMis, mis::Balance>{}, "directional-mis_balance");
-    run(grey, PathEstimator<strategy::DirectionalMis, mis::Power>{}, "directional-mis_power");
-    run(grey, PathEstimator<strategy::NullScatteringMis, mis::Balance>{}, "uni-nee-mis_balance");
-    run(grey, PathEstimator<strategy::NullScatteringMis, mis::Power>{}, "uni-nee-mis_power");
-    run(grey, PathEstimator<strategy::EquiangularNextEvent>{}, "equiangular-nee");  // aimed at the lamp's centre
-    run(grey, PathEstimator<strategy::EquiangularMis, mis::Balance>{}, "equiangular-mis_balance");
-    const std::uint64_t failed_grey = print_table("Room (mono", rows, 4, res, spp, threads);  // z against uni-nee-mis_balance
-    std::printf("room: uni-nee-mis_balance / best single strategy (%s) in cpu-s*var: %.3g; unidirectional / ratio-nee: %.3g\n",
-                rows[cost(rows, 0) <= cost(rows, 1) ? 0 : 1].name.c_str(), cost(rows, 4) / std::min(cost(rows, 0), cost(rows, 1)),
-                cost(rows, 0) / cost(rows, 1));
+    if (want("grey")) {
+        run(grey, PathEstimator<strategy::Unidirectional>{}, "unidirectional");
+        run(grey, PathEstimator<strategy::NextEvent>{}, "ratio-nee");
+        run(grey, PathEstimator<strategy::DirectionalMis, mis::Balance>{}, "directional-mis_balance");
+        run(grey, PathEstimator<strategy::DirectionalMis, mis::Power>{}, "directional-mis_power");
+        run(grey, PathEstimator<strategy::NullScatteringMis, mis::Balance>{}, "uni-nee-mis_balance");
+        run(grey, PathEstimator<strategy::NullScatteringMis, mis::Power>{}, "uni-nee-mis_power");
+        run(grey, PathEstimator<strategy::EquiangularNextEvent>{}, "equiangular-nee");  // aimed at the lamp's centre
+        run(grey, PathEstimator<strategy::EquiangularMis, mis::Balance>{}, "equiangular-mis_balance");
+        run(grey, BdptEstimator<bdpt::NullScattering, mis::Balance>{}, "bdpt_null-mis_balance");
+        failed += print_table("Room (mono", rows, 4, res, spp, threads);  // z against uni-nee-mis_balance
+        std::printf("room: uni-nee-mis_balance / best single strategy (%s) in cpu-s*var: %.3g; unidirectional / ratio-nee: %.3g\n",
+                    rows[cost(rows, 0) <= cost(rows, 1) ? 0 : 1].name.c_str(), cost(rows, 4) / std::min(cost(rows, 0), cost(rows, 1)),
+                    cost(rows, 0) / cost(rows, 1));
+        double best_path = nsp::kInf;
+        for (std::size_t i = 0; i + 1 < rows.size(); ++i) best_path = std::min(best_path, cost(rows, i));
+        std::printf("room: bdpt_null-mis_balance / best path tracer in cpu-s*var: %.3g\n", cost(rows, rows.size() - 1) / best_path);
+    }
 
     // Table 2: the chromatic cloud (extinction 5, 20, 80 per unit density), Rgb: the grey-majorant
     // PathEstimator against SpectralPathEstimator's per-channel pdfs, all uni + NEE MIS.
-    using CM = DenseGridMedium<Rgb>;
-    const CM chroma = nsp_examples::make_chromatic_medium<Rgb>();
-    const auto chroma_grey = nsp_examples::make_room_scene(chroma, GlobalMajorant<CM>(chroma));
-    const auto chroma_channel = nsp_examples::make_room_scene(chroma, ChannelMajorant<CM>(chroma));
     const std::size_t first = rows.size();
-    seed = 7;  // each table its own seeds: a row added to one table leaves the others' numbers as they were
-    run_res = std::max(1, res / 2);  // the chromatic cloud costs about 4x the lookups: half the size, half the spp
-    run_spp = std::max(2, spp / 2);
-    run(chroma_grey, PathEstimator<strategy::NullScatteringMis, mis::Balance>{}, "uni-nee-mis_grey_balance");
-    run(chroma_grey, SpectralPathEstimator<channels::SpectralTrackingAverage, strategy::NullScatteringMis, mis::Balance>{},
-        "uni-nee-mis_spectral-tracking-avg");
-    run(chroma_grey, SpectralPathEstimator<channels::SpectralMis, strategy::NullScatteringMis, mis::Balance>{},
-        "uni-nee-mis_spectral-mis_global");
-    run(chroma_channel, SpectralPathEstimator<channels::SpectralMis, strategy::NullScatteringMis, mis::Balance>{},
-        "uni-nee-mis_spectral-mis_per-channel");
-    std::vector<Row> chromatic(rows.begin() + std::ptrdiff_t(first), rows.end());
-    const std::uint64_t failed_chroma = print_table("Room, chromatic cloud (rgb", chromatic, 3, run_res, run_spp, threads);
-    std::printf("room chromatic: grey-majorant PathEstimator / spectral MIS (per-channel majorant) in cpu-s*var: %.3g "
-                "(the grey estimator's variance is practically infinite on this medium: its sample variance "
-                "understates it; docs/chromatic.md)\n",
-                cost(chromatic, 0) / cost(chromatic, 3));
+    if (want("rgb")) {
+        using CM = DenseGridMedium<Rgb>;
+        const CM chroma = nsp_examples::make_chromatic_medium<Rgb>();
+        const auto chroma_grey = nsp_examples::make_room_scene(chroma, GlobalMajorant<CM>(chroma));
+        const auto chroma_channel = nsp_examples::make_room_scene(chroma, ChannelMajorant<CM>(chroma));
+        seed = 7;  // each table its own seeds: a row added to one table leaves the others' numbers as they were
+        run_res = std::max(1, res / 2);  // the chromatic cloud costs about 4x the lookups: half the size, half the spp
+        run_spp = std::max(2, spp / 2);
+        run(chroma_grey, PathEstimator<strategy::NullScatteringMis, mis::Balance>{}, "uni-nee-mis_grey_balance");
+        run(chroma_grey, SpectralPathEstimator<channels::SpectralTrackingAverage, strategy::NullScatteringMis, mis::Balance>{},
+            "uni-nee-mis_spectral-tracking-avg");
+        run(chroma_grey, SpectralPathEstimator<channels::SpectralMis, strategy::NullScatteringMis, mis::Balance>{},
+            "uni-nee-mis_spectral-mis_global");
+        run(chroma_channel, SpectralPathEstimator<channels::SpectralMis, strategy::NullScatteringMis, mis::Balance>{},
+            "uni-nee-mis_spectral-mis_per-channel");
+        std::vector<Row> chromatic(rows.begin() + std::ptrdiff_t(first), rows.end());
+        failed += print_table("Room, chromatic cloud (rgb", chromatic, 3, run_res, run_spp, threads);
+        std::printf("room chromatic: grey-majorant PathEstimator / spectral MIS (per-channel majorant) in cpu-s*var: %.3g "
+                    "(the grey estimator's variance is practically infinite on this medium: its sample variance "
+                    "understates it; docs/chromatic.md)\n",
+                    cost(chromatic, 0) / cost(chromatic, 3));
+    }
 
     // Table 3: the plume (the cloud's smoke with a flame inside it, an emissive medium), Mono, in
     // the same room: emission and the lights in one MIS.
-    using PM = Emissive<DenseGridMedium<Mono>>;
-    const PM plume = nsp_examples::make_plume_medium<Mono>();
-    const auto plume_room = nsp_examples::make_room_scene(plume, GlobalMajorant<PM>(plume));
     const std::size_t first_plume = rows.size();
-    seed = 11;
-    run(plume_room, PathEstimator<strategy::Unidirectional>{}, "unidirectional");
-    run(plume_room, PathEstimator<strategy::NextEvent>{}, "ratio-nee");
-    run(plume_room, PathEstimator<strategy::NullScatteringMis, mis::Balance>{}, "uni-nee-mis_balance");
-    run(plume_room, PathEstimator<strategy::EquiangularMis, mis::Balance>{}, "equiangular-mis_balance");
-    std::vector<Row> plume_rows(rows.begin() + std::ptrdiff_t(first_plume), rows.end());
-    const std::uint64_t failed_plume = print_table("Room, glowing plume (mono", plume_rows, 2, run_res, run_spp, threads);
-    std::printf("room plume: uni-nee-mis_balance / best single strategy (%s) in cpu-s*var: %.3g\n",
-                plume_rows[cost(plume_rows, 0) <= cost(plume_rows, 1) ? 0 : 1].name.c_str(),
-                cost(plume_rows, 2) / std::min(cost(plume_rows, 0), cost(plume_rows, 1)));
-    const std::uint64_t failed = failed_grey + failed_chroma + failed_plume;
+    run_res = std::max(1, res / 2);
+    run_spp = std::max(2, spp / 2);
+    if (want("plume")) {
+        using PM = Emissive<DenseGridMedium<Mono>>;
+        const PM plume = nsp_examples::make_plume_medium<Mono>();
+        const auto plume_room = nsp_examples::make_room_scene(plume, GlobalMajorant<PM>(plume));
+        seed = 11;
+        run(plume_room, PathEstimator<strategy::Unidirectional>{}, "unidirectional");
+        run(plume_room, PathEstimator<strategy::NextEvent>{}, "ratio-nee");
+        run(plume_room, PathEstimator<strategy::NullScatteringMis, mis::Balance>{}, "uni-nee-mis_balance");
+        run(plume_room, PathEstimator<strategy::EquiangularMis, mis::Balance>{}, "equiangular-mis_balance");
+        std::vector<Row> plume_rows(rows.begin() + std::ptrdiff_t(first_plume), rows.end());
+        failed += print_table("Room, glowing plume (mono", plume_rows, 2, run_res, run_spp, threads);
+        std::printf("room plume: uni-nee-mis_balance / best single strategy (%s) in cpu-s*var: %.3g\n",
+                    plume_rows[cost(plume_rows, 0) <= cost(plume_rows, 1) ? 0 : 1].name.c_str(),
+                    cost(plume_rows, 2) / std::min(cost(plume_rows, 0), cost(plume_rows, 1)));
+    }
+    // Table 4: the lantern (issue 18's scene): the lamp shut in a box that opens into the cloud,
+    // the path tracers against bidirectional path tracing with directional and with full
+    // null-scattering MIS; a quarter of the pixels (BDPT costs several paths a sample).
+    const std::size_t first_lantern = rows.size();
+    if (want("lantern")) {
+        const auto lantern = nsp_examples::make_lantern_scene(nsp_examples::make_default_medium<Mono>(),
+                                                              GlobalMajorant<DenseGridMedium<Mono>>(nsp_examples::make_default_medium<Mono>()));
+        seed = 13;
+        run(lantern, PathEstimator<strategy::Unidirectional>{}, "unidirectional");
+        run(lantern, PathEstimator<strategy::NextEvent>{}, "ratio-nee");
+        run(lantern, PathEstimator<strategy::NullScatteringMis, mis::Balance>{}, "uni-nee-mis_balance");
+        run(lantern, BdptEstimator<bdpt::Directional, mis::Balance>{}, "bdpt_directional-mis_balance");
+        run(lantern, BdptEstimator<bdpt::NullScattering, mis::Balance>{}, "bdpt_null-mis_balance");
+        run(lantern, BdptEstimator<bdpt::NullScattering, mis::Power>{}, "bdpt_null-mis_power");
+        std::vector<Row> lantern_rows(rows.begin() + std::ptrdiff_t(first_lantern), rows.end());
+        failed += print_table("Lantern (mono", lantern_rows, 4, run_res, run_spp, threads,
+                        "the cloud over a floor, lit only by a lamp in a box that opens downward into it");
+        std::printf("lantern: bdpt_null-mis_balance / bdpt_directional-mis_balance in cpu-s*var: %.3g; / uni-nee-mis_balance: "
+                    "%.3g; / best path tracer: %.3g\n",
+                    cost(lantern_rows, 4) / cost(lantern_rows, 3), cost(lantern_rows, 4) / cost(lantern_rows, 2),
+                    cost(lantern_rows, 4) / std::min({cost(lantern_rows, 0), cost(lantern_rows, 1), cost(lantern_rows, 2)}));
+    }
 
     if (!no_png) {
         std::filesystem::create_directories(out);
         // One contact sheet per table, each at one exposure.
         auto sheet = [&](const std::string& path, std::size_t from, std::size_t to) {
+            if (from == to) return;
             std::vector<nsp_examples::Tile> tiles;
             std::vector<const nsp_examples::Image*> images;
             for (std::size_t i = from; i < to; ++i) {
@@ -170,12 +212,15 @@ int main(int argc, char** argv) {
         };
         sheet(out + "/room_sheet.png", 0, first);
         sheet(out + "/room_rgb_sheet.png", first, first_plume);
-        sheet(out + "/room_plume_sheet.png", first_plume, rows.size());
+        sheet(out + "/room_plume_sheet.png", first_plume, first_lantern);
+        sheet(out + "/lantern_sheet.png", first_lantern, rows.size());
+        if (want("grey")) {
         const Row picture = render(grey, PathEstimator<strategy::NullScatteringMis, mis::Balance>{}, "picture",
                                    picture_res, 128, threads, 99);
         nsp_examples::write_png(out + "/room.png", picture.image, nsp_examples::exposure_for({&picture.image}));
         std::fprintf(stderr, "  room: %s/room_sheet.png, %s/room_rgb_sheet.png, %s/room_plume_sheet.png, %s/room.png (%.1f s)\n",
                      out.c_str(), out.c_str(), out.c_str(), out.c_str(), picture.seconds);
+        }
     }
     return failed == 0 ? 0 : 1;
 }

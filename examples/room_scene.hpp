@@ -31,6 +31,16 @@ nsp::QuadLight<S> room_lamp() {
 inline constexpr float kRoomSky = 0.08f;  ///< the environment's radiance (white)
 inline constexpr float kRoomFloorY = -1.05f;
 
+/// The medium's box (null interfaces, medium 0 inside), the floor (material 0) and the back and
+/// left walls (material 1) of the room and of the lantern.
+inline void add_room_shell(nsp_host::Shapes& shapes) {
+    shapes.boxes.push_back({nsp::Vec3(-1.f), nsp::Vec3(1.f), {-1, -1, 0, -1}});
+    const float y0 = kRoomFloorY, y1 = 2.95f;
+    shapes.quads.push_back({nsp::Vec3(-3.f, y0, 3.f), nsp::Vec3(6.f, 0.f, 0.f), nsp::Vec3(0.f, 0.f, -6.f), {0, -1, -1, -1}});
+    shapes.quads.push_back({nsp::Vec3(-3.f, y0, 3.f), nsp::Vec3(0.f, y1 - y0, 0.f), nsp::Vec3(6.f, 0.f, 0.f), {1, -1, -1, -1}});
+    shapes.quads.push_back({nsp::Vec3(-3.f, y0, -3.f), nsp::Vec3(0.f, 0.f, 6.f), nsp::Vec3(0.f, y1 - y0, 0.f), {1, -1, -1, -1}});
+}
+
 /// The room around `medium` (in [-1, 1]^3, behind null interfaces: medium 0) with `majorant`:
 /// the floor (material 0, albedo 0.7), the back and left walls (material 1, albedo 0.5), the lamp
 /// (light 0) and the sky (light 1), light selection by power. Grey surfaces and lights.
@@ -38,11 +48,7 @@ template <nsp::Medium M, class Maj>
 RoomScene<M, Maj> make_room_scene(M medium, Maj majorant) {
     using S = typename M::Spectral;
     nsp_host::Shapes shapes;
-    shapes.boxes.push_back({nsp::Vec3(-1.f), nsp::Vec3(1.f), {-1, -1, 0, -1}});
-    const float y0 = kRoomFloorY, y1 = 2.95f;
-    shapes.quads.push_back({nsp::Vec3(-3.f, y0, 3.f), nsp::Vec3(6.f, 0.f, 0.f), nsp::Vec3(0.f, 0.f, -6.f), {0, -1, -1, -1}});
-    shapes.quads.push_back({nsp::Vec3(-3.f, y0, 3.f), nsp::Vec3(0.f, y1 - y0, 0.f), nsp::Vec3(6.f, 0.f, 0.f), {1, -1, -1, -1}});
-    shapes.quads.push_back({nsp::Vec3(-3.f, y0, -3.f), nsp::Vec3(0.f, 0.f, 6.f), nsp::Vec3(0.f, y1 - y0, 0.f), {1, -1, -1, -1}});
+    add_room_shell(shapes);
     const nsp::QuadLight<S> lamp = room_lamp<S>();
     shapes.quads.push_back({lamp.corner, lamp.edge_u, lamp.edge_v, {-1, 0, -1, -1}});
     return RoomScene<M, Maj>(std::move(shapes), {{std::move(medium), std::move(majorant), nsp::HenyeyGreensteinPhase(kPhaseG)}},
@@ -58,6 +64,37 @@ inline RoomScene<> make_room_scene() {
     auto cloud = make_default_medium<nsp::Mono>();
     nsp::GlobalMajorant<nsp::DenseGridMedium<nsp::Mono>> majorant(cloud);
     return make_room_scene(std::move(cloud), majorant);
+}
+
+/// The lantern: the room's floor and walls around the cloud, no sky, lit only by a lamp inside a
+/// closed box above the cloud whose one opening, its floor, faces down into the smoke (issue
+/// 18's scene, after the paper's BDPT scene): light reaches what the camera sees only by
+/// scattering in the cloud (or straight through its thin parts), the camera cannot see the lamp,
+/// and NEE toward the lamp from the floor and the walls is always blocked: only the points in the
+/// beam below the opening see the lamp. The box, 0.3 x 0.8 x 0.3 over (0, 1.55, 0) with dark
+/// Lambertian walls (albedo 0.2, material 2), holds the lamp 0.26 x 0.26 at its ceiling facing
+/// down, radiance 300; its opening is 0.15 above the cloud's bounds.
+template <nsp::Medium M, class Maj>
+RoomScene<M, Maj> make_lantern_scene(M medium, Maj majorant) {
+    using S = typename M::Spectral;
+    nsp_host::Shapes shapes;
+    add_room_shell(shapes);
+    // The lantern's four sides and its ceiling (material 2); open at y = 1.15.
+    const float lo = 1.15f, hi = 1.95f, h = 0.15f;
+    const nsp::Vec3 up(0.f, hi - lo, 0.f);
+    shapes.quads.push_back({nsp::Vec3(-h, lo, -h), nsp::Vec3(2.f * h, 0.f, 0.f), up, {2, -1, -1, -1}});
+    shapes.quads.push_back({nsp::Vec3(-h, lo, h), up, nsp::Vec3(2.f * h, 0.f, 0.f), {2, -1, -1, -1}});
+    shapes.quads.push_back({nsp::Vec3(-h, lo, -h), up, nsp::Vec3(0.f, 0.f, 2.f * h), {2, -1, -1, -1}});
+    shapes.quads.push_back({nsp::Vec3(h, lo, -h), nsp::Vec3(0.f, 0.f, 2.f * h), up, {2, -1, -1, -1}});
+    shapes.quads.push_back({nsp::Vec3(-h, hi, -h), nsp::Vec3(0.f, 0.f, 2.f * h), nsp::Vec3(2.f * h, 0.f, 0.f), {2, -1, -1, -1}});
+    const nsp::QuadLight<S> lamp{nsp::Vec3(-0.13f, hi - 0.02f, -0.13f), nsp::Vec3(0.26f, 0.f, 0.f), nsp::Vec3(0.f, 0.f, 0.26f),
+                                 nsp::constant_coefficient<S>(300.f)};
+    shapes.quads.push_back({lamp.corner, lamp.edge_u, lamp.edge_v, {-1, 0, -1, -1}});
+    return RoomScene<M, Maj>(std::move(shapes), {{std::move(medium), std::move(majorant), nsp::HenyeyGreensteinPhase(kPhaseG)}},
+                             RoomMaterials<S>({nsp::LambertianBsdf<S>(nsp::constant_coefficient<S>(0.7f)),
+                                               nsp::LambertianBsdf<S>(nsp::constant_coefficient<S>(0.5f)),
+                                               nsp::LambertianBsdf<S>(nsp::constant_coefficient<S>(0.2f))}),
+                             RoomLights<S>(nsp::LightSelection::Power, 4.f, {lamp}, {}), -1);
 }
 
 /// The room's camera: from (0, 0.6, -5.6) toward (0, -0.15, 0), 42 degrees vertical field of

@@ -14,8 +14,10 @@
 #     plume.png; --picture-res, 256 by default). docs/renderer.md explains every flag;
 #  1b. nsp_room: the cloud over a diffuse floor in an open room under a quad light and a dim sky
 #     (the scene with surfaces) with every strategy PathEstimator renders surfaces with, then the
-#     chromatic cloud in the room with the spectral estimators; its two tables and
-#     out/room_sheet.png, out/room_rgb_sheet.png, out/room.png;
+#     chromatic cloud in the room with the spectral estimators, the glowing plume, and the lantern
+#     (a lamp boxed above the cloud) with the path tracers against BDPT; its four tables and
+#     out/room_sheet.png, out/room_rgb_sheet.png, out/room_plume_sheet.png, out/lantern_sheet.png,
+#     out/room.png;
 #  1c. nsp_volume: the smoke plume (512^3, .vdb) and the cloud (.vdb) exported and rendered under
 #     every majorant (global, grid 16^3 and 64^3, tree on the VDB nodes, adaptive tree), their
 #     tables and out/plume_vdb/volume.png, out/cloud_vdb/volume.png; then the plume glowing by its
@@ -58,7 +60,8 @@ fi
 
 start=$SECONDS
 build/examples/nsp_render --out out
-# The scene with surfaces: the cloud over a floor in an open room, grey and chromatic (about 40 s).
+# The scene with surfaces: the cloud over a floor in an open room, grey, chromatic and glowing, and
+# the lantern with BDPT (about 75 s).
 build/examples/nsp_room --out out
 # Volumes from files: the procedural smoke plume (512^3 voxels, 0.5% of them active) written as .vdb
 # and the cloud as .vdb, each rendered under the global, grid 16^3 and 64^3 and tree majorants
