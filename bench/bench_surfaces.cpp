@@ -10,7 +10,9 @@
 // - BM_Lantern/<estimator>: one radiance sample of the lantern (room_scene.hpp: the lamp boxed
 //   above the cloud, issue 18's scene), the path tracers against BdptEstimator; for BDPT the
 //   strategy families' counts per sample (hits s = 0, NEE s = 1, connections s >= 2, each one
-//   evaluated path) and the stack its subpaths take (bytes, MaxDepth = 32).
+//   evaluated path; splats t = 1 with light tracing) and the stack its subpaths take (bytes,
+//   MaxDepth = 32).
+#include <array>
 #include <string>
 
 #include <benchmark/benchmark.h>
@@ -83,7 +85,9 @@ void BM_CloudUnderSky_NoSurfaces(benchmark::State& state) {
     run<E>(state, scene, camera_rays());
 }
 
-template <class E>
+/// With light tracing: BdptEstimator::sample through the room's pinhole camera at the same image
+/// points, the splats summed into a sink.
+template <class E, bool kLightTracing = false>
 void BM_Lantern(benchmark::State& state) {
     static const auto scene = nsp_examples::make_lantern_scene(
         nsp_examples::make_default_medium<nsp::Mono>(),
@@ -91,13 +95,26 @@ void BM_Lantern(benchmark::State& state) {
     const E estimator;
     nsp::Pcg32 rng(6, 66);
     nsp::LookupCount counter;
-    double hits = 0, nee = 0, connections = 0;
-    auto count = [&](int s, int, const auto&, float, const auto&, const auto&) {
-        (s == 0 ? hits : s == 1 ? nee : connections) += 1.0;
+    double hits = 0, nee = 0, connections = 0, splats = 0;
+    auto count = [&](int s, int t, const auto&, float, const auto&, const auto&) {
+        (t == 1 ? splats : s == 0 ? hits : s == 1 ? nee : connections) += 1.0;
     };
     std::size_t i = 0;
     for (auto _ : state) {
-        if constexpr (requires { E::kMaxPath; }) {
+        if constexpr (kLightTracing) {
+            static const nsp::PinholeCamera camera = nsp_examples::room_pinhole();
+            static const std::vector<std::array<float, 2>> uv = [] {
+                nsp::Pcg32 g(8, 88);
+                std::vector<std::array<float, 2>> p(kSetSize);
+                for (auto& x : p) x = {g.uniform(), g.uniform()};
+                return p;
+            }();
+            double sink = 0.0;
+            auto splat = [&](float, float, const auto& value) { sink += double(value[0]); };
+            auto r = estimator.sample_observed(scene, camera, uv[i][0], uv[i][1], {}, rng, counter, splat, count);
+            benchmark::DoNotOptimize(r);
+            benchmark::DoNotOptimize(sink);
+        } else if constexpr (requires { E::kMaxPath; }) {
             auto r = estimator.radiance_observed(scene, room_rays()[i], {}, rng, counter, count);
             benchmark::DoNotOptimize(r);
         } else {
@@ -112,8 +129,9 @@ void BM_Lantern(benchmark::State& state) {
         state.counters["hits/sample"] = hits / n;
         state.counters["nee/sample"] = nee / n;
         state.counters["connections/sample"] = connections / n;
+        state.counters["splats/sample"] = splats / n;
         state.counters["subpath_bytes"] =
-            double(sizeof(nsp::bdpt::Vertex<nsp::Mono>) * (2 * E::kMaxDepth + 2) + sizeof(typename E::Pdfs));
+            double(sizeof(nsp::bdpt::Vertex<nsp::Mono>) * (2 * E::kMaxDepth + 3) + sizeof(typename E::Pdfs));
     }
 }
 
@@ -130,6 +148,8 @@ BENCHMARK_TEMPLATE(BM_Lantern, Uni)->Name("BM_Lantern/unidirectional");
 BENCHMARK_TEMPLATE(BM_Lantern, Nsmis)->Name("BM_Lantern/uni-nee-mis:balance");
 BENCHMARK_TEMPLATE(BM_Lantern, nsp::BdptEstimator<nsp::bdpt::Directional>)->Name("BM_Lantern/bdpt-directional-mis:balance");
 BENCHMARK_TEMPLATE(BM_Lantern, nsp::BdptEstimator<nsp::bdpt::NullScattering>)->Name("BM_Lantern/bdpt-null-mis:balance");
+BENCHMARK_TEMPLATE(BM_Lantern, nsp::BdptEstimator<nsp::bdpt::NullScattering>, true)
+    ->Name("BM_Lantern/bdpt-null-mis:balance+light-tracing");
 BENCHMARK_TEMPLATE(BM_CloudUnderSky_Scene, Uni)->Name("BM_CloudUnderSky/Scene/unidirectional");
 BENCHMARK_TEMPLATE(BM_CloudUnderSky_NoSurfaces, Uni)->Name("BM_CloudUnderSky/NoSurfaces/unidirectional");
 BENCHMARK_TEMPLATE(BM_CloudUnderSky_Scene, Nsmis)->Name("BM_CloudUnderSky/Scene/uni-nee-mis:balance");

@@ -107,4 +107,112 @@ Row render_image(const Sc& scene, const E& estimator, const std::string& name, i
     return row;
 }
 
+/// render_image for an estimator that splats (BdptEstimator::sample with light tracing) through
+/// `camera` (an nsp::Camera): each pixel is the sum of its samples' returns and of the splats it
+/// received, over spp. A pixel's own samples no longer give its variance (its splats come from
+/// other pixels' light subpaths), so the samples are dealt into kBatches batches by index, each
+/// batch an independent image, and a pixel's variance of one sample is the variance of its batch
+/// means times the batch size; the image mean's standard error is that of the batch images' means.
+template <class Sc, class E, class Cam>
+Row render_image_splatting(const Sc& scene, const E& estimator, const Cam& camera, const std::string& name, int res,
+                           int spp, int threads, std::uint64_t seed) {
+    constexpr int kChannels = Sc::Spectral::channels;
+    constexpr int kBatches = 8;
+    const std::size_t n_pix = std::size_t(res) * std::size_t(res);
+    Row row;
+    row.name = name;
+    row.image.width = row.image.height = res;
+    row.image.rgb.assign(n_pix * 3u, 0.f);
+    struct Buffers {
+        std::vector<double> batch;  ///< [batch][pixel]: the channel mean's sum, returns and splats
+        std::vector<double> rgb;    ///< [pixel][3]
+        std::uint64_t lookups = 0, steps = 0, failed = 0;
+        double cpu = 0.0;
+    };
+    std::vector<Buffers> buffers(static_cast<std::size_t>(threads));
+    for (Buffers& b : buffers) {
+        b.batch.assign(kBatches * n_pix, 0.0);
+        b.rgb.assign(3 * n_pix, 0.0);
+    }
+    std::atomic<int> next{0};
+    const auto start = std::chrono::steady_clock::now();
+    auto add = [&](Buffers& out, int batch, std::size_t pixel, const auto& value) {
+        out.batch[std::size_t(batch) * n_pix + pixel] += double(value.mean());
+        for (int c = 0; c < 3; ++c) out.rgb[3 * pixel + std::size_t(c)] += double(value[kChannels == 3 ? c : 0]);
+    };
+    auto work = [&](Buffers& out) {
+        const double cpu0 = thread_cpu_seconds();
+        nsp::LookupCount counter;
+        for (int y; (y = next.fetch_add(1)) < res;)
+            for (int x = 0; x < res; ++x) {
+                const std::size_t pixel = std::size_t(y) * std::size_t(res) + std::size_t(x);
+                nsp::Pcg32 rng(seed, pixel);
+                for (int k = 0; k < spp; ++k) {
+                    const int batch = k % kBatches;
+                    auto splat = [&](float u, float v, const auto& value) {
+                        const int px = std::clamp(int(u * float(res)), 0, res - 1);
+                        const int py = std::clamp(int((1.f - v) * float(res)), 0, res - 1);
+                        add(out, batch, std::size_t(py) * std::size_t(res) + std::size_t(px), value);
+                    };
+                    const float u = (float(x) + rng.uniform()) / float(res);
+                    const float v = 1.f - (float(y) + rng.uniform()) / float(res);
+                    const auto r = estimator.sample(scene, camera, u, v, {}, rng, counter, splat);
+                    if (r.status != nsp::Status::Ok) ++out.failed;
+                    add(out, batch, pixel, r.value);
+                }
+            }
+        out.lookups = counter.count();
+        out.steps = counter.steps;
+        out.cpu = thread_cpu_seconds() - cpu0;
+    };
+    std::vector<std::thread> pool;
+    for (int t = 0; t < threads; ++t) pool.emplace_back(work, std::ref(buffers[std::size_t(t)]));
+    for (auto& t : pool) t.join();
+    row.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    double lookups = 0.0, steps = 0.0;
+    for (const Buffers& b : buffers) {
+        lookups += double(b.lookups);
+        steps += double(b.steps);
+        row.cpu_seconds += b.cpu;
+        row.failed += b.failed;
+    }
+    std::array<double, kBatches> per_batch{};  // samples per pixel in each batch
+    for (int k = 0; k < spp; ++k) per_batch[std::size_t(k % kBatches)] += 1.0;
+    const int batches = std::min(spp, kBatches);
+    std::array<double, kBatches> image_mean{};
+    double sum_var = 0.0, sum_mean = 0.0;
+    for (std::size_t p = 0; p < n_pix; ++p) {
+        double total = 0.0, m = 0.0, m2 = 0.0;
+        for (int b = 0; b < batches; ++b) {
+            double t = 0.0;
+            for (const Buffers& buf : buffers) t += buf.batch[std::size_t(b) * n_pix + p];
+            total += t;
+            const double mean_b = t / per_batch[std::size_t(b)], d = mean_b - m;
+            m += d / (b + 1);
+            m2 += d * (mean_b - m);
+            image_mean[std::size_t(b)] += mean_b / double(n_pix);
+        }
+        for (int c = 0; c < 3; ++c) {
+            double v = 0.0;
+            for (const Buffers& buf : buffers) v += buf.rgb[3 * p + std::size_t(c)];
+            row.image.rgb[3 * p + std::size_t(c)] = float(v / spp);
+        }
+        sum_mean += total / spp;
+        if (batches > 1) sum_var += m2 / (batches - 1) * (double(spp) / batches);
+    }
+    const double samples = double(n_pix) * spp;
+    row.lookups = lookups / samples;
+    row.steps = steps / samples;
+    row.variance = sum_var / double(n_pix);
+    row.mean = sum_mean / double(n_pix);
+    double m = 0.0, m2 = 0.0;
+    for (int b = 0; b < batches; ++b) {
+        const double d = image_mean[std::size_t(b)] - m;
+        m += d / (b + 1);
+        m2 += d * (image_mean[std::size_t(b)] - m);
+    }
+    row.se = batches > 1 ? std::sqrt(m2 / (batches - 1) / batches) : 0.0;
+    return row;
+}
+
 }  // namespace nsp_examples

@@ -10,7 +10,7 @@
 // size and spp) with the path tracers against BdptEstimator's directional and null-scattering MIS.
 //
 //   nsp_room [--res N] [--spp N] [--threads N] [--out DIR] [--no-png] [--picture-res N]
-//            [--tables grey,rgb,plume,lantern]
+//            [--tables grey,rgb,plume,lantern] [--seed N]
 //
 // Writes DIR/room_sheet.png, DIR/room_rgb_sheet.png, DIR/room_plume_sheet.png and
 // DIR/lantern_sheet.png (each table's rows at one exposure) and
@@ -47,6 +47,14 @@ Row render(const Sc& scene, const E& estimator, const std::string& name, int res
                                       [](float u, float v) { return nsp_examples::room_camera_ray(u, v, 1.f); });
 }
 
+/// The room's image with light tracing: BdptEstimator::sample through room_pinhole(), splats included.
+template <class Sc, class E>
+Row render_splatting(const Sc& scene, const E& estimator, const std::string& name, int res, int spp, int threads,
+                     std::uint64_t seed) {
+    return nsp_examples::render_image_splatting(scene, estimator, nsp_examples::room_pinhole(), name, res, spp, threads,
+                                                seed);
+}
+
 /// CPU seconds x variance of row i: what cpu-s*var orders by (per sample, up to a common factor).
 double cost(const std::vector<Row>& rows, std::size_t i) { return rows[i].cpu_seconds * rows[i].variance; }
 
@@ -69,7 +77,8 @@ std::uint64_t print_table(const char* title, const std::vector<Row>& rows, std::
                     r.lookups, r.variance, r.lookups * r.variance, cpu_var, cpu_var / best, r.mean, z);
         failed += r.failed;
     }
-    std::printf("var/spl: per-pixel sample variance of the channel mean, averaged over pixels; cpu-s*var: thread CPU "
+    std::printf("var/spl: per-pixel sample variance of the channel mean, averaged over pixels (bdpt rows with light "
+                "tracing: from 8 batch images, as their splats land in other pixels); cpu-s*var: thread CPU "
                 "seconds per sample x var/spl (lower is better; cpu/best against the best row). z: |mean - mean of %s| "
                 "in combined standard errors of the image means. Paths with a failed status: %llu\n",
                 ref.name.c_str(), static_cast<unsigned long long>(failed));
@@ -90,6 +99,8 @@ int main(int argc, char** argv) {
     app.add_option("--out", out, "directory for the PNG pictures");
     app.add_option("--picture-res", picture_res, "size of room.png")->check(CLI::Range(16, 4096));
     app.add_flag("--no-png", no_png, "write no pictures");
+    std::uint64_t seed_offset = 0;
+    app.add_option("--seed", seed_offset, "added to every row's seed (independent runs)");
     std::vector<std::string> tables{"grey", "rgb", "plume", "lantern"};
     app.add_option("--tables", tables, "which tables to render (default: all)")
         ->check(CLI::IsMember({"grey", "rgb", "plume", "lantern"}))
@@ -98,11 +109,16 @@ int main(int argc, char** argv) {
     auto want = [&](const char* t) { return std::find(tables.begin(), tables.end(), t) != tables.end(); };
 
     using namespace nsp;
-    std::uint64_t seed = 1;
+    seed_offset *= 1000;  // each row takes the next seed: runs 1000 apart share none
+    std::uint64_t seed = 1 + seed_offset;
     std::vector<Row> rows;
     int run_res = res, run_spp = spp;
     auto run = [&](const auto& scene, const auto& estimator, const char* name) {
         rows.push_back(render(scene, estimator, name, run_res, run_spp, threads, seed++));
+        std::fprintf(stderr, "  room: %-44s %6.2f s\n", name, rows.back().seconds);
+    };
+    auto run_splatting = [&](const auto& scene, const auto& estimator, const char* name) {
+        rows.push_back(render_splatting(scene, estimator, name, run_res, run_spp, threads, seed++));
         std::fprintf(stderr, "  room: %-44s %6.2f s\n", name, rows.back().seconds);
     };
 
@@ -118,7 +134,7 @@ int main(int argc, char** argv) {
         run(grey, PathEstimator<strategy::NullScatteringMis, mis::Power>{}, "uni-nee-mis_power");
         run(grey, PathEstimator<strategy::EquiangularNextEvent>{}, "equiangular-nee");  // aimed at the lamp's centre
         run(grey, PathEstimator<strategy::EquiangularMis, mis::Balance>{}, "equiangular-mis_balance");
-        run(grey, BdptEstimator<bdpt::NullScattering, mis::Balance>{}, "bdpt_null-mis_balance");
+        run_splatting(grey, BdptEstimator<bdpt::NullScattering, mis::Balance>{}, "bdpt_null-mis_balance");
         failed += print_table("Room (mono", rows, 4, res, spp, threads);  // z against uni-nee-mis_balance
         std::printf("room: uni-nee-mis_balance / best single strategy (%s) in cpu-s*var: %.3g; unidirectional / ratio-nee: %.3g\n",
                     rows[cost(rows, 0) <= cost(rows, 1) ? 0 : 1].name.c_str(), cost(rows, 4) / std::min(cost(rows, 0), cost(rows, 1)),
@@ -136,7 +152,7 @@ int main(int argc, char** argv) {
         const CM chroma = nsp_examples::make_chromatic_medium<Rgb>();
         const auto chroma_grey = nsp_examples::make_room_scene(chroma, GlobalMajorant<CM>(chroma));
         const auto chroma_channel = nsp_examples::make_room_scene(chroma, ChannelMajorant<CM>(chroma));
-        seed = 7;  // each table its own seeds: a row added to one table leaves the others' numbers as they were
+        seed = 7 + seed_offset;  // each table its own seeds: a row added to one table leaves the others' numbers as they were
         run_res = std::max(1, res / 2);  // the chromatic cloud costs about 4x the lookups: half the size, half the spp
         run_spp = std::max(2, spp / 2);
         run(chroma_grey, PathEstimator<strategy::NullScatteringMis, mis::Balance>{}, "uni-nee-mis_grey_balance");
@@ -163,7 +179,7 @@ int main(int argc, char** argv) {
         using PM = Emissive<DenseGridMedium<Mono>>;
         const PM plume = nsp_examples::make_plume_medium<Mono>();
         const auto plume_room = nsp_examples::make_room_scene(plume, GlobalMajorant<PM>(plume));
-        seed = 11;
+        seed = 11 + seed_offset;
         run(plume_room, PathEstimator<strategy::Unidirectional>{}, "unidirectional");
         run(plume_room, PathEstimator<strategy::NextEvent>{}, "ratio-nee");
         run(plume_room, PathEstimator<strategy::NullScatteringMis, mis::Balance>{}, "uni-nee-mis_balance");
@@ -181,19 +197,21 @@ int main(int argc, char** argv) {
     if (want("lantern")) {
         const auto lantern = nsp_examples::make_lantern_scene(nsp_examples::make_default_medium<Mono>(),
                                                               GlobalMajorant<DenseGridMedium<Mono>>(nsp_examples::make_default_medium<Mono>()));
-        seed = 13;
+        seed = 13 + seed_offset;
         run(lantern, PathEstimator<strategy::Unidirectional>{}, "unidirectional");
         run(lantern, PathEstimator<strategy::NextEvent>{}, "ratio-nee");
         run(lantern, PathEstimator<strategy::NullScatteringMis, mis::Balance>{}, "uni-nee-mis_balance");
-        run(lantern, BdptEstimator<bdpt::Directional, mis::Balance>{}, "bdpt_directional-mis_balance");
-        run(lantern, BdptEstimator<bdpt::NullScattering, mis::Balance>{}, "bdpt_null-mis_balance");
-        run(lantern, BdptEstimator<bdpt::NullScattering, mis::Power>{}, "bdpt_null-mis_power");
+        run_splatting(lantern, BdptEstimator<bdpt::Directional, mis::Balance>{}, "bdpt_directional-mis_balance");
+        run_splatting(lantern, BdptEstimator<bdpt::NullScattering, mis::Balance>{}, "bdpt_null-mis_balance");
+        run_splatting(lantern, BdptEstimator<bdpt::NullScattering, mis::Power>{}, "bdpt_null-mis_power");
+        run(lantern, BdptEstimator<bdpt::Directional, mis::Balance>{}, "bdpt_directional-mis_balance_no-t1");
+        run(lantern, BdptEstimator<bdpt::NullScattering, mis::Balance>{}, "bdpt_null-mis_balance_no-t1");
         std::vector<Row> lantern_rows(rows.begin() + std::ptrdiff_t(first_lantern), rows.end());
         failed += print_table("Lantern (mono", lantern_rows, 4, run_res, run_spp, threads,
                         "the cloud over a floor, lit only by a lamp in a box that opens downward into it");
-        std::printf("lantern: bdpt_null-mis_balance / bdpt_directional-mis_balance in cpu-s*var: %.3g; / uni-nee-mis_balance: "
-                    "%.3g; / best path tracer: %.3g\n",
-                    cost(lantern_rows, 4) / cost(lantern_rows, 3), cost(lantern_rows, 4) / cost(lantern_rows, 2),
+        std::printf("lantern: bdpt_null-mis_balance / bdpt_directional-mis_balance in cpu-s*var: %.3g (without light "
+                    "tracing: %.3g); / best path tracer: %.3g\n",
+                    cost(lantern_rows, 4) / cost(lantern_rows, 3), cost(lantern_rows, 7) / cost(lantern_rows, 6),
                     cost(lantern_rows, 4) / std::min({cost(lantern_rows, 0), cost(lantern_rows, 1), cost(lantern_rows, 2)}));
     }
 

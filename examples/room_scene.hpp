@@ -108,4 +108,10 @@ inline nsp::Ray room_camera_ray(float u, float v, float aspect) {
     return {eye, glm::normalize(f + (2.f * u - 1.f) * tan_half * aspect * r + (2.f * v - 1.f) * tan_half * up)};
 }
 
+/// The same camera as an nsp::PinholeCamera (light tracing needs where points appear on the image):
+/// its ray(u, v) is room_camera_ray(u, v, 1).
+inline nsp::PinholeCamera room_pinhole() {
+    return nsp::PinholeCamera(nsp::Vec3(0.f, 0.6f, -5.6f), nsp::Vec3(0.f, -0.15f, 0.f), nsp::Vec3(0.f, 1.f, 0.f), 42.f, 1.f);
+}
+
 }  // namespace nsp_examples

@@ -10,7 +10,8 @@ cd "$(dirname "$0")/.."
 
 # What the sanitizer build runs: the tracking suite (free flight, pdfs, MIS weights, transmittance,
 # equiangular sampling), the stability suite (every tracker, majorant kind, bound policy and mode
-# at the extremes, and the path estimators) and the debug-mode tests. The fuzz corpus runs under
+# at the extremes, and the path estimators), the bidirectional suite (BdptEstimator's vertex
+# arrays and strategy weights; about 30 s instrumented) and the debug-mode tests. The fuzz corpus runs under
 # the same sanitizers in scripts/run-fuzz.sh (libFuzzer replays the corpus before it fuzzes, and
 # the harness drives grid majorants, channel trackers, emissive media and seven estimators), so
 # its replay test is not built twice. Left out, to keep CI under 30 minutes on 2 cores (the
@@ -19,7 +20,7 @@ cd "$(dirname "$0")/.."
 # nsp_test_majorants (every strategy x heuristic x majorant x mode, the slowest to compile); the
 # kernels they drive run here through the stability suite and in the fuzzer. Name them as
 # arguments to run them too.
-default_tests="nsp_test_tracking nsp_test_stability nsp_test_debug nsp_debug_check_fires nsp_test_volume_files"
+default_tests="nsp_test_tracking nsp_test_stability nsp_test_bdpt nsp_test_debug nsp_debug_check_fires nsp_test_volume_files"
 read -r -a tests <<< "${*:-${NSP_SANITIZE_TESTS:-$default_tests}}"
 
 # clang, not g++: with the sanitizers on, g++ took several times its Release time on these

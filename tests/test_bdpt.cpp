@@ -1,10 +1,12 @@
 // tests/test_bdpt.cpp: nsp::BdptEstimator (THEORY 5.5): the strategy weights of one path sum to 1
-// and equal the brute-force balance and power heuristics of the strategies' path pdfs; each
-// strategy's reported pdf ratios against every other strategy are the true ones (the expected
-// ratio p_s' / p_s over paths strategy s draws is the probability that s' draws a path at all);
-// each (s, t) strategy alone is unbiased; and the combined estimator against closed forms (the
-// furnace of six emitting walls, nested absorbing media behind null interfaces, a mirror behind an
-// absorbing slab) and against PathEstimator on a scattering cube over a floor under a lamp and a sky.
+// and equal the brute-force balance and power heuristics of the strategies' path pdfs (light
+// tracing, t = 1, included); the strategies' pdfs are their true densities (a symmetry that any
+// misplaced null-chain factor breaks, and that directional MIS's pseudo-pdfs do break); each
+// (s, t) strategy alone, t = 1 too, is unbiased; the combined estimator against closed forms (the
+// furnace of six emitting walls, with and without light tracing, nested absorbing media behind
+// null interfaces, a mirror behind an absorbing slab) and against PathEstimator (a scattering
+// cube over a floor under a lamp and a sky, and with light tracing pixel by pixel); finite output
+// at extreme densities and light sizes; PinholeCamera's rays, image coordinates and density.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -68,8 +70,12 @@ using Pdfs = bdpt::PathPdfs<16>;
 /// (x_0 by NEE when s = 1, by emission when s >= 2), x_s..x_{k-1} from the camera; 0 where a
 /// connection would end at a delta vertex.
 double brute_pdf(const Pdfs& p, int s) {
-    if (s == 1 && !p.connectible[1]) return 0.0;
-    if (s >= 2 && !(p.connectible[s - 1] && p.connectible[s])) return 0.0;
+    if (s == p.k) {  // t = 1: x_0..x_{k-1} from the light, x_{k-1} connected to the camera
+        if (!p.light_tracing || p.k < 2 || !p.connectible[p.k - 1]) return 0.0;
+    } else {
+        if (s == 1 && !p.connectible[1]) return 0.0;
+        if (s >= 2 && !(p.connectible[s - 1] && p.connectible[s])) return 0.0;
+    }
     double v = s == 0 ? p.from_camera[0] : s == 1 ? p.nee : p.emit;
     for (int i = 1; i < s; ++i) v *= p.from_light[i];
     for (int i = std::max(s, 1); i < p.k; ++i) v *= p.from_camera[i];
@@ -78,7 +84,8 @@ double brute_pdf(const Pdfs& p, int s) {
 
 TEST_CASE("bdpt: the strategy weights of a path are the heuristics of its strategies' pdfs and sum to 1") {
     // Random densities over 12 orders of magnitude, delta vertices and zero densities (a point
-    // light: from_camera[0] = 0; a light at infinity: emit = 0), paths of 2 to 15 vertices.
+    // light: from_camera[0] = 0; a light at infinity: emit = 0), paths of 2 to 15 vertices, with
+    // and without light tracing (t = 1).
     Pcg32 rng(17, 3);
     const mis::Balance balance;
     const mis::Power power(2.f);
@@ -92,17 +99,20 @@ TEST_CASE("bdpt: the strategy weights of a path are the heuristics of its strate
             p.connectible[i] = rng.uniform() > 0.15f;
         }
         p.connectible[0] = true;
-        p.from_camera[p.k - 1] = 1.f;
+        p.light_tracing = rng.uniform() < 0.5f;
+        if (!p.light_tracing) p.from_camera[p.k - 1] = 1.f;
         p.nee = density();
         p.emit = rng.uniform() < 0.2f ? 0.f : density();
         if (rng.uniform() < 0.2f) p.from_camera[0] = 0.f;
+        const int count = p.light_tracing && p.k >= 2 ? p.k + 1 : p.k;
+        CHECK(bdpt::strategy_count(p) == count);
         double total = 0.0, total2 = 0.0;
-        for (int s = 0; s < p.k; ++s) {
+        for (int s = 0; s < count; ++s) {
             total += brute_pdf(p, s);
             total2 += brute_pdf(p, s) * brute_pdf(p, s);
         }
         float sum_b = 0.f, sum_p = 0.f;
-        for (int s = 0; s < p.k; ++s) {
+        for (int s = 0; s < count; ++s) {
             const float wb = bdpt::strategy_weight(balance, p, s), wp = bdpt::strategy_weight(power, p, s);
             CAPTURE(trial);
             CAPTURE(s);
@@ -243,11 +253,19 @@ struct StrategyRecord {
     std::map<std::pair<int, int>, std::map<int, Stat>> share;
 };
 
+/// The cube's camera as a PinholeCamera: cube_camera(u, v) is its ray(u, 1 - v).
+PinholeCamera cube_pinhole() {
+    return PinholeCamera(Vec3(0.f, 0.3f, -4.5f), Vec3(0.f, 0.3f, 0.f), Vec3(0.f, 1.f, 0.f),
+                         2.f * std::atan(0.7f) * 180.f / kPi, 1.f);
+}
+
+/// Samples of the cube's image at uniform (u, v) over the whole image, light tracing included.
 template <class E>
 StrategyRecord record_strategies(const E& est, const Sc& sc, int n_samples, int longest) {
     StrategyRecord rec;
     Pcg32 rng(41, 7);
     LookupCount counter;
+    const PinholeCamera camera = cube_pinhole();
     std::map<std::pair<int, int>, double> value;
     std::map<std::pair<int, int>, std::vector<double>> shares;
     auto far_apart = [](const auto& v) {
@@ -264,22 +282,25 @@ StrategyRecord record_strategies(const E& est, const Sc& sc, int n_samples, int 
         auto observe = [&](int s, int t, const Spectrum& f, float, const auto& pdfs, const auto& vertices) {
             if (!far_apart(vertices)) return;
             value[{s, t}] += double(f[0]);
-            double q[E::kMaxPath];
+            double q[E::kMaxPath + 1];
             REQUIRE(bdpt::strategy_pdfs(pdfs, q));
+            const int count = bdpt::strategy_count(pdfs);
             double sum = 0.0;
-            for (int o = 0; o < pdfs.k; ++o) sum += q[o];
+            for (int o = 0; o < count; ++o) sum += q[o];
             auto& sh = shares[{s, t}];
-            sh.assign(std::size_t(pdfs.k), 0.0);
-            for (int o = 0; o < pdfs.k; ++o) sh[std::size_t(o)] = q[o] / sum;
+            sh.assign(std::size_t(count), 0.0);
+            for (int o = 0; o < count; ++o) sh[std::size_t(o)] = q[o] / sum;
         };
-        const auto r = est.radiance_observed(sc, cube_camera(rng), {}, rng, counter, observe);
+        auto splat = [](float, float, const Spectrum&) {};
+        const float u = rng.uniform(), v = rng.uniform();
+        const auto r = est.sample_observed(sc, camera, u, v, {}, rng, counter, splat, observe);
         REQUIRE(r.status == Status::Ok);
         for (int n = 1; n <= longest; ++n)
-            for (int s = 0; s <= n; ++s) {
+            for (int s = 0; s <= n + 1; ++s) {
                 const auto key = std::make_pair(s, n + 2 - s);
                 rec.alone[key].add(value.count(key) ? value[key] : 0.0);
                 const auto it = shares.find(key);
-                for (int o = 0; o <= n; ++o)
+                for (int o = 0; o <= n + 1; ++o)
                     rec.share[key][o].add(it == shares.end() ? 0.0 : it->second[std::size_t(o)]);
             }
     }
@@ -291,8 +312,8 @@ StrategyRecord record_strategies(const E& est, const Sc& sc, int n_samples, int 
 double worst_share_asymmetry(StrategyRecord& rec, int longest) {
     double worst = 0.0;
     for (int n = 1; n <= longest; ++n)
-        for (int s = 0; s <= n; ++s)
-            for (int o = s + 1; o <= n; ++o) {
+        for (int s = 0; s <= n + 1; ++s)
+            for (int o = s + 1; o <= n + 1; ++o) {
                 const Stat& a = rec.share[{s, n + 2 - s}][o];
                 const Stat& b = rec.share[{o, n + 2 - o}][s];
                 const double se = std::sqrt(a.se() * a.se() + b.se() * b.se());
@@ -306,8 +327,9 @@ double worst_share_asymmetry(StrategyRecord& rec, int longest) {
 
 TEST_CASE("bdpt: each strategy alone is unbiased, and the strategies' pdfs are the true densities") {
     // The cube over the floor under the lamp alone (no sky, no roulette, no delta vertices), paths
-    // of n = 1, 2, 3 interior vertices: every (s, t) with s + t - 2 = n draws every such path, so
-    // each alone (weight 1) estimates the same radiance: against NEE's (s = 1), 5 combined SE.
+    // of n = 1, 2, 3 interior vertices, the image's average over uniform (u, v), light tracing on:
+    // every (s, t) with s + t - 2 = n (t = 1 too) draws every such path, so each alone (weight 1)
+    // estimates the same radiance: against NEE's (s = 1), 5 combined SE.
     // The pdfs: for any two strategies s, o and true path densities p,
     //     E_s[p_o / sum_r p_r] = integral of p_s p_o / sum_r p_r = E_o[p_s / sum_r p_r],
     // a symmetry that breaks where a strategy's reported pdf is off by a factor that depends on
@@ -323,7 +345,7 @@ TEST_CASE("bdpt: each strategy alone is unbiased, and the strategies' pdfs are t
     StrategyRecord rec = record_strategies(BdptEstimator<bdpt::NullScattering, mis::Balance>(opts), sc, 200000, 3);
     for (int n = 1; n <= 3; ++n) {
         const Stat& nee = rec.alone[{1, n + 1}];
-        for (int s = 0; s <= n; ++s) {
+        for (int s = 0; s <= n + 1; ++s) {
             const Stat& a = rec.alone[{s, n + 2 - s}];
             CAPTURE(n);
             CAPTURE(s);
@@ -346,6 +368,137 @@ TEST_CASE("bdpt: the pdf symmetry test sees directional MIS's pdfs are not densi
     opts.max_depth = 3;
     StrategyRecord rec = record_strategies(BdptEstimator<bdpt::Directional, mis::Balance>(opts), sc, 200000, 3);
     CHECK(worst_share_asymmetry(rec, 3) > 4.0 * kSigmas);
+}
+
+TEST_CASE("bdpt: with light tracing, the image agrees with PathEstimator pixel by pixel") {
+    // The cube over the floor under the lamp and the sky, 4 x 4 pixels through cube_pinhole(),
+    // BdptEstimator::sample with splats: each pixel = (its samples' returns + the splats it
+    // received) / its sample count. Against PathEstimator's pixel means, 5 combined SE; the BDPT
+    // pixel's SE from 10 independent batches (splats land in other pixels than their sample's, so
+    // a pixel's samples alone do not give its variance).
+    const Sc sc = cube_over_floor(true);
+    const PinholeCamera camera = cube_pinhole();
+    constexpr int kRes = 4, kBatches = 10, kPerBatch = 1500;  // samples per pixel per batch
+    for_each_bdpt([&](const auto& est, const char* name) {
+        CAPTURE(std::string(name));
+        std::vector<Stat> bdpt_pixel(kRes * kRes), path_pixel(kRes * kRes);
+        Pcg32 rng(77, 1);
+        LookupCount counter;
+        const PathEstimator<strategy::NullScatteringMis, mis::Balance> path;
+        for (int b = 0; b < kBatches; ++b) {
+            std::vector<double> sum(kRes * kRes, 0.0);
+            auto splat = [&](float u, float v, const Spectrum& value) {
+                const int px = std::min(kRes - 1, int(u * kRes)), py = std::min(kRes - 1, int(v * kRes));
+                sum[std::size_t(py * kRes + px)] += double(value[0]);
+            };
+            for (int p = 0; p < kRes * kRes; ++p)
+                for (int i = 0; i < kPerBatch; ++i) {
+                    const float u = (float(p % kRes) + rng.uniform()) / kRes, v = (float(p / kRes) + rng.uniform()) / kRes;
+                    const auto r = est.sample(sc, camera, u, v, {}, rng, counter, splat);
+                    REQUIRE(r.status == Status::Ok);
+                    sum[std::size_t(p)] += double(r.value[0]);
+                    const auto q = path.radiance(sc, camera.ray(u, v), {}, rng, counter);
+                    REQUIRE(q.status == Status::Ok);
+                    path_pixel[std::size_t(p)].add(double(q.value[0]));
+                }
+            for (int p = 0; p < kRes * kRes; ++p) bdpt_pixel[std::size_t(p)].add(sum[std::size_t(p)] / kPerBatch);
+        }
+        for (int p = 0; p < kRes * kRes; ++p) {
+            const Stat& a = bdpt_pixel[std::size_t(p)];
+            const Stat& b = path_pixel[std::size_t(p)];
+            CAPTURE(p);
+            CAPTURE(a.mean);
+            CAPTURE(b.mean);
+            CHECK(std::abs(a.mean - b.mean) <= kSigmas * std::sqrt(a.se() * a.se() + b.se() * b.se()) + 1e-6);
+        }
+    });
+}
+
+TEST_CASE("bdpt: with light tracing, the furnace of six emitting walls is still L = 2 everywhere") {
+    // The camera inside the closed box: every pixel sees L = 2, so the image's average over
+    // uniform (u, v), each sample's return plus its light subpath's splats, is 2 (5 SE).
+    Shapes shapes;
+    std::vector<QuadLight<S>> walls;
+    box_walls(1.f, {1, 4}, shapes, walls);
+    const Sc sc(shapes, {medium(Box{Vec3(-1.f), Vec3(1.f)}, 0.f, 1.5f)}, materials(),
+                Ls(LightSelection::Uniform, 2.f, walls, {}), 0);
+    const PinholeCamera camera(Vec3(0.1f, -0.2f, 0.3f), Vec3(0.5f, 0.f, -1.f), Vec3(0.f, 1.f, 0.f), 70.f, 1.3f);
+    EstimatorOptions opts;
+    opts.max_depth = 64;
+    for_each_bdpt<64>(
+        [&](const auto& est, const char* name) {
+            CAPTURE(std::string(name));
+            Pcg32 rng(19, 2);
+            LookupCount counter;
+            Stat s;
+            for (int i = 0; i < 6000; ++i) {
+                double x = 0.0;
+                auto splat = [&](float, float, const Spectrum& value) { x += double(value[0]); };
+                const auto r = est.sample(sc, camera, rng.uniform(), rng.uniform(), {}, rng, counter, splat);
+                REQUIRE(r.status == Status::Ok);
+                s.add(x + double(r.value[0]));
+            }
+            CAPTURE(s.mean);
+            CAPTURE(s.se());
+            CHECK(std::abs(s.mean - 2.0) <= kSigmas * s.se());
+        },
+        opts);
+}
+
+TEST_CASE("bdpt: PinholeCamera's rays, image coordinates and direction density agree") {
+    // raster inverts ray; pdf_dir integrates to 1 over the image (Monte Carlo over the sphere of
+    // directions, 5 SE); bad parameters are rejected by name.
+    const PinholeCamera cam(Vec3(1.f, 2.f, 3.f), Vec3(0.f, 0.f, 0.f), Vec3(0.f, 1.f, 0.f), 50.f, 1.5f);
+    Pcg32 rng(3, 3);
+    for (int i = 0; i < 1000; ++i) {
+        const float u = rng.uniform(), v = rng.uniform();
+        float uu = -1.f, vv = -1.f;
+        REQUIRE(cam.raster(cam.ray(u, v).d, uu, vv));
+        CHECK(uu == doctest::Approx(u).epsilon(1e-3));
+        CHECK(vv == doctest::Approx(v).epsilon(1e-3));
+    }
+    Stat s;
+    for (int i = 0; i < 200000; ++i) s.add(double(cam.pdf_dir(uniform_sphere(rng.uniform(), rng.uniform()))) * 4.0 * kPi);
+    CHECK(std::abs(s.mean - 1.0) <= kSigmas * s.se());
+    CHECK_THROWS_WITH_AS(PinholeCamera(Vec3(0.f), Vec3(0.f, 0.f, 1.f), Vec3(0.f, 1.f, 0.f), 180.f),
+                         doctest::Contains("vfov_degrees = 180 is not allowed"), InvalidArgument);
+    CHECK_THROWS_WITH_AS(PinholeCamera(Vec3(0.f), Vec3(0.f, 1.f, 0.f), Vec3(0.f, 1.f, 0.f), 40.f),
+                         doctest::Contains("up is parallel"), InvalidArgument);
+}
+
+TEST_CASE("bdpt: finite estimates and splats at the extremes of density and light size") {
+    // Densities 0, 1e-6 and 1e6 (optical depth 2e6 across the cube), a lamp of 1e-3 x 1e-3 and one
+    // of 100 x 100, the camera inside the cube: every return and splat is finite, every status Ok.
+    for (const float sigma : {0.f, 1e-6f, 1e6f})
+        for (const float size : {1e-3f, 100.f}) {
+            Shapes shapes;
+            shapes.boxes.push_back({Vec3(-1.f), Vec3(1.f), {-1, -1, 0, -1}});
+            shapes.quads.push_back({Vec3(-3.f, -1.05f, 3.f), Vec3(6.f, 0.f, 0.f), Vec3(0.f, 0.f, -6.f), {0, -1, -1, -1}});
+            const QuadLight<S> lamp{Vec3(-0.5f * size, 2.6f, -0.5f * size), Vec3(size, 0.f, 0.f), Vec3(0.f, 0.f, size),
+                                    Spectrum::Constant(12.f)};
+            shapes.quads.push_back({lamp.corner, lamp.edge_u, lamp.edge_v, {-1, 0, -1, -1}});
+            const Sc sc(shapes, {medium(Box{Vec3(-1.f), Vec3(1.f)}, 0.5f * sigma, 0.5f * sigma)}, materials(0.6f),
+                        Ls(LightSelection::Power, 4.f, {lamp}, {EnvironmentLight<S>{Spectrum::Constant(0.05f)}}), 0);
+            const PinholeCamera camera(Vec3(0.f, 0.2f, 0.f), Vec3(0.f, 0.f, 1.f), Vec3(0.f, 1.f, 0.f), 60.f);
+            for_each_bdpt([&](const auto& est, const char* name) {
+                CAPTURE(std::string(name));
+                CAPTURE(sigma);
+                CAPTURE(size);
+                Pcg32 rng(5, 5);
+                LookupCount counter;
+                bool finite = true;
+                auto splat = [&](float, float, const Spectrum& v) { finite = finite && std::isfinite(v[0]); };
+                for (int i = 0; i < 300; ++i) {
+                    const auto a = est.radiance(sc, camera.ray(rng.uniform(), rng.uniform()), {}, rng, counter);
+                    const auto b = est.sample(sc, camera, rng.uniform(), rng.uniform(), {}, rng, counter, splat);
+                    CHECK(a.status == Status::Ok);
+                    CHECK(b.status == Status::Ok);
+                    CHECK(std::isfinite(a.value[0]));
+                    CHECK(std::isfinite(b.value[0]));
+                }
+                CHECK(finite);
+            });
+        }
 }
 
 TEST_CASE("bdpt: rejects a max_depth beyond its vertex arrays") {

@@ -2,6 +2,7 @@
 #pragma once
 
 #include "bsdf.hpp"
+#include "camera.hpp"
 #include "channel_tracking.hpp"
 #include "color.hpp"
 #include "core/counter.hpp"

@@ -8,14 +8,16 @@
 // with the segment's null-scattering factors: prod P_n(n_j) of the nulls on the segment it was
 // drawn along, and mu_bar P_s at a medium vertex (the Tbar and mu_bar(n_j) factors appear in
 // every strategy's pdf of a segment and cancel). Strategies (s, t), s light vertices and t camera
-// vertices, t >= 2:
+// vertices:
 // - s = 0: the camera subpath hits an emitter (a surface light, or the lights at infinity);
 // - s = 1: next-event estimation from the camera vertex (the scene's light sampler);
 // - s >= 2: a connection between light vertex s-1 and camera vertex t-1, its transmittance and its
-//   nulls' P_n product by ratio tracking across the media and null interfaces between them.
+//   nulls' P_n product by ratio tracking across the media and null interfaces between them;
+// - t = 1 (sample(), with the host's Camera): light vertex s-1 connected to the camera and
+//   splatted where it appears on the image (light tracing); radiance() leaves it out, and its
+//   weights leave it out for every path alike, so they still sum to 1.
 // Each is weighted against every other strategy that could have drawn the same path (bdpt::
-// strategy_weight). Light tracing (t = 1, splatting onto the image) is not among them: the
-// weights leave it out consistently, so every path's weights still sum to 1.
+// strategy_weight).
 //
 // Policies: bdpt::NullScattering (the paper's full null-scattering MIS) or bdpt::Directional
 // (the baseline: direction pdfs and geometry only, the tracking factors left out, as pbrt's BDPT
@@ -35,6 +37,7 @@
 #include "../core/counter.hpp"
 #include "../core/rng.hpp"
 #include "../geometry.hpp"
+#include "../camera.hpp"
 #include "../media/emissive.hpp"
 #include "../mis.hpp"
 #include "../surface_scene.hpp"
@@ -71,19 +74,30 @@ concept MisPolicy = requires {
 /// - emit: the density of x_0 under light subpaths (the light sampler's emission, selection
 ///   included; 0 for lights at infinity); nee: its density under NEE from x_1 (solid angle at
 ///   infinity, area measure otherwise, a point light's selection probability);
-/// - connectible[i]: x_i is not a delta vertex (a mirror), so a connection may end there.
+/// - connectible[i]: x_i is not a delta vertex (a mirror), so a connection may end there;
+/// - light_tracing: strategy s = k (t = 1, x_{k-1} connected to the camera) is among them; then
+///   from_camera[k-1] is the camera's own density of x_{k-1} (its pdf_dir converted), else any
+///   value > 0 (it is the same in every strategy and cancels).
 /// Strategy s draws x_0..x_{s-1} from the light and x_s..x_k from the camera.
 template <int N>
 struct PathPdfs {
     int k = 0;
+    bool light_tracing = false;
     float emit = 0.f, nee = 0.f;
     float from_light[N] = {};
     float from_camera[N] = {};
     bool connectible[N] = {};
 };
 
+/// How many strategies the path has: s = 0..k-1, and s = k (t = 1, light tracing) when
+/// `light_tracing` and k >= 2.
+template <int N>
+int strategy_count(const PathPdfs<N>& p) noexcept {
+    return p.light_tracing && p.k >= 2 ? p.k + 1 : p.k;
+}
+
 /// Strategy s's pdf of the path relative to the largest of all strategies' (each in [0, 1]; 0
-/// where s cannot draw it), written into q[0..k-1]. Each vertex's two densities are scaled by
+/// where s cannot draw it), written into q[0..k-1] (q[0..k] with light tracing). Each vertex's two densities are scaled by
 /// their larger one and the products taken in double, so long paths neither overflow nor
 /// underflow. Returns false when no strategy can draw the path.
 template <int N>
@@ -102,18 +116,20 @@ bool strategy_pdfs(const PathPdfs<N>& p, double* q) noexcept {
     for (int i = k - 1; i >= 1; --i) suffix[i] = suffix[i + 1] * c[i];
     const double m0 = std::max({double(p.from_camera[0]), double(p.nee), double(p.emit)});
     if (!(m0 > 0.0)) return false;
+    const int last = strategy_count(p);
     double prefix = 1.0, largest = 0.0;  // prefix = prod_{i=1}^{s-1} l_i
-    for (int s = 0; s < k; ++s) {
+    for (int s = 0; s < last; ++s) {
         if (s >= 2) prefix *= l[s - 1];
         double v = 0.0;
         if (s == 0) v = double(p.from_camera[0]) / m0 * suffix[1];
         else if (s == 1) v = p.connectible[1] ? double(p.nee) / m0 * suffix[1] : 0.0;
+        else if (s == k) v = p.connectible[k - 1] ? double(p.emit) / m0 * prefix : 0.0;  // t = 1
         else if (p.connectible[s - 1] && p.connectible[s]) v = double(p.emit) / m0 * prefix * suffix[s];
         q[s] = v;
         largest = std::max(largest, v);
     }
     if (!(largest > 0.0)) return false;
-    for (int s = 0; s < k; ++s) q[s] /= largest;
+    for (int s = 0; s < last; ++s) q[s] /= largest;
     return true;
 }
 
@@ -122,12 +138,13 @@ bool strategy_pdfs(const PathPdfs<N>& p, double* q) noexcept {
 /// cannot draw it. NaN densities give NaN (the estimator reports Status::NonFinite).
 template <mis::CombiningHeuristic H, int N>
 float strategy_weight(const H& h, const PathPdfs<N>& p, int s) noexcept {
-    if (s < 0 || s >= p.k) return 0.f;
-    double q[N];
+    const int n = strategy_count(p);
+    if (s < 0 || s >= n) return 0.f;
+    double q[N + 1];
     if (!strategy_pdfs(p, q)) return 0.f;
     if (!(q[s] > 0.0)) return std::isnan(q[s]) ? q[s] : 0.f;
     double sum = 0.0;
-    for (int i = 0; i < p.k; ++i) sum += double(h.power(float(q[i])));
+    for (int i = 0; i < n; ++i) sum += double(h.power(float(q[i])));
     return float(double(h.power(float(q[s]))) / sum);
 }
 
@@ -236,13 +253,46 @@ public:
     template <class Sc, UniformRng R, LookupCounter C, class Observe>
     RadianceSample<typename Sc::Spectral> radiance_observed(const Sc& sc, const Ray& camera_ray,
                                                             const typename Sc::Spectral::Wavelengths& lambda, R& rng,
-                                                            C& counter, Observe& observe) const;
+                                                            C& counter, Observe& observe) const {
+        NoSplat none;
+        return trace(sc, camera_ray, static_cast<const NoCamera*>(nullptr), lambda, rng, counter, none, observe);
+    }
+
+    /// One sample of the image of `camera` at image coordinates (u, v), with light tracing (t = 1)
+    /// among the strategies: returns the camera ray's MIS-weighted estimate for the pixel at
+    /// (u, v), and calls `splat(u', v', value)` for each light-tracing contribution, which the host
+    /// adds to the pixel at (u', v'). Every pixel's value is then the sum of its samples' returns
+    /// and of the splats it received, divided by its own number of samples (the same for every
+    /// pixel: the light subpaths are one per camera sample over the whole image). Never throws.
+    template <class Sc, Camera Cam, UniformRng R, LookupCounter C, class Splat>
+    RadianceSample<typename Sc::Spectral> sample(const Sc& sc, const Cam& camera, float u, float v,
+                                                 const typename Sc::Spectral::Wavelengths& lambda, R& rng, C& counter,
+                                                 Splat&& splat) const {
+        NoObserver none;
+        return trace(sc, camera.ray(u, v), &camera, lambda, rng, counter, splat, none);
+    }
+
+    /// sample(), with the observer of radiance_observed (t = 1 included: its contribution is the
+    /// splat's value before weighting).
+    template <class Sc, Camera Cam, UniformRng R, LookupCounter C, class Splat, class Observe>
+    RadianceSample<typename Sc::Spectral> sample_observed(const Sc& sc, const Cam& camera, float u, float v,
+                                                          const typename Sc::Spectral::Wavelengths& lambda, R& rng,
+                                                          C& counter, Splat&& splat, Observe& observe) const {
+        return trace(sc, camera.ray(u, v), &camera, lambda, rng, counter, splat, observe);
+    }
 
 private:
     struct NoObserver {
         template <class... T>
         void operator()(const T&...) const noexcept {}
     };
+    using NoSplat = NoObserver;
+    struct NoCamera {};
+
+    template <class Sc, class Cam, UniformRng R, LookupCounter C, class Splat, class Observe>
+    RadianceSample<typename Sc::Spectral> trace(const Sc& sc, const Ray& camera_ray, const Cam* cam,
+                                                const typename Sc::Spectral::Wavelengths& lambda, R& rng, C& counter,
+                                                Splat& splat, Observe& observe) const;
     using Kernels = VertexKernels<std::conditional_t<Mis::null_pdfs, strategy::NullScatteringMis, strategy::DirectionalMis>,
                                   H, A>;
 
@@ -347,7 +397,10 @@ int BdptEstimator<Mis, H, A, MaxDepth>::walk(const Sc& sc, VertexT<Sc>* path, in
         v.wo = ray.d;
         v.beta = beta;
         v.nulls_in = nulls;
-        v.pdf_fwd = prev.kind == VertexKind::Camera ? 1.f : to_vertex_measure(pdf_dir, prev.p, v) * nulls * v.event;
+        // From the camera: its own density of the ray converted (light tracing), or 1, which every
+        // strategy with t >= 2 shares.
+        v.pdf_fwd = prev.kind == VertexKind::Camera && !(pdf_dir > 0.f) ? 1.f
+                                                                        : to_vertex_measure(pdf_dir, prev.p, v) * nulls * v.event;
         path[count] = v;
         V& cur = path[count++];
         if (count >= max_vertices) return count;
@@ -378,11 +431,12 @@ int BdptEstimator<Mis, H, A, MaxDepth>::walk(const Sc& sc, VertexT<Sc>* path, in
 }
 
 template <bdpt::MisPolicy Mis, mis::CombiningHeuristic H, AbsorptionPolicy A, int MaxDepth>
-template <class Sc, UniformRng R, LookupCounter C, class Observe>
-RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::radiance_observed(
-    const Sc& sc, const Ray& camera_ray, const typename Sc::Spectral::Wavelengths& lambda, R& rng, C& counter,
-    Observe& observe) const {
+template <class Sc, class Cam, UniformRng R, LookupCounter C, class Splat, class Observe>
+RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::trace(
+    const Sc& sc, const Ray& camera_ray, const Cam* cam, const typename Sc::Spectral::Wavelengths& lambda, R& rng,
+    C& counter, Splat& splat, Observe& observe) const {
     check_scene<Sc>();
+    constexpr bool kLightTracing = !std::is_same_v<Cam, NoCamera>;
     using namespace bdpt;
     using Spectrum = typename Sc::Spectrum;
     using V = VertexT<Sc>;
@@ -390,8 +444,9 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::radian
     Spectrum L = Spectrum::Zero();
     Status status = Status::Ok;
     V camera[MaxDepth + 2];  // z_0 .. z_{depth+1}
-    V light[MaxDepth];       // y_0 .. y_{depth-1}
+    V light[MaxDepth + 1];   // y_0 .. y_{depth-1}, and y_depth for light tracing
     Pdfs pdfs;
+    pdfs.light_tracing = kLightTracing;
     auto add = [&](int s, int t, const Spectrum& f, const Pdfs& p, const Vec3& x0) {
         const float w = strategy_weight(kernels_.heuristic(), p, s);
         observe(s, t, f, w, p, PathVertices<typename Sc::Spectral>{light, s, camera, s == 0 ? t - 1 : t, x0});
@@ -417,7 +472,6 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::radian
             pdfs.from_light[i] = camera[j].pdf_rev;
             pdfs.connectible[i] = !camera[j].delta;
         }
-        pdfs.from_camera[k - 1] = 1.f;
         pdfs.connectible[0] = true;
     };
 
@@ -476,13 +530,15 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::radian
     camera[0].p = camera_ray.o;
     camera[0].beta = Spectrum::Ones();
     camera[0].medium = sc.camera_medium;
-    const int nc = walk(sc, camera, 1, depth + 2, camera_ray, sc.camera_medium, 0.f, Spectrum::Ones(), lambda, rng,
+    float camera_pdf = 0.f;  // the camera's density of the ray's direction (light tracing), else 0
+    if constexpr (kLightTracing) camera_pdf = cam->pdf_dir(camera_ray.d);
+    const int nc = walk(sc, camera, 1, depth + 2, camera_ray, sc.camera_medium, camera_pdf, Spectrum::Ones(), lambda, rng,
                         counter, on_camera_hit, status);
 
     // The light subpath.
     int nl = 0;
     float nee_y0 = 0.f;  // NEE's density of y_0 from y_1
-    if (depth >= 2) {
+    if (depth >= (kLightTracing ? 1 : 2)) {
         const float u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform(), u3 = rng.uniform(), u4 = rng.uniform();
         const EmittedLight<typename Sc::Spectral> e = sc.lights.sample_emission(u0, u1, u2, u3, u4, lambda);
         if (e.emission.pdf_pos > 0.f && e.emission.pdf_dir > 0.f && (e.emission.radiance != 0.f).any()) {
@@ -494,7 +550,7 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::radian
             y0.delta_position = e.emission.delta_position;
             y0.beta = e.emission.radiance / e.emission.pdf_pos;
             y0.pdf_fwd = e.emission.pdf_pos;
-            nl = walk(sc, light, 1, depth, Ray{e.emission.p, e.emission.w}, -2, e.emission.pdf_dir,
+            nl = walk(sc, light, 1, kLightTracing ? depth + 1 : depth, Ray{e.emission.p, e.emission.w}, -2, e.emission.pdf_dir,
                       Spectrum(y0.beta * (e.emission.cos / e.emission.pdf_dir)), lambda, rng, counter,
                       [](auto&&...) {}, status);
             if (nl >= 2) {
@@ -608,6 +664,40 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::radian
                 pdfs.from_camera[s - 2] = to_vertex_measure(eval_at(y, -w, -y.wo).pdf, y.p, y2) * y.nulls_in * y2.event;
             }
             add(s, t, f, pdfs, light[0].p);
+        }
+    }
+    // t = 1: light vertex s-1 seen by the camera, splatted where it appears on the image.
+    if constexpr (kLightTracing) {
+        const Vec3 eye = cam->position();
+        for (int s = 2; s <= nl && s - 1 <= depth; ++s) {
+            const V& y = light[s - 1];
+            if (y.delta) continue;
+            const Vec3 d = eye - y.p;
+            const float d2 = glm::dot(d, d);
+            if (!(d2 > 0.f)) continue;
+            const Vec3 w = d / std::sqrt(d2);  // from y toward the camera
+            float u = 0.f, v = 0.f;
+            const float pc = cam->pdf_dir(-w);
+            if (!(pc > 0.f) || !cam->raster(-w, u, v)) continue;
+            const auto fy = eval_at(y, y.wo, w);
+            if (!(fy.value != 0.f).any()) continue;
+            V eye_vertex;
+            eye_vertex.p = eye;
+            float nulls = 1.f;
+            const Spectrum tr = transmit(y, eye_vertex, nulls);
+            if (!(tr != 0.f).any()) continue;
+            const Spectrum f = y.beta * fy.value * tr * (pc / d2);
+            gather(s, 0, s);
+            pdfs.emit = light[0].pdf_fwd;
+            pdfs.nee = nee_y0;
+            pdfs.from_camera[s - 1] = to_vertex_measure(pc, eye, y) * nulls * y.event;
+            const V& y2 = light[s - 2];
+            pdfs.from_camera[s - 2] = to_vertex_measure(eval_at(y, -w, -y.wo).pdf, y.p, y2) * y.nulls_in * y2.event;
+            const float wt = strategy_weight(kernels_.heuristic(), pdfs, s);
+            observe(s, 1, f, wt, pdfs, PathVertices<typename Sc::Spectral>{light, s, camera, 1, light[0].p});
+            const Spectrum value = f * wt;
+            if (all_finite(value)) splat(u, v, value);
+            else status = Status::NonFinite;
         }
     }
     if (!all_finite(L)) return {Spectrum::Zero(), Status::NonFinite};
