@@ -108,6 +108,32 @@ inline nsp::Ray room_camera_ray(float u, float v, float aspect) {
     return {eye, glm::normalize(f + (2.f * u - 1.f) * tan_half * aspect * r + (2.f * v - 1.f) * tan_half * up)};
 }
 
+/// The main job's cloud scene (default_scene.hpp, set-up A or B) as a SurfaceScene, so that the
+/// bidirectional estimator, which needs a geometry that reports the lights it may hit, renders
+/// it: the cloud behind null interfaces (medium 0), the set-up's sphere light as a sphere shape
+/// naming light 0, no other surface. What PathEstimator renders from it equals the nsp::Scene's
+/// image (the same medium, phase function, light and camera).
+using CloudLights = nsp::LightSampler<nsp::Mono, nsp::SphereLight<nsp::Mono>>;
+using CloudSurfaceScene =
+    nsp::SurfaceScene<nsp_host::Shapes, nsp::DenseGridMedium<nsp::Mono>, nsp::GlobalMajorant<nsp::DenseGridMedium<nsp::Mono>>,
+                      nsp::HenyeyGreensteinPhase, RoomMaterials<nsp::Mono>, CloudLights>;
+inline CloudSurfaceScene make_cloud_surface_scene(LightSetup setup) {
+    auto cloud = make_default_medium<nsp::Mono>();
+    nsp::GlobalMajorant<nsp::DenseGridMedium<nsp::Mono>> majorant(cloud);
+    const nsp::SphereLight<nsp::Mono> light = *default_lights<nsp::Mono>(setup).sphere();
+    nsp_host::Shapes shapes;
+    shapes.boxes.push_back({nsp::Vec3(-1.f), nsp::Vec3(1.f), {-1, -1, 0, -1}});
+    shapes.spheres.push_back({light.center, light.radius, {-1, 0, -1, -1}});
+    return CloudSurfaceScene(std::move(shapes), {{std::move(cloud), majorant, nsp::HenyeyGreensteinPhase(kPhaseG)}},
+                             RoomMaterials<nsp::Mono>({}), CloudLights(nsp::LightSelection::Uniform, 4.f, {light}), -1);
+}
+
+/// The main job's camera (default_scene.hpp's camera_ray) as an nsp::PinholeCamera, square image.
+inline nsp::PinholeCamera cloud_pinhole() {
+    const nsp::Vec3 eye(kEye[0], kEye[1], kEye[2]);
+    return nsp::PinholeCamera(eye, eye + nsp::Vec3(0.f, 0.f, 1.f), nsp::Vec3(0.f, 1.f, 0.f), kFovY, 1.f);
+}
+
 /// The same camera as an nsp::PinholeCamera (light tracing needs where points appear on the image):
 /// its ray(u, v) is room_camera_ray(u, v, 1).
 inline nsp::PinholeCamera room_pinhole() {

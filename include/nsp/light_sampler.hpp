@@ -112,6 +112,9 @@ public:
         return ((EmittingLight<Ls, S> || is_infinite<Ls>() || bool(Ls::is_delta)) && ...);
     }
 
+    /// Whether any light can start a light subpath (an EmittingLight with a positive probability).
+    bool has_emitters() const noexcept { return !emitters_.empty(); }
+
     /// The probability with which sample_emission() starts at light `light` (0 for lights at
     /// infinity, directional lights and indices outside the table).
     float emission_selection_pdf(int light) const noexcept {

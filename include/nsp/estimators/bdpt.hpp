@@ -17,7 +17,10 @@
 //   splatted where it appears on the image (light tracing); radiance() leaves it out, and its
 //   weights leave it out for every path alike, so they still sum to 1.
 // Each is weighted against every other strategy that could have drawn the same path (bdpt::
-// strategy_weight).
+// strategy_weight). An emissive medium is a light source too (THEORY 5.7): the camera subpath
+// collects its emission at every tentative collision (s = 0), NEE also draws a point in the
+// volume (s = 1), and light subpaths start there (one half of them when the scene also has
+// lights), so connections and light tracing carry it as well.
 //
 // Policies: bdpt::NullScattering (the paper's full null-scattering MIS) or bdpt::Directional
 // (the baseline: direction pdfs and geometry only, the tracking factors left out, as pbrt's BDPT
@@ -43,6 +46,7 @@
 #include "../surface_scene.hpp"
 #include "../vertex.hpp"
 #include "common.hpp"
+#include "surface_emission.hpp"
 #include "surface_walk.hpp"
 
 namespace nsp {
@@ -309,8 +313,6 @@ private:
         static_assert(is_surface_scene_v<Sc>, "nsp::BdptEstimator renders a SurfaceScene (NoSurfaces for media alone)");
         static_assert(!is_per_channel_majorant_v<typename Sc::MajorantType, typename Sc::MediumType>,
                       "nsp::BdptEstimator drives every channel with one pdf and needs a grey majorant");
-        static_assert(!EmissiveMedium<typename Sc::MediumType>,
-                      "nsp::BdptEstimator: emissive media are not light vertices yet; use PathEstimator");
         static_assert(std::remove_cvref_t<decltype(std::declval<Sc>().lights)>::bidirectional_ready(),
                       "nsp::BdptEstimator: every light model must start light subpaths (EmittingLight: "
                       "sample_emission, emission_pdf) or lie at infinity / be a delta light");
@@ -319,10 +321,30 @@ private:
     template <class Sc>
     using VertexT = bdpt::Vertex<typename Sc::Spectral>;
 
-    template <class Sc, UniformRng R, LookupCounter C, class OnHit>
+    /// A walk's emission callback that does nothing (light subpaths, media without emission).
+    struct NoEmission {};
+
+    /// Calls the walk's emission callback at every tentative collision of a tracked piece.
+    template <class Sc, class F>
+    struct EmissionVisitor {
+        static constexpr bool enabled = true;
+        F& f;
+        const VertexT<Sc>* path;
+        int count, medium;
+        const Ray& ray;
+        const typename Sc::Spectrum& beta;
+        float nulls, pdf_dir;
+        void operator()(float t, const Coefficients<typename Sc::Spectral>& c, float mu_bar,
+                        const typename Sc::Spectrum& w, float null_pdf_product) const {
+            f(path, count, medium, ray.at(t), c, mu_bar, typename Sc::Spectrum(beta * w),
+              Mis::null_pdfs ? nulls * null_pdf_product : 1.f, pdf_dir);
+        }
+    };
+
+    template <class Sc, UniformRng R, LookupCounter C, class OnHit, class OnEmission = NoEmission>
     int walk(const Sc& sc, VertexT<Sc>* path, int count, int max_vertices, Ray ray, int medium, float pdf_dir,
              typename Sc::Spectrum beta, const typename Sc::Spectral::Wavelengths& lambda, R& rng, C& counter,
-             OnHit on_hit, Status& status) const;
+             OnHit on_hit, Status& status, OnEmission on_emission = {}) const;
 
     Kernels kernels_;
 };
@@ -330,11 +352,11 @@ private:
 // ---------------------------------------------------------------------------------------------
 
 template <bdpt::MisPolicy Mis, mis::CombiningHeuristic H, AbsorptionPolicy A, int MaxDepth>
-template <class Sc, UniformRng R, LookupCounter C, class OnHit>
+template <class Sc, UniformRng R, LookupCounter C, class OnHit, class OnEmission>
 int BdptEstimator<Mis, H, A, MaxDepth>::walk(const Sc& sc, VertexT<Sc>* path, int count, int max_vertices, Ray ray,
                                              int medium, float pdf_dir, typename Sc::Spectrum beta,
                                              const typename Sc::Spectral::Wavelengths& lambda, R& rng, C& counter,
-                                             OnHit on_hit, Status& status) const {
+                                             OnHit on_hit, Status& status, OnEmission on_emission) const {
     using namespace bdpt;
     using V = VertexT<Sc>;
     constexpr int kUnknownMedium = -2;  // a light subpath's start: the medium its first hit says it left
@@ -352,7 +374,16 @@ int BdptEstimator<Mis, H, A, MaxDepth>::walk(const Sc& sc, VertexT<Sc>* path, in
         bool scattered = false;
         if (sc.has_medium(medium)) {
             const auto& m = sc.media[std::size_t(medium)];
-            const auto seg = kernels_.track(m.medium, m.majorant, ray, hit.t, lambda, rng, counter);
+            DeltaTrack<typename Sc::Spectral> seg;
+            if constexpr (!std::is_same_v<OnEmission, NoEmission>) {
+                // The collision estimator of volume emission: every tentative collision, with the
+                // throughput and null product of the nulls before it (THEORY 5.7).
+                seg = kernels_.track_visiting(
+                    m.medium, m.majorant, ray, hit.t, lambda, rng, counter,
+                    EmissionVisitor<Sc, OnEmission>{on_emission, path, count, medium, ray, beta, nulls, pdf_dir});
+            } else {
+                seg = kernels_.track(m.medium, m.majorant, ray, hit.t, lambda, rng, counter);
+            }
             if (const Status fs = flight_status(seg.end); fs != Status::Ok) {
                 status = fs;
                 return count;
@@ -447,6 +478,12 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::trace(
     V light[MaxDepth + 1];   // y_0 .. y_{depth-1}, and y_depth for light tracing
     Pdfs pdfs;
     pdfs.light_tracing = kLightTracing;
+    // Light subpaths start in the emitting volume with probability q_volume, at a light otherwise
+    // (both kinds: one half each); every density of a light subpath's start carries its share.
+    constexpr bool kEmissive = EmissiveMedium<typename Sc::MediumType>;
+    const bool has_volume = kEmissive && sc.select_emission(0.5f) >= 0;
+    const float q_volume = has_volume ? (sc.lights.has_emitters() ? 0.5f : 1.f) : 0.f;
+    const float q_lights = 1.f - q_volume;
     auto add = [&](int s, int t, const Spectrum& f, const Pdfs& p, const Vec3& x0) {
         const float w = strategy_weight(kernels_.heuristic(), p, s);
         observe(s, t, f, w, p, PathVertices<typename Sc::Spectral>{light, s, camera, s == 0 ? t - 1 : t, x0});
@@ -500,7 +537,7 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::trace(
                 const EmissionDensity e = sc.lights.emission_pdf(light_index, hit.p, -w);
                 const float cos0 = std::abs(glm::dot(hit.ng, w));
                 pdfs.from_camera[0] = z.delta ? 1.f * cos0 / d2 * nulls : pdf_dir_z * cos0 / d2 * nulls;
-                pdfs.emit = e.pdf_pos;
+                pdfs.emit = q_lights * e.pdf_pos;
                 pdfs.nee = sc.lights.pdf(light_index, z.p, w) * cos0 / d2;
                 pdfs.from_light[1] = to_vertex_measure(e.pdf_dir, hit.p, z) * nulls * z.event;
             } else {
@@ -525,6 +562,46 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::trace(
         }
     };
 
+    // s = 0 in an emissive medium: the camera subpath's tentative collision at y, after
+    // camera[0..count-1], collects mu_a L_e / mu_bar (the collision estimator); as a path ending
+    // at y its camera-side density is the direction pdf / d^2 x the nulls' P_n x mu_bar(y).
+    auto on_camera_emission = [&](const V* path, int count, int medium, const Vec3& y,
+                                  const Coefficients<typename Sc::Spectral>& c, float mu_bar, const Spectrum& beta,
+                                  float nulls, float pdf_dir) {
+        if constexpr (kEmissive) {
+            const int t = count + 1;
+            if (t - 2 > depth || !(c.sigma_a > 0.f).any() || !(mu_bar > 0.f)) return;
+            const auto& m = sc.media[std::size_t(medium)].medium;
+            const Spectrum le = m.emission(y, lambda);
+            if (!(le > 0.f).any()) return;
+            const Spectrum f = beta * c.sigma_a * le / mu_bar;
+            if (t == 2) {  // seen from the camera: the only strategy
+                pdfs.k = 1;
+                pdfs.from_camera[0] = 1.f;
+                pdfs.nee = pdfs.emit = 0.f;
+                add(0, 2, f, pdfs, y);
+                return;
+            }
+            const V& z = path[count - 1];  // x_1
+            gather(0, t - 1, t - 1);
+            const Vec3 d = y - z.p;
+            const float d2 = glm::dot(d, d);
+            const float p_v = sc.emission_selection_pdf(medium) * m.emission_pdf(y);
+            pdfs.from_camera[0] = pdf_dir / d2 * nulls * mu_bar;
+            pdfs.nee = p_v;
+            pdfs.emit = q_volume * p_v;
+            pdfs.from_light[1] = to_vertex_measure(kInv4Pi, y, z) * nulls * z.event;
+            if (t >= 4) {
+                const V& z2 = camera[t - 3];  // x_2
+                const float pd = z.delta ? 1.f : eval_at(z, -(d / std::sqrt(d2)), -z.wo).pdf;
+                pdfs.from_light[2] = to_vertex_measure(pd, z.p, z2) * z.nulls_in * z2.event;
+            }
+            add(0, t, f, pdfs, y);
+        } else {
+            (void)path, (void)count, (void)medium, (void)y, (void)c, (void)mu_bar, (void)beta, (void)nulls, (void)pdf_dir;
+        }
+    };
+
     // The camera subpath.
     camera[0].kind = VertexKind::Camera;
     camera[0].p = camera_ray.o;
@@ -532,33 +609,77 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::trace(
     camera[0].medium = sc.camera_medium;
     float camera_pdf = 0.f;  // the camera's density of the ray's direction (light tracing), else 0
     if constexpr (kLightTracing) camera_pdf = cam->pdf_dir(camera_ray.d);
-    const int nc = walk(sc, camera, 1, depth + 2, camera_ray, sc.camera_medium, camera_pdf, Spectrum::Ones(), lambda, rng,
-                        counter, on_camera_hit, status);
+    int nc = 0;
+    if constexpr (kEmissive)
+        nc = walk(sc, camera, 1, depth + 2, camera_ray, sc.camera_medium, camera_pdf, Spectrum::Ones(), lambda, rng,
+                  counter, on_camera_hit, status, on_camera_emission);
+    else
+        nc = walk(sc, camera, 1, depth + 2, camera_ray, sc.camera_medium, camera_pdf, Spectrum::Ones(), lambda, rng,
+                  counter, on_camera_hit, status);
 
-    // The light subpath.
+    // The light subpath: from a light, or from the emitting volume.
     int nl = 0;
     float nee_y0 = 0.f;  // NEE's density of y_0 from y_1
+    const int light_vertices = kLightTracing ? depth + 1 : depth;
     if (depth >= (kLightTracing ? 1 : 2)) {
-        const float u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform(), u3 = rng.uniform(), u4 = rng.uniform();
-        const EmittedLight<typename Sc::Spectral> e = sc.lights.sample_emission(u0, u1, u2, u3, u4, lambda);
-        if (e.emission.pdf_pos > 0.f && e.emission.pdf_dir > 0.f && (e.emission.radiance != 0.f).any()) {
-            V& y0 = light[0];
-            y0.kind = VertexKind::Light;
-            y0.p = e.emission.p;
-            y0.ng = y0.ns = e.emission.n;
-            y0.light = e.light;
-            y0.delta_position = e.emission.delta_position;
-            y0.beta = e.emission.radiance / e.emission.pdf_pos;
-            y0.pdf_fwd = e.emission.pdf_pos;
-            nl = walk(sc, light, 1, kLightTracing ? depth + 1 : depth, Ray{e.emission.p, e.emission.w}, -2, e.emission.pdf_dir,
-                      Spectrum(y0.beta * (e.emission.cos / e.emission.pdf_dir)), lambda, rng, counter,
-                      [](auto&&...) {}, status);
-            if (nl >= 2) {
-                const Vec3 d = y0.p - light[1].p;
-                const float d2 = glm::dot(d, d);
-                nee_y0 = y0.delta_position ? sc.lights.selection_pdf(y0.light)
-                                           : sc.lights.pdf(y0.light, light[1].p, d / std::sqrt(d2)) *
-                                                 std::abs(glm::dot(y0.ng, d)) / (d2 * std::sqrt(d2));
+        const float uq = q_volume > 0.f && q_volume < 1.f ? rng.uniform() : 0.f;
+        if (q_volume > 0.f && uq < q_volume) {
+            if constexpr (kEmissive) {
+                const float us = rng.uniform(), u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform(),
+                            u3 = rng.uniform(), u4 = rng.uniform(), u5 = rng.uniform();
+                const int i = sc.select_emission(us);
+                const float select = sc.emission_selection_pdf(i);
+                const auto& m = sc.media[std::size_t(i)];
+                const VolumeSample yv = m.medium.sample_emission(u0, u1, u2, u3);
+                const Vec3 w = uniform_sphere(u4, u5);
+                // The point counts only inside medium i's surfaces: the first boundary ahead of it
+                // must be one it leaves medium i through (as the camera side's NEE walk checks).
+                const SurfaceHit h = sc.geometry.intersect(Ray{yv.p, w}, kInf);
+                const bool inside = detail::usable_hit(sc, h) && h.found() && h.medium_left(w) == i;
+                if (i >= 0 && select > 0.f && yv.pdf > 0.f && inside) {
+                    const auto c = lookup_untracked(m.medium, m.majorant, Ray{yv.p, w}, 0.f, lambda, counter);
+                    if (!c) {
+                        status = Status::Rejected;
+                    } else if ((c->k.sigma_a > 0.f).any() && c->mu > 0.f) {
+                        const Spectrum source = c->k.sigma_a * m.medium.emission(yv.p, lambda);
+                        if ((source > 0.f).any()) {
+                            V& y0 = light[0];
+                            y0.kind = VertexKind::Medium;
+                            y0.p = yv.p;
+                            y0.medium = i;
+                            y0.event = c->mu;  // a tentative collision's density there: mu_bar
+                            y0.pdf_fwd = q_volume * select * yv.pdf;
+                            y0.beta = source / y0.pdf_fwd;
+                            nl = walk(sc, light, 1, light_vertices, Ray{yv.p, w}, i, kInv4Pi,
+                                      Spectrum(y0.beta * (4.f * kPi)), lambda, rng, counter, [](auto&&...) {}, status);
+                            nee_y0 = select * yv.pdf;
+                        }
+                    }
+                }
+            }
+        } else {
+            const float u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform(), u3 = rng.uniform(),
+                        u4 = rng.uniform();
+            const EmittedLight<typename Sc::Spectral> e = sc.lights.sample_emission(u0, u1, u2, u3, u4, lambda);
+            if (e.emission.pdf_pos > 0.f && e.emission.pdf_dir > 0.f && (e.emission.radiance != 0.f).any()) {
+                V& y0 = light[0];
+                y0.kind = VertexKind::Light;
+                y0.p = e.emission.p;
+                y0.ng = y0.ns = e.emission.n;
+                y0.light = e.light;
+                y0.delta_position = e.emission.delta_position;
+                y0.pdf_fwd = q_lights * e.emission.pdf_pos;
+                y0.beta = e.emission.radiance / y0.pdf_fwd;
+                nl = walk(sc, light, 1, light_vertices, Ray{e.emission.p, e.emission.w}, -2, e.emission.pdf_dir,
+                          Spectrum(y0.beta * (e.emission.cos / e.emission.pdf_dir)), lambda, rng, counter,
+                          [](auto&&...) {}, status);
+                if (nl >= 2) {
+                    const Vec3 d = y0.p - light[1].p;
+                    const float d2 = glm::dot(d, d);
+                    nee_y0 = y0.delta_position ? sc.lights.selection_pdf(y0.light)
+                                               : sc.lights.pdf(y0.light, light[1].p, d / std::sqrt(d2)) *
+                                                     std::abs(glm::dot(y0.ng, d)) / (d2 * std::sqrt(d2));
+                }
             }
         }
     }
@@ -607,7 +728,7 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::trace(
                         if (ls.sample.delta) {  // a point or directional light: NEE alone reaches it
                             pdfs.from_camera[0] = 0.f;
                             pdfs.nee = ls.sample.pdf;
-                            pdfs.emit = at_infinity ? 0.f : sc.lights.emission_pdf(ls.light, y0.p, -w).pdf_pos;
+                            pdfs.emit = at_infinity ? 0.f : q_lights * sc.lights.emission_pdf(ls.light, y0.p, -w).pdf_pos;
                             pdfs.from_light[1] = at_infinity ? 0.f
                                                              : to_vertex_measure(sc.lights.emission_pdf(ls.light, y0.p, -w).pdf_dir,
                                                                                  y0.p, z) * nulls * z.event;
@@ -620,7 +741,7 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::trace(
                             const EmissionDensity e = sc.lights.emission_pdf(ls.light, y0.p, -w);
                             pdfs.from_camera[0] = fz.pdf * e.cos / d2 * nulls;
                             pdfs.nee = ls.sample.pdf * e.cos / d2;
-                            pdfs.emit = e.pdf_pos;
+                            pdfs.emit = q_lights * e.pdf_pos;
                             pdfs.from_light[1] = to_vertex_measure(e.pdf_dir, y0.p, z) * nulls * z.event;
                         }
                         if (t >= 3) {
@@ -629,6 +750,44 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::trace(
                                                  z.nulls_in * z2.event;
                         }
                         add(1, t, f, pdfs, y0.p);
+                    }
+                }
+            }
+        }
+        // s = 1 toward the emitting volume: a point drawn by the power grids, the shadow walk
+        // through every medium up to it (THEORY 5.7).
+        if constexpr (kEmissive) {
+            if (has_volume) {
+                if (const auto e = detail::draw_emission_point(sc, z.p, rng)) {
+                    const auto& m = sc.media[std::size_t(e->index)];
+                    const auto fz = eval_at(z, z.wo, e->wi);
+                    if ((fz.value != 0.f).any()) {
+                        const auto sh = detail::emission_shadow(kernels_, sc, Ray{z.p, e->wi}, e->dist,
+                                                                z.medium_toward(e->wi), e->index, false, lambda, rng,
+                                                                counter);
+                        if (sh.status != Status::Ok) status = sh.status;
+                        if (sh.status == Status::Ok && sh.reached && (sh.transmittance != 0.f).any()) {
+                            const auto c = lookup_untracked(m.medium, m.majorant, sh.last, sh.t_last, lambda, counter);
+                            if (!c) {
+                                status = Status::Rejected;
+                            } else if ((c->k.sigma_a > 0.f).any() && c->mu > 0.f) {
+                                const float p_v = e->select * e->y.pdf;
+                                const Spectrum f = z.beta * fz.value * sh.transmittance * c->k.sigma_a *
+                                                   m.medium.emission(e->y.p, lambda) / (e->dist2 * p_v);
+                                const float nulls = Mis::null_pdfs ? sh.nulls_before * sh.nulls_own : 1.f;
+                                gather(0, t, t);  // camera[0..t-1]; the emission point is x_0
+                                pdfs.from_camera[0] = fz.pdf / e->dist2 * nulls * c->mu;
+                                pdfs.nee = p_v;
+                                pdfs.emit = q_volume * p_v;
+                                pdfs.from_light[1] = to_vertex_measure(kInv4Pi, e->y.p, z) * nulls * z.event;
+                                if (t >= 3) {
+                                    const V& z2 = camera[t - 2];
+                                    pdfs.from_light[2] = to_vertex_measure(eval_at(z, -e->wi, -z.wo).pdf, z.p, z2) *
+                                                         z.nulls_in * z2.event;
+                                }
+                                add(1, t, f, pdfs, e->y.p);
+                            }
+                        }
                     }
                 }
             }
