@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <string>
 #include <utility>
@@ -143,6 +144,31 @@ TEST_CASE("bdpt: the strategy weights of a path are the heuristics of its strate
             CHECK(sum_p == doctest::Approx(1.f).epsilon(1e-5));
         }
     }
+}
+
+TEST_CASE("bdpt: an overflowed (infinite) density takes the weight; NaN gives NaN") {
+    // Path x_0..x_3 (k = 3), strategies s = 0, 1, 2: from_light[1] = inf, so the strategy that
+    // draws x_1 from the light side (s = 2) takes the whole weight; both sides of x_1 infinite: a
+    // tie among all; a NaN density: NaN, which the estimator reports as Status::NonFinite.
+    const mis::Balance h;
+    Pdfs p;
+    p.k = 3;
+    for (int i = 0; i < 3; ++i) {
+        p.from_light[i] = 1.f;
+        p.from_camera[i] = 1.f;
+        p.connectible[i] = true;
+    }
+    p.nee = p.emit = 1.f;
+    p.from_light[1] = kInf;
+    CHECK(bdpt::strategy_weight(h, p, 2) == 1.f);
+    CHECK(bdpt::strategy_weight(h, p, 0) == 0.f);
+    CHECK(bdpt::strategy_weight(h, p, 1) == 0.f);
+    p.from_camera[1] = kInf;  // both infinite: a tie between the two sides of x_1
+    const float w0 = bdpt::strategy_weight(h, p, 0), w1 = bdpt::strategy_weight(h, p, 1), w2 = bdpt::strategy_weight(h, p, 2);
+    CHECK(w0 + w1 + w2 == doctest::Approx(1.f));
+    CHECK(w2 > 0.f);
+    p.from_camera[1] = std::numeric_limits<float>::quiet_NaN();
+    CHECK(std::isnan(bdpt::strategy_weight(h, p, 0)));
 }
 
 /// The six walls of [-1, 1]^3 as quad lights emitting `le` inward, and as shapes naming them

@@ -177,6 +177,29 @@ void check_heuristic(Input& in, const H& h) {
     const float en = emission_weight(h, EmissionTechnique::Nee, ep);
     for (const float x : {ec, es, en}) NSP_FUZZ_CHECK(x >= 0.f && x <= 1.f);
     if (ep.collision > 0.f || ep.segment > 0.f || ep.nee > 0.f) NSP_FUZZ_CHECK(std::abs(ec + es + en - 1.f) <= kWeightTol);
+
+    // BDPT (THEORY 5.5): the (s, t) strategies of one path, densities in [0, inf] per vertex, delta
+    // vertices, with and without light tracing: every weight in [0, 1], and they sum to 1 where any
+    // strategy can draw the path (strategy_pdfs true), to 0 where none can.
+    bdpt::PathPdfs<12> p;
+    p.k = 1 + int(in.pick(11));
+    p.light_tracing = in.pick(2) == 1;
+    for (int i = 0; i < p.k; ++i) {
+        p.from_light[i] = ratio(in);
+        p.from_camera[i] = ratio(in);
+        p.connectible[i] = in.pick(4) != 0;
+    }
+    p.nee = ratio(in);
+    p.emit = ratio(in);
+    double q[12];
+    const bool drawable = bdpt::strategy_pdfs(p, q);
+    float sum = 0.f;
+    for (int s = 0; s < bdpt::strategy_count(p); ++s) {
+        const float w = bdpt::strategy_weight(h, p, s);
+        NSP_FUZZ_CHECK(w >= 0.f && w <= 1.f);
+        sum += w;
+    }
+    NSP_FUZZ_CHECK(drawable ? std::abs(sum - 1.f) <= kWeightTol : sum == 0.f);
 }
 
 void check_mis(Input& in) {

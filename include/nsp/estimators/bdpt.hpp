@@ -35,6 +35,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <type_traits>
 
 #include "../core/counter.hpp"
@@ -101,35 +102,56 @@ int strategy_count(const PathPdfs<N>& p) noexcept {
 }
 
 /// Strategy s's pdf of the path relative to the largest of all strategies' (each in [0, 1]; 0
-/// where s cannot draw it), written into q[0..k-1] (q[0..k] with light tracing). Each vertex's two densities are scaled by
-/// their larger one and the products taken in double, so long paths neither overflow nor
-/// underflow. Returns false when no strategy can draw the path.
+/// where s cannot draw it), written into q[0..k-1] (q[0..k] with light tracing). Each vertex's
+/// two densities are scaled by their larger one (an infinite one, an overflowed density, wins)
+/// and the products taken in double, so long paths neither overflow nor underflow. Returns false
+/// when no strategy can draw the path. NaN densities give NaN.
 template <int N>
 bool strategy_pdfs(const PathPdfs<N>& p, double* q) noexcept {
     const int k = p.k;
     if (k < 1 || k >= N) return false;
+    // Scales numbers >= 0 by their largest: an infinite one (a density that overflowed) becomes
+    // 1 and takes the place of every finite one, which become 0; all 0 stays 0.
+    // A NaN makes them all NaN.
+    auto scale = [](double* v, int n) {
+        bool inf = false, nan = false;
+        double m = 0.0;
+        for (int i = 0; i < n; ++i) {
+            inf = inf || std::isinf(v[i]);
+            nan = nan || std::isnan(v[i]);
+            m = std::max(m, v[i]);
+        }
+        for (int i = 0; i < n; ++i)
+            v[i] = nan ? v[i] * 0.0 + std::numeric_limits<double>::quiet_NaN()
+                       : inf ? (std::isinf(v[i]) ? 1.0 : 0.0) : (m > 0.0 ? v[i] / m : 0.0);
+    };
     double l[N], c[N];
     for (int i = 1; i < k; ++i) {
-        const double a = double(p.from_light[i]), b = double(p.from_camera[i]), m = std::max(a, b);
-        l[i] = m > 0.0 ? a / m : 0.0;
-        c[i] = m > 0.0 ? b / m : 0.0;
+        double v[2] = {double(p.from_light[i]), double(p.from_camera[i])};
+        scale(v, 2);
+        l[i] = v[0];
+        c[i] = v[1];
     }
     // suffix[j] = prod_{i=j}^{k-1} c_i
     double suffix[N + 1];
     suffix[k] = 1.0;
     for (int i = k - 1; i >= 1; --i) suffix[i] = suffix[i + 1] * c[i];
-    const double m0 = std::max({double(p.from_camera[0]), double(p.nee), double(p.emit)});
-    if (!(m0 > 0.0)) return false;
+    double x0[3] = {double(p.from_camera[0]), double(p.nee), double(p.emit)};  // x_0 under s = 0, 1, >= 2
+    scale(x0, 3);
     const int last = strategy_count(p);
     double prefix = 1.0, largest = 0.0;  // prefix = prod_{i=1}^{s-1} l_i
     for (int s = 0; s < last; ++s) {
         if (s >= 2) prefix *= l[s - 1];
         double v = 0.0;
-        if (s == 0) v = double(p.from_camera[0]) / m0 * suffix[1];
-        else if (s == 1) v = p.connectible[1] ? double(p.nee) / m0 * suffix[1] : 0.0;
-        else if (s == k) v = p.connectible[k - 1] ? double(p.emit) / m0 * prefix : 0.0;  // t = 1
-        else if (p.connectible[s - 1] && p.connectible[s]) v = double(p.emit) / m0 * prefix * suffix[s];
+        if (s == 0) v = x0[0] * suffix[1];
+        else if (s == 1) v = p.connectible[1] ? x0[1] * suffix[1] : 0.0;
+        else if (s == k) v = p.connectible[k - 1] ? x0[2] * prefix : 0.0;  // t = 1
+        else if (p.connectible[s - 1] && p.connectible[s]) v = x0[2] * prefix * suffix[s];
         q[s] = v;
+        if (std::isnan(v)) {  // a NaN density: every strategy's pdf is NaN
+            for (int r = 0; r < last; ++r) q[r] = v;
+            return true;
+        }
         largest = std::max(largest, v);
     }
     if (!(largest > 0.0)) return false;
