@@ -284,8 +284,9 @@ int main(int argc, char** argv) {
         const Row picture = render(grey, PathEstimator<strategy::NullScatteringMis, mis::Balance>{}, "picture",
                                    picture_res, 128, threads, 99);
         nsp_examples::write_png(out + "/room.png", picture.image, nsp_examples::exposure_for({&picture.image}));
-        std::fprintf(stderr, "  room: %s/room_sheet.png, %s/room_rgb_sheet.png, %s/room_plume_sheet.png, %s/room.png (%.1f s)\n",
-                     out.c_str(), out.c_str(), out.c_str(), out.c_str(), picture.seconds);
+        std::fprintf(stderr, "  room: %s/room_sheet.png, %s/room_rgb_sheet.png, %s/room_plume_sheet.png, %s/lantern_sheet.png, "
+                     "%s/room.png (%.1f s)\n",
+                     out.c_str(), out.c_str(), out.c_str(), out.c_str(), out.c_str(), picture.seconds);
         }
     }
     return failed == 0 ? 0 : 1;
