@@ -247,6 +247,8 @@ int main(int argc, char** argv) {
             cloud_render(PathEstimator<strategy::NullScatteringMis, mis::Balance>{}, "uni-nee-mis_balance");
             cloud_render(BdptEstimator<bdpt::Directional, mis::Balance>{}, "bdpt_directional-mis_balance");
             cloud_render(BdptEstimator<bdpt::NullScattering, mis::Balance>{}, "bdpt_null-mis_balance");
+            cloud_render(BdptEstimator<bdpt::NullScattering, mis::Balance>(BdptEstimator<>::default_options(), {}, 0.25f),
+                         "bdpt_null-mis_balance_light-0.25");  // a light subpath on 1/4 of the samples
             std::vector<Row> setup_rows(rows.begin() + std::ptrdiff_t(first_setup), rows.end());
             const bool a = setup == nsp_examples::LightSetup::A;
             failed += print_table(a ? "Cloud, set-up A (mono" : "Cloud, set-up B (mono", setup_rows, 2, run_res, run_spp,

@@ -632,6 +632,49 @@ TEST_CASE("bdpt: agrees with PathEstimator on an emitting cube over a floor unde
     });
 }
 
+TEST_CASE("bdpt: light subpaths on a fraction of the samples (an expected count < 1) stay unbiased") {
+    // THEORY 5.9: with light_subpath_probability c the connections and light tracing run on a
+    // fraction c of the samples and weigh with c times their densities. The emitting furnace
+    // (L = 2, with and without light tracing) at c = 0.3, and the cube's pdf symmetry and each
+    // strategy alone at c = 0.4 (the densities now include c), 5 SE.
+    Shapes shapes;
+    std::vector<QuadLight<S>> walls;
+    box_walls(1.f, {}, shapes, walls);
+    const ESc sc(shapes, {emitting(Box{Vec3(-1.f), Vec3(1.f)}, 0.6f, 1.f, 2.f)}, materials(),
+                 Ls(LightSelection::Uniform, 2.f, walls, {}), 0);
+    const PinholeCamera camera(Vec3(0.1f, -0.2f, 0.3f), Vec3(0.5f, 0.f, -1.f), Vec3(0.f, 1.f, 0.f), 70.f, 1.3f);
+    const BdptEstimator<bdpt::NullScattering, mis::Balance> est(BdptEstimator<>::default_options(), {}, 0.3f);
+    CHECK(est.light_subpath_probability() == 0.3f);
+    const Stat a = estimate(est, sc, 6000, 43, [](Pcg32& rng) {
+        return Ray{Vec3(0.1f, -0.2f, 0.3f), uniform_sphere(rng.uniform(), rng.uniform())};
+    });
+    CAPTURE(a.mean);
+    CHECK(std::abs(a.mean - 2.0) <= kSigmas * a.se());
+    const Stat b = image_average(est, sc, camera, 6000, 44);
+    CAPTURE(b.mean);
+    CHECK(std::abs(b.mean - 2.0) <= kSigmas * b.se());
+
+    EstimatorOptions opts;
+    opts.russian_roulette = false;
+    opts.max_depth = 3;
+    StrategyRecord rec =
+        record_strategies(BdptEstimator<bdpt::NullScattering, mis::Balance>(opts, {}, 0.4f), cube_over_floor(false), 200000, 3);
+    for (int n = 1; n <= 3; ++n) {
+        const Stat& nee = rec.alone[{1, n + 1}];
+        for (int s = 0; s <= n + 1; ++s) {
+            const Stat& x = rec.alone[{s, n + 2 - s}];
+            CAPTURE(n);
+            CAPTURE(s);
+            CHECK(std::abs(x.mean - nee.mean) <= kSigmas * std::sqrt(x.se() * x.se() + nee.se() * nee.se()));
+        }
+    }
+    CHECK(worst_share_asymmetry(rec, 3) <= kSigmas);
+    CHECK_THROWS_WITH_AS((BdptEstimator<>(BdptEstimator<>::default_options(), {}, 0.f)),
+                         doctest::Contains("light_subpath_probability = 0 is not allowed"), InvalidArgument);
+    CHECK_THROWS_WITH_AS((BdptEstimator<>(BdptEstimator<>::default_options(), {}, 1.5f)),
+                         doctest::Contains("light_subpath_probability = 1.5 is not allowed"), InvalidArgument);
+}
+
 TEST_CASE("bdpt: rejects a max_depth beyond its vertex arrays") {
     EstimatorOptions opts;
     opts.max_depth = 40;

@@ -257,8 +257,20 @@ public:
 
     /// Throws InvalidArgument on invalid roulette settings (see EstimatorOptions) or a max_depth
     /// above MaxDepth (the vertex arrays' size).
-    explicit BdptEstimator(EstimatorOptions opts = default_options(), H heuristic = H{})
-        : kernels_(checked(opts), heuristic) {}
+    /// `light_subpath_probability` in (0, 1]: the expected number of light subpaths per sample
+    /// (THEORY 5.9). Each sample traces one with that probability; every strategy that uses it
+    /// (connections, light tracing) then has that probability times its density in every weight
+    /// and divides by it, so the estimate stays unbiased for any value. 1 (the default): always.
+    /// Throws InvalidArgument on a value outside (0, 1].
+    explicit BdptEstimator(EstimatorOptions opts = default_options(), H heuristic = H{},
+                           float light_subpath_probability = 1.f)
+        : kernels_(checked(opts), heuristic), light_probability_(light_subpath_probability) {
+        if (!(light_probability_ > 0.f && light_probability_ <= 1.f))
+            detail::fail("BdptEstimator light_subpath_probability = ", light_probability_,
+                         " is not allowed: it must lie in (0, 1]");
+    }
+
+    float light_subpath_probability() const noexcept { return light_probability_; }
 
     const EstimatorOptions& options() const noexcept { return kernels_.options(); }
 
@@ -369,6 +381,7 @@ private:
              OnHit on_hit, Status& status, OnEmission on_emission = {}) const;
 
     Kernels kernels_;
+    float light_probability_ = 1.f;
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -500,12 +513,16 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::trace(
     V light[MaxDepth + 1];   // y_0 .. y_{depth-1}, and y_depth for light tracing
     Pdfs pdfs;
     pdfs.light_tracing = kLightTracing;
-    // Light subpaths start in the emitting volume with probability q_volume, at a light otherwise
-    // (both kinds: one half each); every density of a light subpath's start carries its share.
+    // A light subpath is traced with probability light_probability_; it starts in the emitting
+    // volume with probability q_volume_share, at a light otherwise (both kinds: one half each);
+    // every density of a light subpath's start carries both.
     constexpr bool kEmissive = EmissiveMedium<typename Sc::MediumType>;
     const bool has_volume = kEmissive && sc.select_emission(0.5f) >= 0;
-    const float q_volume = has_volume ? (sc.lights.has_emitters() ? 0.5f : 1.f) : 0.f;
-    const float q_lights = 1.f - q_volume;
+    // Both carry the light subpath's expected count (THEORY 5.9): a start density times it is the
+    // density of a light subpath starting there per sample.
+    const float q_volume_share = has_volume ? (sc.lights.has_emitters() ? 0.5f : 1.f) : 0.f;
+    const float q_volume = light_probability_ * q_volume_share;
+    const float q_lights = light_probability_ * (1.f - q_volume_share);
     auto add = [&](int s, int t, const Spectrum& f, const Pdfs& p, const Vec3& x0) {
         const float w = strategy_weight(kernels_.heuristic(), p, s);
         observe(s, t, f, w, p, PathVertices<typename Sc::Spectral>{light, s, camera, s == 0 ? t - 1 : t, x0});
@@ -643,9 +660,10 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::trace(
     int nl = 0;
     float nee_y0 = 0.f;  // NEE's density of y_0 from y_1
     const int light_vertices = kLightTracing ? depth + 1 : depth;
-    if (depth >= (kLightTracing ? 1 : 2)) {
-        const float uq = q_volume > 0.f && q_volume < 1.f ? rng.uniform() : 0.f;
-        if (q_volume > 0.f && uq < q_volume) {
+    const bool traced = light_probability_ >= 1.f || rng.uniform() < light_probability_;
+    if (traced && depth >= (kLightTracing ? 1 : 2)) {
+        const float uq = q_volume_share > 0.f && q_volume_share < 1.f ? rng.uniform() : 0.f;
+        if (q_volume_share > 0.f && uq < q_volume_share) {
             if constexpr (kEmissive) {
                 const float us = rng.uniform(), u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform(),
                             u3 = rng.uniform(), u4 = rng.uniform(), u5 = rng.uniform();
