@@ -373,6 +373,25 @@ double worst_share_asymmetry(StrategyRecord& rec, int longest) {
     return worst;
 }
 
+/// The two checks on a record of paths of 1..3 interior vertices (see the test below): every
+/// (s, t) alone against NEE's estimate of the same path length, and the pdf symmetry over every
+/// pair of strategies, both within 5 combined SE.
+void check_strategies_alone_and_symmetric(StrategyRecord& rec) {
+    for (int n = 1; n <= 3; ++n) {
+        const Stat& nee = rec.alone[{1, n + 1}];
+        for (int s = 0; s <= n + 1; ++s) {
+            const Stat& a = rec.alone[{s, n + 2 - s}];
+            CAPTURE(n);
+            CAPTURE(s);
+            CAPTURE(a.mean);
+            CAPTURE(nee.mean);
+            CHECK(a.mean > 0.0);
+            CHECK(std::abs(a.mean - nee.mean) <= kSigmas * std::sqrt(a.se() * a.se() + nee.se() * nee.se()));
+        }
+    }
+    CHECK(worst_share_asymmetry(rec, 3) <= kSigmas);
+}
+
 TEST_CASE("bdpt: each strategy alone is unbiased, and the strategies' pdfs are the true densities") {
     // The cube over the floor under the lamp alone (no sky, no roulette, no delta vertices), paths
     // of n = 1, 2, 3 interior vertices, the image's average over uniform (u, v), light tracing on:
@@ -391,19 +410,7 @@ TEST_CASE("bdpt: each strategy alone is unbiased, and the strategies' pdfs are t
     opts.russian_roulette = false;
     opts.max_depth = 3;
     StrategyRecord rec = record_strategies(BdptEstimator<bdpt::NullScattering, mis::Balance>(opts), sc, 200000, 3);
-    for (int n = 1; n <= 3; ++n) {
-        const Stat& nee = rec.alone[{1, n + 1}];
-        for (int s = 0; s <= n + 1; ++s) {
-            const Stat& a = rec.alone[{s, n + 2 - s}];
-            CAPTURE(n);
-            CAPTURE(s);
-            CAPTURE(a.mean);
-            CAPTURE(nee.mean);
-            CHECK(a.mean > 0.0);
-            CHECK(std::abs(a.mean - nee.mean) <= kSigmas * std::sqrt(a.se() * a.se() + nee.se() * nee.se()));
-        }
-    }
-    CHECK(worst_share_asymmetry(rec, 3) <= kSigmas);
+    check_strategies_alone_and_symmetric(rec);
 }
 
 TEST_CASE("bdpt: the pdf symmetry test sees directional MIS's pdfs are not densities") {
@@ -597,20 +604,7 @@ TEST_CASE("bdpt: an emitting cube: each strategy alone unbiased, the pdfs true d
     opts.russian_roulette = false;
     opts.max_depth = 3;
     StrategyRecord rec = record_strategies(BdptEstimator<bdpt::NullScattering, mis::Balance>(opts), sc, 200000, 3);
-    for (int n = 1; n <= 3; ++n) {
-        const Stat& nee = rec.alone[{1, n + 1}];
-        for (int s = 0; s <= n + 1; ++s) {
-            const Stat& a = rec.alone[{s, n + 2 - s}];
-            CAPTURE(n);
-            CAPTURE(s);
-            CAPTURE(a.mean);
-            CAPTURE(nee.mean);
-            if (getenv("BDPT_DEBUG")) printf("emissive n=%d s=%d alone %.5f +- %.5f (nee %.5f)\n", n, s, a.mean, a.se(), nee.mean);
-            CHECK(a.mean > 0.0);
-            CHECK(std::abs(a.mean - nee.mean) <= kSigmas * std::sqrt(a.se() * a.se() + nee.se() * nee.se()));
-        }
-    }
-    CHECK(worst_share_asymmetry(rec, 3) <= kSigmas);
+    check_strategies_alone_and_symmetric(rec);
 }
 
 TEST_CASE("bdpt: agrees with PathEstimator on an emitting cube over a floor under a lamp") {
@@ -659,16 +653,7 @@ TEST_CASE("bdpt: light subpaths on a fraction of the samples (an expected count 
     opts.max_depth = 3;
     StrategyRecord rec =
         record_strategies(BdptEstimator<bdpt::NullScattering, mis::Balance>(opts, {}, 0.4f), cube_over_floor(false), 200000, 3);
-    for (int n = 1; n <= 3; ++n) {
-        const Stat& nee = rec.alone[{1, n + 1}];
-        for (int s = 0; s <= n + 1; ++s) {
-            const Stat& x = rec.alone[{s, n + 2 - s}];
-            CAPTURE(n);
-            CAPTURE(s);
-            CHECK(std::abs(x.mean - nee.mean) <= kSigmas * std::sqrt(x.se() * x.se() + nee.se() * nee.se()));
-        }
-    }
-    CHECK(worst_share_asymmetry(rec, 3) <= kSigmas);
+    check_strategies_alone_and_symmetric(rec);
     CHECK_THROWS_WITH_AS((BdptEstimator<>(BdptEstimator<>::default_options(), {}, 0.f)),
                          doctest::Contains("light_subpath_probability = 0 is not allowed"), InvalidArgument);
     CHECK_THROWS_WITH_AS((BdptEstimator<>(BdptEstimator<>::default_options(), {}, 1.5f)),
