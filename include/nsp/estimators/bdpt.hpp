@@ -229,6 +229,24 @@ float to_vertex_measure(float pdf_dir, const Vec3& from, const Vertex<S>& to) no
     }
 }
 
+/// The medium a light subpath starting at p along w is in (-3 where the host's hits cannot be
+/// used): the side of the first surface ahead that the ray leaves, else of the first surface
+/// behind it that faces p, else, where no surface lies on the whole line, the scene's unbounded
+/// region: the camera's medium when the geometry has no surfaces at all (nsp::NoSurfaces: media
+/// in empty space fill it), vacuum otherwise. The camera side's walks see the same media, so both
+/// sides of every connection agree.
+template <class Sc>
+int light_start_medium(const Sc& sc, const Vec3& p, const Vec3& w) noexcept {
+    const SurfaceHit ahead = sc.geometry.intersect(Ray{p, w}, kInf);
+    if (!detail::usable_hit(sc, ahead)) return -3;
+    if (ahead.found()) return ahead.medium_left(w);
+    const SurfaceHit behind = sc.geometry.intersect(Ray{p, -w}, kInf);
+    if (!detail::usable_hit(sc, behind)) return -3;
+    if (behind.found()) return behind.medium_left(-w);
+    if constexpr (std::is_same_v<typename Sc::GeometryType, NoSurfaces>) return sc.camera_medium;
+    else return -1;
+}
+
 }  // namespace bdpt
 
 /// Volumetric BDPT (see the header comment): MIS policy Mis, heuristic H, absorption policy A of
@@ -394,7 +412,6 @@ int BdptEstimator<Mis, H, A, MaxDepth>::walk(const Sc& sc, VertexT<Sc>* path, in
                                              OnHit on_hit, Status& status, OnEmission on_emission) const {
     using namespace bdpt;
     using V = VertexT<Sc>;
-    constexpr int kUnknownMedium = -2;  // a light subpath's start: the medium its first hit says it left
     const float beta_scale = float(beta.abs().maxCoeff());
     float nulls = 1.f;
     int crossings = 0;
@@ -404,7 +421,6 @@ int BdptEstimator<Mis, H, A, MaxDepth>::walk(const Sc& sc, VertexT<Sc>* path, in
             status = Status::InvalidInput;
             return count;
         }
-        if (medium == kUnknownMedium) medium = hit.found() ? hit.medium_left(ray.d) : -1;
         V v;
         bool scattered = false;
         if (sc.has_medium(medium)) {
@@ -674,8 +690,9 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::trace(
                 const Vec3 w = uniform_sphere(u4, u5);
                 // The point counts only inside medium i's surfaces: the first boundary ahead of it
                 // must be one it leaves medium i through (as the camera side's NEE walk checks).
-                const SurfaceHit h = sc.geometry.intersect(Ray{yv.p, w}, kInf);
-                const bool inside = detail::usable_hit(sc, h) && h.found() && h.medium_left(w) == i;
+                const int start = light_start_medium(sc, yv.p, w);
+                if (start == -3) status = Status::InvalidInput;
+                const bool inside = start == i;
                 if (i >= 0 && select > 0.f && yv.pdf > 0.f && inside) {
                     const auto c = lookup_untracked(m.medium, m.majorant, Ray{yv.p, w}, 0.f, lambda, counter);
                     if (!c) {
@@ -710,9 +727,12 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::trace(
                 y0.delta_position = e.emission.delta_position;
                 y0.pdf_fwd = q_lights * e.emission.pdf_pos;
                 y0.beta = e.emission.radiance / y0.pdf_fwd;
-                nl = walk(sc, light, 1, light_vertices, Ray{e.emission.p, e.emission.w}, -2, e.emission.pdf_dir,
-                          Spectrum(y0.beta * (e.emission.cos / e.emission.pdf_dir)), lambda, rng, counter,
-                          [](auto&&...) {}, status);
+                const int start = light_start_medium(sc, e.emission.p, e.emission.w);
+                if (start == -3) status = Status::InvalidInput;
+                else
+                    nl = walk(sc, light, 1, light_vertices, Ray{e.emission.p, e.emission.w}, start, e.emission.pdf_dir,
+                              Spectrum(y0.beta * (e.emission.cos / e.emission.pdf_dir)), lambda, rng, counter,
+                              [](auto&&...) {}, status);
                 if (nl >= 2) {
                     const Vec3 d = y0.p - light[1].p;
                     const float d2 = glm::dot(d, d);
