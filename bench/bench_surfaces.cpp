@@ -8,7 +8,7 @@
 //   light): the same estimator, so the ratio of the two times is the price of the surface walk
 //   (its geometry queries and handle checks, the light sampler) for a host that uses it anyway.
 // - BM_Lantern/<estimator>: one radiance sample of the lantern (room_scene.hpp: the lamp boxed
-//   above the cloud, issue 18's scene), the path tracers against BdptEstimator; for BDPT the
+//   above the cloud, the BDPT scene), the path tracers against BdptEstimator; for BDPT the
 //   strategy families' counts per sample (hits s = 0, NEE s = 1, connections s >= 2, each one
 //   evaluated path; splats t = 1 with light tracing) and the stack its subpaths take (bytes,
 //   MaxDepth = 32).

@@ -6,7 +6,7 @@
 // (Rgb, half the size and spp) with the grey-majorant PathEstimator against
 // nsp::SpectralPathEstimator's per-channel pdfs, then the glowing plume (the cloud's smoke with a
 // flame in it, an emissive medium; Mono, half the size and spp) with emission and lights in one MIS,
-// then the lantern (the lamp boxed above the cloud, opening into it: issue 18's scene; half the
+// then the lantern (the lamp boxed above the cloud, opening into it: the BDPT scene; half the
 // size and spp) with the path tracers against BdptEstimator's directional and null-scattering MIS.
 // On request (--tables cloud) the main job's cloud in empty space, set-ups A and B, as a
 // SurfaceScene (its sphere light a shape the geometry reports), path tracers against BDPT.
@@ -199,7 +199,7 @@ int main(int argc, char** argv) {
                     cost(plume_rows, 4) / std::min({cost(plume_rows, 0), cost(plume_rows, 1), cost(plume_rows, 2),
                                                     cost(plume_rows, 3)}));
     }
-    // Table 4: the lantern (issue 18's scene): the lamp shut in a box that opens into the cloud,
+    // Table 4: the lantern (the BDPT scene): the lamp shut in a box that opens into the cloud,
     // the path tracers against bidirectional path tracing with directional and with full
     // null-scattering MIS; a quarter of the pixels (BDPT costs several paths a sample).
     const std::size_t first_lantern = rows.size();

@@ -67,9 +67,10 @@ inline RoomScene<> make_room_scene() {
 }
 
 /// The lantern: the room's floor and walls around the cloud, no sky, lit only by a lamp inside a
-/// closed box above the cloud whose one opening, its floor, faces down into the smoke (issue
-/// 18's scene, after the paper's BDPT scene): light reaches what the camera sees only by
-/// scattering in the cloud (or straight through its thin parts), the camera cannot see the lamp,
+/// closed box above the cloud whose one opening, its floor, faces down into the smoke (after
+/// the paper's BDPT scene): light reaches what the camera sees only by
+/// scattering in the cloud (or straight through its thin parts), the camera cannot see the lamp
+/// (only a sliver of the box's lit inner wall),
 /// and NEE toward the lamp from the floor and the walls is always blocked: only the points in the
 /// beam below the opening see the lamp. The box, 0.3 x 0.8 x 0.3 over (0, 1.55, 0) with dark
 /// Lambertian walls (albedo 0.2, material 2), holds the lamp 0.26 x 0.26 at its ceiling facing
