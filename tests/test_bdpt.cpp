@@ -17,32 +17,15 @@
 #include <vector>
 
 #include "common.hpp"
-#include "host/shapes.hpp"
-#include "surfaces.hpp"
+#include "grey_surface_scenes.hpp"
 
 namespace {
 
 using namespace nsp_test;
-using S = Mono;
-using Spectrum = S::Spectrum;
-using nsp_host::Shapes;
-using M = HomogeneousMedium<S>;
-using Mats = Materials<S, LambertianBsdf<S>, MirrorBsdf<S>>;
-using Ls = LightSampler<S, QuadLight<S>, EnvironmentLight<S>>;
-using Sc = SurfaceScene<Shapes, M, GlobalMajorant<M>, HenyeyGreensteinPhase, Mats, Ls>;
+using namespace nsp_test::grey_scenes;
 
 // k = 5 standard errors, estimated from the samples, with fixed seeds: deterministic.
 constexpr double kSigmas = 5.0;
-
-Mats materials(float albedo = 0.5f) {
-    return Mats({LambertianBsdf<S>(Spectrum::Constant(albedo))}, {MirrorBsdf<S>(Spectrum::Constant(albedo))});
-}
-
-/// A homogeneous medium over `box` with a majorant twice its extinction: every segment has nulls.
-SceneMedium<M, GlobalMajorant<M>, HenyeyGreensteinPhase> medium(Box box, float sigma_a, float sigma_s, float g = 0.3f) {
-    const M m(box, Spectrum::Constant(sigma_a), Spectrum::Constant(sigma_s));
-    return {m, GlobalMajorant<M>(m, 2.f * (sigma_a + sigma_s) + 0.5f), HenyeyGreensteinPhase(g)};
-}
 
 template <class E, class Scene, class Make>
 Stat estimate(const E& est, const Scene& sc, int n, std::uint64_t seed, Make make_ray) {
@@ -171,17 +154,6 @@ TEST_CASE("bdpt: an overflowed (infinite) density takes the weight; NaN gives Na
     CHECK(std::isnan(bdpt::strategy_weight(h, p, 0)));
 }
 
-/// The six walls of [-1, 1]^3 as quad lights emitting `le` inward, and as shapes naming them
-/// (normals inward; medium 0 on that side); the walls in `mirrors` are mirrors, the rest Lambertian.
-void box_walls(float le, const std::vector<int>& mirrors, Shapes& shapes, std::vector<QuadLight<S>>& lights) {
-    for (const CubeFace& f : inward_cube_faces()) {
-        const int index = int(lights.size());
-        const bool mirror = std::find(mirrors.begin(), mirrors.end(), index) != mirrors.end();
-        lights.push_back({f.corner, f.u, f.v, Spectrum::Constant(le)});
-        shapes.quads.push_back({f.corner, f.u, f.v, {mirror ? 1 : 0, index, -1, 0}});
-    }
-}
-
 TEST_CASE("bdpt: the furnace of six emitting walls around a medium of albedo 1 (L = 2), camera inside") {
     // As the surface estimators' furnace: L = Le / (1 - 0.5) = 2 whatever the phase function,
     // the density and which walls are mirrors. Subpaths of up to 64 vertices: the walls halve the
@@ -207,18 +179,6 @@ TEST_CASE("bdpt: the furnace of six emitting walls around a medium of albedo 1 (
             },
             opts);
     }
-}
-
-/// A box [-1, 1]^3 of absorbing medium 0 (sigma_a 0.5) behind null interfaces, holding a sphere of
-/// radius 0.5 of medium 1 (sigma_a 1), and a quad light at z = 2 emitting 1 toward -z.
-Sc nested_media() {
-    Shapes shapes;
-    shapes.boxes.push_back({Vec3(-1.f), Vec3(1.f), {-1, -1, 0, -1}});
-    shapes.spheres.push_back({Vec3(0.f), 0.5f, {-1, -1, 1, 0}});
-    const QuadLight<S> lamp{Vec3(-2.f, -2.f, 2.f), Vec3(0.f, 4.f, 0.f), Vec3(4.f, 0.f, 0.f), Spectrum::Constant(1.f)};
-    shapes.quads.push_back({lamp.corner, lamp.edge_u, lamp.edge_v, {-1, 0, -1, -1}});
-    return Sc(shapes, {medium(Box{Vec3(-1.f), Vec3(1.f)}, 0.5f, 0.f), medium(Box{Vec3(-0.5f), Vec3(0.5f)}, 1.f, 0.f)},
-              materials(), Ls(LightSelection::Uniform, 3.f, {lamp}, {}), -1);
 }
 
 TEST_CASE("bdpt: nested media behind null interfaces, the camera outside and inside") {
@@ -373,6 +333,15 @@ double worst_share_asymmetry(StrategyRecord& rec, int longest) {
     return worst;
 }
 
+/// What the per-strategy tests render with: no roulette (its survival is left out of the weights)
+/// and paths of at most 3 interior vertices, the lengths the tests check.
+EstimatorOptions strategy_test_options() {
+    EstimatorOptions opts;
+    opts.russian_roulette = false;
+    opts.max_depth = 3;
+    return opts;
+}
+
 /// The two checks on a record of paths of 1..3 interior vertices (see the test below): every
 /// (s, t) alone against NEE's estimate of the same path length, and the pdf symmetry over every
 /// pair of strategies, both within 5 combined SE.
@@ -406,9 +375,7 @@ TEST_CASE("bdpt: each strategy alone is unbiased, and the strategies' pdfs are t
     // is the same for every strategy: near d = 0 a connection's 1 / d^2 gives a strategy alone
     // infinite variance. Deterministic: fixed seeds.
     const Sc sc = cube_over_floor(false);
-    EstimatorOptions opts;
-    opts.russian_roulette = false;
-    opts.max_depth = 3;
+    const EstimatorOptions opts = strategy_test_options();
     StrategyRecord rec = record_strategies(BdptEstimator<bdpt::NullScattering, mis::Balance>(opts), sc, 200000, 3);
     check_strategies_alone_and_symmetric(rec);
 }
@@ -418,9 +385,7 @@ TEST_CASE("bdpt: the pdf symmetry test sees directional MIS's pdfs are not densi
     // (unbiased, but its "pdfs" are not the strategies' densities): the symmetry must break, by
     // far more than 5 SE. Shows that the test above can fail.
     const Sc sc = cube_over_floor(false);
-    EstimatorOptions opts;
-    opts.russian_roulette = false;
-    opts.max_depth = 3;
+    const EstimatorOptions opts = strategy_test_options();
     StrategyRecord rec = record_strategies(BdptEstimator<bdpt::Directional, mis::Balance>(opts), sc, 200000, 3);
     CHECK(worst_share_asymmetry(rec, 3) > 4.0 * kSigmas);
 }
@@ -547,17 +512,6 @@ TEST_CASE("bdpt: finite estimates and splats at the extremes of density and ligh
         }
 }
 
-using EM = Emissive<HomogeneousMedium<S>>;
-using ESc = SurfaceScene<Shapes, EM, GlobalMajorant<EM>, HenyeyGreensteinPhase, Mats, Ls>;
-
-/// A homogeneous medium over `box` emitting L_e = `le` everywhere in it, majorant twice its
-/// extinction.
-SceneMedium<EM, GlobalMajorant<EM>, HenyeyGreensteinPhase> emitting(Box box, float sigma_a, float sigma_s, float le,
-                                                                    float g = 0.3f) {
-    const HomogeneousMedium<S> base(box, Spectrum::Constant(sigma_a), Spectrum::Constant(sigma_s));
-    const EM m(base, EmissionGrid(box, {2, 2, 2}, std::vector<float>(8, 1.f)), Spectrum::Constant(le), {4, 4, 4});
-    return {m, GlobalMajorant<EM>(m, 2.f * (sigma_a + sigma_s) + 0.5f), HenyeyGreensteinPhase(g)};
-}
 
 TEST_CASE("bdpt: an emitting medium in the furnace: L = L_e everywhere, light subpaths from the volume and the walls") {
     // Walls of albedo 0.5 emitting (1 - 0.5) L_e around a medium that absorbs (sigma_a 0.6),
@@ -600,9 +554,7 @@ TEST_CASE("bdpt: an emitting cube: each strategy alone unbiased, the pdfs true d
     // The symmetry and each-strategy-alone tests of the plain cube, with the cube emitting: paths
     // now start at the lamp or anywhere in the volume, every strategy samples both (5 SE).
     const ESc sc = emitting_cube_over_floor();
-    EstimatorOptions opts;
-    opts.russian_roulette = false;
-    opts.max_depth = 3;
+    const EstimatorOptions opts = strategy_test_options();
     StrategyRecord rec = record_strategies(BdptEstimator<bdpt::NullScattering, mis::Balance>(opts), sc, 200000, 3);
     check_strategies_alone_and_symmetric(rec);
 }
@@ -648,9 +600,7 @@ TEST_CASE("bdpt: light subpaths on a fraction of the samples (an expected count 
     CAPTURE(b.mean);
     CHECK(std::abs(b.mean - 2.0) <= kSigmas * b.se());
 
-    EstimatorOptions opts;
-    opts.russian_roulette = false;
-    opts.max_depth = 3;
+    const EstimatorOptions opts = strategy_test_options();
     StrategyRecord rec =
         record_strategies(BdptEstimator<bdpt::NullScattering, mis::Balance>(opts, {}, 0.4f), cube_over_floor(false), 200000, 3);
     check_strategies_alone_and_symmetric(rec);

@@ -11,6 +11,7 @@
 
 #include "common.hpp"
 #include "host/shapes.hpp"
+#include "grey_surface_scenes.hpp"
 #include "surfaces.hpp"
 
 namespace {
@@ -23,6 +24,7 @@ using EM = Emissive<HomogeneousMedium<S>>;
 using Mats = Materials<S, LambertianBsdf<S>, MirrorBsdf<S>>;
 using Ls = LightSampler<S, QuadLight<S>, EnvironmentLight<S>>;
 using Sc = SurfaceScene<Shapes, EM, GlobalMajorant<EM>, HenyeyGreensteinPhase, Mats, Ls>;
+using grey_scenes::emitting;  // the emitting homogeneous medium, shared with the bidirectional tests
 
 // k = 5 standard errors, estimated from the samples, with fixed seeds: deterministic.
 constexpr double kSigmas = 5.0;
@@ -33,15 +35,6 @@ constexpr double kSigmas = 5.0;
 // nothing (measured: 0.87 +- 0.03 and 1.25 +- 0.25 over 12000 paths, i.e. rare huge samples).
 // The combined strategies keep the variance finite (the collision estimator takes over near x).
 // The floor under an emitting sphere below, where every NEE distance is >= 1, checks it.
-
-/// A homogeneous medium over `box` emitting `le` everywhere in it (a 2^3 grid of 1, radiance
-/// scale le), under a majorant twice its extinction, so that every piece has nulls.
-SceneMedium<EM, GlobalMajorant<EM>, HenyeyGreensteinPhase> emitting(Box box, float sigma_a, float sigma_s, float le,
-                                                                    float g) {
-    const HomogeneousMedium<S> base(box, Spectrum::Constant(sigma_a), Spectrum::Constant(sigma_s));
-    const EM m(base, EmissionGrid(box, {2, 2, 2}, std::vector<float>(8, 1.f)), Spectrum::Constant(le), {4, 4, 4});
-    return {m, GlobalMajorant<EM>(m, 2.f * (sigma_a + sigma_s) + 0.5f), HenyeyGreensteinPhase(g)};
-}
 
 template <class E, class Make>
 Stat estimate(const E& est, const Sc& sc, int n, std::uint64_t seed, Make make_ray) {

@@ -13,33 +13,15 @@
 #include <vector>
 
 #include "common.hpp"
-#include "host/shapes.hpp"
-#include "surfaces.hpp"
+#include "grey_surface_scenes.hpp"
 
 namespace {
 
 using namespace nsp_test;
-using S = Mono;
-using Spectrum = S::Spectrum;
-using nsp_host::Shapes;
-using M = HomogeneousMedium<S>;
-using Mats = Materials<S, LambertianBsdf<S>, MirrorBsdf<S>>;
-using Ls = LightSampler<S, QuadLight<S>, EnvironmentLight<S>>;
-using Sc = SurfaceScene<Shapes, M, GlobalMajorant<M>, HenyeyGreensteinPhase, Mats, Ls>;
+using namespace nsp_test::grey_scenes;
 
 // k = 5 standard errors, estimated from the samples, with fixed seeds: deterministic.
 constexpr double kSigmas = 5.0;
-
-Mats materials(float albedo = 0.5f) {
-    return Mats({LambertianBsdf<S>(Spectrum::Constant(albedo))}, {MirrorBsdf<S>(Spectrum::Constant(albedo))});
-}
-
-/// A homogeneous medium over `box` with a majorant twice its extinction: every segment has
-/// nulls, so their P_n enter the null-scattering MIS.
-SceneMedium<M, GlobalMajorant<M>, HenyeyGreensteinPhase> medium(Box box, float sigma_a, float sigma_s, float g = 0.3f) {
-    const M m(box, Spectrum::Constant(sigma_a), Spectrum::Constant(sigma_s));
-    return {m, GlobalMajorant<M>(m, 2.f * (sigma_a + sigma_s) + 0.5f), HenyeyGreensteinPhase(g)};
-}
 
 template <class E, class Scene, class Make>
 Stat estimate(const E& est, const Scene& sc, int n, std::uint64_t seed, Make make_ray) {
@@ -64,17 +46,6 @@ void for_each_strategy(F check) {
     check(PathEstimator<strategy::NullScatteringMis, mis::Power, absorption::Event>{}, "uni-nee-mis power event");
     check(PathEstimator<strategy::EquiangularNextEvent>{}, "equiangular-nee");
     check(PathEstimator<strategy::EquiangularMis, mis::Balance>{}, "equiangular-mis balance");
-}
-
-/// The six walls of [-1, 1]^3 as quad lights emitting `le` inward, and as shapes naming them
-/// (normals inward; medium 0 on that side); the walls in `mirrors` are mirrors, the rest Lambertian.
-void box_walls(float le, const std::vector<int>& mirrors, Shapes& shapes, std::vector<QuadLight<S>>& lights) {
-    for (const CubeFace& f : inward_cube_faces()) {
-        const int index = int(lights.size());
-        const bool mirror = std::find(mirrors.begin(), mirrors.end(), index) != mirrors.end();
-        lights.push_back({f.corner, f.u, f.v, Spectrum::Constant(le)});
-        shapes.quads.push_back({f.corner, f.u, f.v, {mirror ? 1 : 0, index, -1, 0}});
-    }
 }
 
 TEST_CASE("surface estimators: the furnace of six emitting walls around a medium of albedo 1 (L = 2), camera inside") {
@@ -130,18 +101,6 @@ TEST_CASE("surface estimators: the white furnace: albedo-1 floor, mirror and med
         CAPTURE(s.se());
         CHECK(std::abs(s.mean - 1.0) <= kSigmas * s.se());
     });
-}
-
-/// A box [-1, 1]^3 of absorbing medium 0 (sigma_a 0.5) behind null interfaces, holding a sphere of
-/// radius 0.5 of medium 1 (sigma_a 1), and a quad light at z = 2 emitting 1 toward -z.
-Sc nested_media() {
-    Shapes shapes;
-    shapes.boxes.push_back({Vec3(-1.f), Vec3(1.f), {-1, -1, 0, -1}});
-    shapes.spheres.push_back({Vec3(0.f), 0.5f, {-1, -1, 1, 0}});
-    const QuadLight<S> lamp{Vec3(-2.f, -2.f, 2.f), Vec3(0.f, 4.f, 0.f), Vec3(4.f, 0.f, 0.f), Spectrum::Constant(1.f)};
-    shapes.quads.push_back({lamp.corner, lamp.edge_u, lamp.edge_v, {-1, 0, -1, -1}});
-    return Sc(shapes, {medium(Box{Vec3(-1.f), Vec3(1.f)}, 0.5f, 0.f), medium(Box{Vec3(-0.5f), Vec3(0.5f)}, 1.f, 0.f)},
-              materials(), Ls(LightSelection::Uniform, 3.f, {lamp}, {}), -1);
 }
 
 TEST_CASE("surface estimators: nested media behind null interfaces, the camera outside and inside") {

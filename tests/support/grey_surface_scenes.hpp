@@ -1,0 +1,71 @@
+// tests/support/grey_surface_scenes.hpp: the grey (Mono) surface scenes that the surface,
+// emission and bidirectional estimator tests share: a homogeneous medium behind null interfaces
+// (and its emitting variant) under a loose majorant, Lambertian and mirror materials, the furnace
+// of six emitting walls, and the nested absorbing media with their closed-form transmittance.
+#pragma once
+
+#include <algorithm>
+#include <vector>
+
+#include <nsp/nsp.hpp>
+
+#include "host/shapes.hpp"
+#include "surfaces.hpp"
+
+namespace nsp_test::grey_scenes {
+
+using namespace nsp;
+using S = Mono;
+using Spectrum = S::Spectrum;
+using nsp_host::Shapes;
+using M = HomogeneousMedium<S>;
+using EM = Emissive<HomogeneousMedium<S>>;
+using Mats = Materials<S, LambertianBsdf<S>, MirrorBsdf<S>>;
+using Ls = LightSampler<S, QuadLight<S>, EnvironmentLight<S>>;
+using Sc = SurfaceScene<Shapes, M, GlobalMajorant<M>, HenyeyGreensteinPhase, Mats, Ls>;
+using ESc = SurfaceScene<Shapes, EM, GlobalMajorant<EM>, HenyeyGreensteinPhase, Mats, Ls>;
+
+inline Mats materials(float albedo = 0.5f) {
+    return Mats({LambertianBsdf<S>(Spectrum::Constant(albedo))}, {MirrorBsdf<S>(Spectrum::Constant(albedo))});
+}
+
+/// A homogeneous medium over `box` with a majorant twice its extinction: every segment has
+/// nulls, so their P_n enter the null-scattering MIS.
+inline SceneMedium<M, GlobalMajorant<M>, HenyeyGreensteinPhase> medium(Box box, float sigma_a, float sigma_s, float g = 0.3f) {
+    const M m(box, Spectrum::Constant(sigma_a), Spectrum::Constant(sigma_s));
+    return {m, GlobalMajorant<M>(m, 2.f * (sigma_a + sigma_s) + 0.5f), HenyeyGreensteinPhase(g)};
+}
+
+/// A homogeneous medium over `box` emitting L_e = `le` everywhere in it, majorant twice its
+/// extinction.
+inline SceneMedium<EM, GlobalMajorant<EM>, HenyeyGreensteinPhase> emitting(Box box, float sigma_a, float sigma_s, float le,
+                                                                    float g = 0.3f) {
+    const HomogeneousMedium<S> base(box, Spectrum::Constant(sigma_a), Spectrum::Constant(sigma_s));
+    const EM m(base, EmissionGrid(box, {2, 2, 2}, std::vector<float>(8, 1.f)), Spectrum::Constant(le), {4, 4, 4});
+    return {m, GlobalMajorant<EM>(m, 2.f * (sigma_a + sigma_s) + 0.5f), HenyeyGreensteinPhase(g)};
+}
+
+/// The six walls of [-1, 1]^3 as quad lights emitting `le` inward, and as shapes naming them
+/// (normals inward; medium 0 on that side); the walls in `mirrors` are mirrors, the rest Lambertian.
+inline void box_walls(float le, const std::vector<int>& mirrors, Shapes& shapes, std::vector<QuadLight<S>>& lights) {
+    for (const CubeFace& f : inward_cube_faces()) {
+        const int index = int(lights.size());
+        const bool mirror = std::find(mirrors.begin(), mirrors.end(), index) != mirrors.end();
+        lights.push_back({f.corner, f.u, f.v, Spectrum::Constant(le)});
+        shapes.quads.push_back({f.corner, f.u, f.v, {mirror ? 1 : 0, index, -1, 0}});
+    }
+}
+
+/// A box [-1, 1]^3 of absorbing medium 0 (sigma_a 0.5) behind null interfaces, holding a sphere of
+/// radius 0.5 of medium 1 (sigma_a 1), and a quad light at z = 2 emitting 1 toward -z.
+inline Sc nested_media() {
+    Shapes shapes;
+    shapes.boxes.push_back({Vec3(-1.f), Vec3(1.f), {-1, -1, 0, -1}});
+    shapes.spheres.push_back({Vec3(0.f), 0.5f, {-1, -1, 1, 0}});
+    const QuadLight<S> lamp{Vec3(-2.f, -2.f, 2.f), Vec3(0.f, 4.f, 0.f), Vec3(4.f, 0.f, 0.f), Spectrum::Constant(1.f)};
+    shapes.quads.push_back({lamp.corner, lamp.edge_u, lamp.edge_v, {-1, 0, -1, -1}});
+    return Sc(shapes, {medium(Box{Vec3(-1.f), Vec3(1.f)}, 0.5f, 0.f), medium(Box{Vec3(-0.5f), Vec3(0.5f)}, 1.f, 0.f)},
+              materials(), Ls(LightSelection::Uniform, 3.f, {lamp}, {}), -1);
+}
+
+}  // namespace nsp_test::grey_scenes
