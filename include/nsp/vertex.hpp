@@ -20,9 +20,11 @@
 //             vertex = surface;                     // else a real surface vertex
 //         }                                         // else a real medium vertex at seg.t
 //         q = k.survival(++depth, beta);            // before NEE: both continuations share it
-//         if (not a delta lobe) { light = host.sample_light(x); sh = k.shadow(medium, majorant, shadow_ray, light.dist, ...);
-//         L += beta * sh.transmittance * light.Le * f(wo, light.wi) *
-//              k.light_weight(q, pdf(wo, light.wi), sh.null_pdf_product, light.pdf, light.delta) / light.pdf; }
+//         if (not a delta lobe && k.draw_nee(rng)) {   // draw_nee: always at the default nee_count 1
+//             light = host.sample_light(x); sh = k.shadow(medium, majorant, shadow_ray, light.dist, ...);
+//             L += beta * sh.transmittance * light.Le * f(wo, light.wi) *
+//                  k.light_weight(q, pdf(wo, light.wi), sh.null_pdf_product, light.pdf, light.delta) /
+//                  (light.pdf * k.nee_count()); }
 //         roulette with q; sample wi from the BSDF or phase function; beta *= value / pdf;
 //         from = VertexPdf::scattered(q, pdf, delta); nulls = 1; ray = {x, wi};
 //     }
@@ -269,10 +271,21 @@ public:
         return std::min(opts_.rr_max_survival, float(beta.abs().maxCoeff()));
     }
 
+    /// The expected count of NEE at a real vertex (EstimatorOptions::nee_count, THEORY 5.9): a
+    /// light sample's estimate divides by it; hit_weight and light_weight already weigh NEE by it.
+    float nee_count() const noexcept { return opts_.nee_count; }
+
+    /// Whether NEE runs at this vertex: always at nee_count 1 (no random number drawn), else with
+    /// probability nee_count (draw_technique). Decide it after the roulette survival.
+    template <UniformRng R>
+    bool draw_nee(R& rng) const {
+        return draw_technique(opts_.nee_count, rng);
+    }
+
     /// The MIS weight of an emitter that the path's segments from `from` reached, with the null
     /// products of those segments multiplied into `null_pdf_product`, and `light_pdf` the
     /// solid-angle pdf with which light sampling from `from` picks that point (light selection
-    /// included). 1 from the camera, after a delta lobe, or where light sampling cannot reach it
+    /// included; the weight multiplies it by nee_count()). 1 from the camera, after a delta lobe, or where light sampling cannot reach it
     /// (light_pdf 0); 1 for single strategies (the host adds a hit only if St::hits_lights).
     /// A NaN or negative pdf or product (bad host input) gives 0: the contribution is dropped,
     /// never turned into a NaN.
@@ -284,7 +297,8 @@ public:
             if (from.camera || from.delta) return 1.f;
             if (!valid(from.survival, from.direction_pdf, null_pdf_product, light_pdf)) return 0.f;
             if (!(light_pdf > 0.f)) return 1.f;
-            return unidirectional_weight<St>(heuristic_, from.survival, from.direction_pdf, null_pdf_product, light_pdf);
+            return unidirectional_weight<St>(heuristic_, from.survival, from.direction_pdf, null_pdf_product,
+                                             light_pdf * opts_.nee_count);
         }
     }
 
@@ -292,7 +306,8 @@ public:
     /// included) from a real vertex with roulette survival `survival`, whose BSDF or phase
     /// function would draw that direction with `direction_pdf`; `null_pdf_product` from the shadow
     /// rays. 1 for a delta light (nothing else reaches it) and for single strategies; 0 for a NaN
-    /// or negative pdf or product, as hit_weight.
+    /// or negative pdf or product, as hit_weight. NEE's pdf is weighed as nee_count() x light_pdf;
+    /// the caller still divides the estimate by nee_count().
     float light_weight(float survival, float direction_pdf, float null_pdf_product, float light_pdf,
                        bool delta_light) const noexcept {
         if constexpr (!St::combines) {
@@ -301,7 +316,8 @@ public:
         } else {
             if (delta_light) return 1.f;
             if (!valid(survival, direction_pdf, null_pdf_product, light_pdf)) return 0.f;
-            return next_event_weight<St>(heuristic_, survival, direction_pdf, null_pdf_product, light_pdf);
+            return next_event_weight<St>(heuristic_, survival, direction_pdf, null_pdf_product,
+                                         light_pdf * opts_.nee_count);
         }
     }
 

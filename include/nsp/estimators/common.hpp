@@ -9,6 +9,7 @@
 #include <type_traits>
 
 #include "../core/error.hpp"
+#include "../counts.hpp"
 #include "../equiangular.hpp"
 #include "../light.hpp"
 #include "../media/emissive.hpp"
@@ -90,6 +91,14 @@ struct EstimatorOptions {
     /// the volume by MIS. It is the only sampling technique for the emission a camera ray sees
     /// directly. Off: collisions and NEE only. No effect on other media or strategies.
     bool emission_along_segments = true;
+    /// The expected count of NEE toward the lights at each real vertex, in (0, 1] (THEORY 5.9,
+    /// counts.hpp): NEE runs there with this probability, its estimate divided by it, and the MIS
+    /// weights of both techniques take nee_count x the light pdf. 1: NEE at every vertex. Below 1
+    /// it trades variance for the shadow rays' cost where tracking finds the light well (a large
+    /// light, an environment); NeeCountLearner chooses it per pixel tile. nsp::PathEstimator
+    /// (every strategy that samples lights, NEE from equiangular vertices excepted: they exist for
+    /// it); the spectral and bidirectional estimators reject a value other than 1.
+    float nee_count = 1.f;
 };
 
 /// How a radiance estimate ended.
@@ -223,6 +232,15 @@ inline void validate(const EstimatorOptions& opts) {
     if (!(opts.rr_max_survival > 0.f && opts.rr_max_survival <= 1.f))
         detail::fail("EstimatorOptions rr_max_survival = ", opts.rr_max_survival,
                      " is not allowed: it must lie in (0, 1]");
+    validate_count("EstimatorOptions nee_count", opts.nee_count);
+}
+
+/// Throws InvalidArgument unless opts.nee_count is 1: for the estimators that do not take NEE
+/// counts (`estimator` names it), so that a count is never silently ignored.
+inline void require_unit_nee_count(const EstimatorOptions& opts, const char* estimator) {
+    if (opts.nee_count != 1.f)
+        detail::fail("EstimatorOptions nee_count = ", opts.nee_count, " is not allowed for ", estimator,
+                     ": it takes NEE at every vertex (nee_count 1); expected counts are nsp::PathEstimator's");
 }
 
 }  // namespace nsp

@@ -29,6 +29,7 @@
 
 #include "../core/counter.hpp"
 #include "../core/rng.hpp"
+#include "../counts.hpp"
 #include "../equiangular.hpp"
 #include "../media/emissive.hpp"
 #include "../mis.hpp"
@@ -107,7 +108,7 @@ private:
                     const Interval in = scene.medium.bounds().clip(ray, 0.f, hit.t);
                     eq = EquiangularSampler(ray, *target, in.t0, in.t1);
                     eq_select = equiangular_selection<St>(kernels_.options(), scene, ray, eq, lambda);
-                    if (depth < kernels_.options().max_depth && (eq_select >= 1.f || rng.uniform() < eq_select)) {
+                    if (depth < kernels_.options().max_depth && draw_technique(eq_select, rng)) {
                         const Status es =
                             equiangular_vertex(scene, ray, eq, eq_select, depth + 1, beta, lambda, rng, counter, L);
                         if (es != Status::Ok) status = es;
@@ -157,10 +158,24 @@ private:
                                 const float s = unidirectional_pdf<St>(prev_survival, prev_phase_pdf,
                                                                        seg.null_pdf_product) /
                                                 scene.lights.pdf(prev_x, hit);
-                                w = equiangular_mis_weight(kernels_.heuristic(), VertexTechnique::TrackHit, 1.f, s, prev_eq_ratio);
+                                const float c = kernels_.nee_count();
+                                w = equiangular_mis_weight(kernels_.heuristic(), VertexTechnique::TrackHit, c, s, prev_eq_ratio);
+                                // Relative to tracking + hit: NEE 1 / s, equiangular + NEE eq_ratio / s.
+                                if (s > 0.f)
+                                    detail::record_light(counter, (beta * scene.lights.emitted(hit, lambda)).mean(), 1.f,
+                                                         1.f / s, prev_eq_ratio / s, c, LightTechnique::Hit);
                             } else {
+                                const float p_light = scene.lights.pdf(prev_x, hit);
                                 w = kernels_.hit_weight(VertexPdf::scattered(prev_survival, prev_phase_pdf),
-                                                        seg.null_pdf_product, scene.lights.pdf(prev_x, hit));
+                                                        seg.null_pdf_product, p_light);
+                                if constexpr (MisRecorder<C>) {
+                                    const float p_uni =
+                                        unidirectional_pdf<St>(prev_survival, prev_phase_pdf, seg.null_pdf_product);
+                                    if (p_uni > 0.f && p_light > 0.f)
+                                        detail::record_light(counter, (beta * scene.lights.emitted(hit, lambda)).mean(),
+                                                             1.f, p_light / p_uni, 0.f, kernels_.nee_count(),
+                                                             LightTechnique::Hit);
+                                }
                             }
                         }
                     }
@@ -183,7 +198,8 @@ private:
             const float q = kernels_.survival(depth, beta);
             if constexpr (St::samples_lights) {
                 // Equiangular + NEE alone leaves the lights to its own vertices when it has a target.
-                if (St::combines || !St::equiangular || !target) {
+                // NEE at the expected count EstimatorOptions::nee_count (THEORY 5.9).
+                if ((St::combines || !St::equiangular || !target) && kernels_.draw_nee(rng)) {
                     const Status ns = next_event(scene, x, ray.d, q, lambda, rng, counter, beta, L, 1.f, eq_ratio, false);
                     if (ns != Status::Ok) status = ns;
                 }
@@ -214,7 +230,9 @@ private:
     /// Adds NEE's weighted contribution at real vertex x (arrived along wo, throughput beta) to L;
     /// returns Aborted or Rejected if its shadow flight was, else Ok. For the equiangular
     /// strategies, `track_ratio_` and `eq_ratio` are the tracking and equiangular pdfs of x over
-    /// the pdf of the technique that drew x (`equiangular_drawn` says which one it was).
+    /// the pdf of the technique that drew x (`equiangular_drawn` says which one it was). NEE from
+    /// a tracked vertex ran with the expected count nee_count (its estimate divides by it); from an
+    /// equiangular vertex always (count 1: that vertex exists for it).
     template <class Sc, UniformRng R, LookupCounter C>
     Status next_event(const Sc& scene, const Vec3& x, const Vec3& wo, float survival,
                       const typename Sc::Spectral::Wavelengths& lambda, R& rng, C& counter,
@@ -225,26 +243,39 @@ private:
         if (!(ls.pdf > 0.f)) return Status::Ok;
         const Ray shadow{x, ls.wi};
         if (ls.occludable_by_sphere && scene.lights.sphere_blocks(shadow, ls.distance)) return Status::Ok;
+        const std::uint64_t before = detail::recorder_count(counter);
         const auto tr = kernels_.shadow(scene.medium, scene.majorant, shadow, ls.distance, lambda, rng, counter);
+        detail::record_nee_lookups(counter, before);
         if (tr.status != Status::Ok) return tr.status;
         if (!(tr.transmittance != 0.f).any()) return Status::Ok;
+        const float count = equiangular_drawn ? 1.f : kernels_.nee_count();
+        const typename Sc::Spectrum f = beta * tr.transmittance * ls.radiance * (scene.phase.eval(wo, ls.wi) / ls.pdf);
         float w = 1.f;
         if constexpr (St::combines) {
+            const float c = kernels_.nee_count();
             if constexpr (St::equiangular) {
-                // Three techniques, relative to the one that drew x followed by NEE: tracking + NEE,
-                // tracking + hit (not for a point light) and equiangular + NEE.
+                // Three techniques, relative to the one that drew x followed by NEE (uncounted):
+                // tracking + NEE (its count c), tracking + hit (not for a point light) and
+                // equiangular + NEE.
                 const float s = ls.delta ? 0.f
                                          : unidirectional_pdf<St>(survival, scene.phase.pdf(wo, ls.wi),
                                                                   tr.null_pdf_product) / ls.pdf;
                 w = equiangular_mis_weight(kernels_.heuristic(),
                                            equiangular_drawn ? VertexTechnique::EquiangularNee : VertexTechnique::TrackNee,
-                                           track_ratio_, track_ratio_ * s, eq_ratio);
+                                           track_ratio_ * c, track_ratio_ * s, eq_ratio);
+                detail::record_light(counter, f.mean(), track_ratio_ * s, track_ratio_, eq_ratio, c,
+                                     equiangular_drawn ? LightTechnique::Other : LightTechnique::Nee);
             } else {  // a point light cannot be hit: NEE keeps weight 1
-                w = kernels_.light_weight(survival, scene.phase.pdf(wo, ls.wi), tr.null_pdf_product, ls.pdf, ls.delta);
+                const float p_dir = scene.phase.pdf(wo, ls.wi);
+                w = kernels_.light_weight(survival, p_dir, tr.null_pdf_product, ls.pdf, ls.delta);
+                if constexpr (MisRecorder<C>)
+                    detail::record_light(counter, f.mean(),
+                                         ls.delta ? 0.f : unidirectional_pdf<St>(survival, p_dir, tr.null_pdf_product) / ls.pdf,
+                                         1.f, 0.f, c, LightTechnique::Nee);
             }
         }
         NSP_DEBUG_ASSERT(!(w < 0.f) && !(w > 1.f), "an MIS weight left [0, 1]");
-        L += beta * tr.transmittance * ls.radiance * (w * scene.phase.eval(wo, ls.wi) / ls.pdf);
+        L += f * (w / count);
         return Status::Ok;
     }
 

@@ -62,7 +62,10 @@ public:
     using Absorption = A;
 
     /// Throws InvalidArgument on the option values PathEstimator rejects.
-    explicit SpectralPathEstimator(EstimatorOptions opts = {}) : opts_(opts) { validate(opts); }
+    explicit SpectralPathEstimator(EstimatorOptions opts = {}) : opts_(opts) {
+        validate(opts);
+        require_unit_nee_count(opts, "nsp::SpectralPathEstimator");
+    }
 
     const EstimatorOptions& options() const noexcept { return opts_; }
 

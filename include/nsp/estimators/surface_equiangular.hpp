@@ -91,23 +91,35 @@ Status light_event(const K& k, const Sc& sc, const SceneVertex& v, const Vec3& x
     if (!(ls.sample.pdf > 0.f)) return Status::Ok;
     const auto f = eval_vertex(sc, v, wo, ls.sample.wi, lambda);
     if (!(f.value != 0.f).any()) return Status::Ok;
+    const std::uint64_t before = recorder_count(counter);
     const auto sh = shadow_through(k, sc, Ray{x, f.wi}, shadow_distance(ls.sample.distance), start_medium(f.wi), lambda,
                                    rng, counter);
+    record_nee_lookups(counter, before);
     if (sh.status != Status::Ok) return sh.status;
     if (!(sh.transmittance != 0.f).any()) return Status::Ok;
+    // NEE from a tracked vertex or a surface ran with the expected count nee_count; from an
+    // equiangular vertex always (THEORY 5.9).
+    const float count = eq_drawn ? 1.f : k.nee_count();
+    const typename Sc::Spectrum contribution = beta * sh.transmittance * ls.sample.radiance * f.value / ls.sample.pdf;
     float w;
     if constexpr (St::equiangular && St::combines) {
-        // Relative to the technique that drew x followed by NEE: tracking + NEE, tracking + hit
-        // (not for a delta light) and equiangular + NEE.
+        // Relative to the technique that drew x followed by NEE (uncounted): tracking + NEE (its
+        // count), tracking + hit (not for a delta light) and equiangular + NEE.
         const float s = ls.sample.delta ? 0.f
                                         : unidirectional_pdf<St>(q, f.pdf, sh.null_pdf_product) / ls.sample.pdf;
         w = equiangular_mis_weight(k.heuristic(), eq_drawn ? VertexTechnique::EquiangularNee : VertexTechnique::TrackNee,
-                                   track, track * s, eq);
+                                   track * k.nee_count(), track * s, eq);
+        record_light(counter, contribution.mean(), track * s, track, eq, k.nee_count(),
+                     eq_drawn ? LightTechnique::Other : LightTechnique::Nee);
     } else {
         (void)track, (void)eq, (void)eq_drawn;
         w = k.light_weight(q, f.pdf, sh.null_pdf_product, ls.sample.pdf, ls.sample.delta);
+        if constexpr (St::combines && MisRecorder<C>)
+            record_light(counter, contribution.mean(),
+                         ls.sample.delta ? 0.f : unidirectional_pdf<St>(q, f.pdf, sh.null_pdf_product) / ls.sample.pdf,
+                         1.f, 0.f, k.nee_count(), LightTechnique::Nee);
     }
-    L += beta * sh.transmittance * ls.sample.radiance * f.value * (w / ls.sample.pdf);
+    L += contribution * (w / count);
     return Status::Ok;
 }
 

@@ -48,12 +48,24 @@ RadianceSample<typename Sc::Spectral> surface_radiance(const K& k, const Sc& sc,
     // The MIS weight of a light the segments from `from` reach, sampled there with `light_pdf`:
     // against NEE, and with equiangular MIS also against equiangular + NEE (relative to tracking
     // + NEE: hitting is p_uni / p_light, equiangular + NEE the vertex's p_eq / p_track).
-    auto hit_weight = [&](float light_pdf) {
+    // `le` is the light's emitted radiance, for a MisRecorder counter (counts.hpp).
+    auto hit_weight = [&](float light_pdf, const Spectrum& le) {
         if constexpr (St::equiangular && St::combines) {
             if (from.camera || from.delta || !(light_pdf > 0.f)) return 1.f;
             const float s = unidirectional_pdf<St>(from.survival, from.direction_pdf, nulls) / light_pdf;
-            return equiangular_mis_weight(k.heuristic(), VertexTechnique::TrackHit, 1.f, s, from_eq);
+            // Relative to tracking + hit: NEE 1 / s, equiangular + NEE from_eq / s.
+            if (s > 0.f) detail::record_light(counter, (beta * le).mean(), 1.f, 1.f / s, from_eq / s, k.nee_count(),
+                                                 LightTechnique::Hit);
+            return equiangular_mis_weight(k.heuristic(), VertexTechnique::TrackHit, k.nee_count(), s, from_eq);
         } else {
+            if constexpr (St::combines && MisRecorder<C>) {
+                const float p_uni = unidirectional_pdf<St>(from.survival, from.direction_pdf, nulls);
+                if (!from.camera && !from.delta && p_uni > 0.f && light_pdf > 0.f)
+                    detail::record_light(counter, (beta * le).mean(), 1.f, light_pdf / p_uni, 0.f, k.nee_count(),
+                                         LightTechnique::Hit);
+            } else {
+                (void)le;
+            }
             return k.hit_weight(from, nulls, light_pdf);
         }
     };
@@ -77,7 +89,7 @@ RadianceSample<typename Sc::Spectral> surface_radiance(const K& k, const Sc& sc,
                 eq = PieceEquiangular<Sc>(sc, ray, in.t0, in.t1);
                 if (eq.valid()) {
                     eq_select = eq.template selection<St, typename Sc::MediumType>(k.options(), m.majorant, lambda);
-                    if (depth < k.options().max_depth && (eq_select >= 1.f || rng.uniform() < eq_select)) {
+                    if (depth < k.options().max_depth && draw_technique(eq_select, rng)) {
                         const Status es =
                             equiangular_event(k, sc, medium, ray, eq, eq_select, depth + 1, beta, lambda, rng, counter, L);
                         if (es != Status::Ok) status = es;
@@ -117,14 +129,16 @@ RadianceSample<typename Sc::Spectral> surface_radiance(const K& k, const Sc& sc,
         } else {
             if (!hit.found()) {  // the ray leaves the scene: the lights at infinity
                 if (k.counts_hit(from))
-                    for (const int i : sc.lights.infinite())
-                        L += beta * sc.lights.emitted(i, ray.d, lambda) *
-                             hit_weight(from.camera ? 0.f : sc.lights.pdf(i, prev, ray.d));
+                    for (const int i : sc.lights.infinite()) {
+                        const Spectrum le = sc.lights.emitted(i, ray.d, lambda);
+                        L += beta * le * hit_weight(from.camera ? 0.f : sc.lights.pdf(i, prev, ray.d), le);
+                    }
                 break;
             }
-            if (hit.light >= 0 && k.counts_hit(from))
-                L += beta * sc.lights.emitted(hit.light, ray.d, lambda) *
-                     hit_weight(from.camera ? 0.f : sc.lights.pdf(hit.light, prev, ray.d));
+            if (hit.light >= 0 && k.counts_hit(from)) {
+                const Spectrum le = sc.lights.emitted(hit.light, ray.d, lambda);
+                L += beta * le * hit_weight(from.camera ? 0.f : sc.lights.pdf(hit.light, prev, ray.d), le);
+            }
             if (crosses(sc, hit)) {  // a null interface: no vertex, the segment goes on in the next medium
                 if (++crossings > kMaxInterfaceCrossings) {
                     status = Status::InvalidInput;
@@ -147,7 +161,8 @@ RadianceSample<typename Sc::Spectral> surface_radiance(const K& k, const Sc& sc,
         if constexpr (St::samples_lights) {
             auto side = [&](const Vec3& wi) { return v.on_surface() ? hit.medium_entered(wi) : medium; };
             // Equiangular + NEE alone leaves the lights of a vertex its own vertices cover to them.
-            if (St::combines || !St::equiangular || !eq_covers) {
+            // NEE at the expected count EstimatorOptions::nee_count (THEORY 5.9).
+            if ((St::combines || !St::equiangular || !eq_covers) && k.draw_nee(rng)) {
                 const Status ns = light_event(k, sc, v, x, ray.d, q, side, 1.f, eq_ratio, false, lambda, rng, counter,
                                               beta, L);
                 if (ns != Status::Ok) status = ns;
