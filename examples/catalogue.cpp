@@ -19,7 +19,8 @@ std::vector<SceneEntry> make_catalogue() {
                  {{"A", {K::Cloud, LightSetup::A}}, {"B", {K::Cloud, LightSetup::B}}},
                  mono, 128, 128, 256,
                  // every PathEstimator but the equiangular ones (their lamp is the fog's business)
-                 {"unidirectional_grey", "ratio-nee_grey", "directional-mis_grey", "uni-nee-mis_grey"},
+                 {"unidirectional_grey", "ratio-nee_grey", "directional-mis_grey", "uni-nee-mis_grey",
+                  "uni-nee-mis_grey_balance_absorb-weight_learned"},
                  {"global"}, "", false,
                  "A", nsp::Mono::name, "uni-nee-mis_grid_balance_absorb-weight", 128,
                  "uni-nee-mis_balance_absorb-weight", {"unidirectional_absorb-weight", "ratio-nee_absorb-weight"}});
@@ -58,7 +59,8 @@ std::vector<SceneEntry> make_catalogue() {
                  {{"SA", {K::Sparse, LightSetup::A}}, {"SB", {K::Sparse, LightSetup::B}, 0, false}},
                  mono, 64, 64, 256,
                  {"unidirectional_grey_absorb-weight", "ratio-nee_grey_absorb-weight",
-                  "directional-mis_grey_balance_absorb-weight", "uni-nee-mis_grey_balance_absorb-weight"},
+                  "directional-mis_grey_balance_absorb-weight", "uni-nee-mis_grey_balance_absorb-weight",
+                  "uni-nee-mis_grey_balance_absorb-weight_learned"},
                  {"global", "grid"}, "", false,
                  "SA", nsp::Mono::name, "uni-nee-mis_grid_balance_absorb-weight", 64,
                  "uni-nee-mis_balance_absorb-weight", {"unidirectional_absorb-weight", "ratio-nee_absorb-weight"}});
@@ -72,7 +74,8 @@ std::vector<SceneEntry> make_catalogue() {
                    // tracking + NEE (with a point light uni-nee-mis is the same estimator), equiangular +
                    // NEE and the three-way MIS with both heuristics
                    {"ratio-nee_grey_absorb-weight", "uni-nee-mis_grey_balance_absorb-weight",
-                    "equiangular-nee_grey_absorb-weight", "uni-nee-eq-mis_grey_absorb-weight"},
+                    "equiangular-nee_grey_absorb-weight", "uni-nee-eq-mis_grey_absorb-weight",
+                    "uni-nee-eq-mis_grey_balance_absorb-weight_learned"},
                    {"global", "grid"},
                    // its NEE from tracked vertices near the lamp is weighted down by the equiangular pdf
                    // there: no 1/r^2 tail, unlike tracking + NEE

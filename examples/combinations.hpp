@@ -238,6 +238,13 @@ struct Combination<tl::list<S, CP, Maj, St, H, A, Med>> {
         else return false;
     }();
 
+    /// True for nsp::PathEstimator rows that combine NEE with tracking under the balance heuristic:
+    /// the rows whose NEE count nsp::NeeCountLearner can learn (render_job_impl.hpp, "_learned").
+    static constexpr bool learns_nee_count = [] {
+        if constexpr (spectral) return false;
+        else return St::combines && St::samples_lights && std::is_same_v<H, nsp::mis::Balance>;
+    }();
+
     /// True for the grey estimator with the plain global majorant (the rows of the first tables).
     static constexpr bool plain_global = !spectral && std::is_same_v<Maj, GlobalMajorantPolicy<>>;
 
@@ -293,6 +300,7 @@ struct CombinationInfo {
     bool bounding;              ///< the majorant bounds the extinction (bound::Guaranteed)
     bool per_channel_majorant;  ///< per-channel or channel-grid
     bool emissive;              ///< the medium emits (the plume's): only the plume scene renders it
+    bool learns_nee_count;      ///< see Combination::learns_nee_count
     std::string (*name)();      ///< Combination::name
 };
 
@@ -304,7 +312,8 @@ struct infos_of<tl::list<Cs...>> {
     static constexpr std::array<CombinationInfo, sizeof...(Cs)> value{CombinationInfo{
         Cs::Spectral::name, Cs::ChannelPolicy::name, Cs::MajorantKind::name, Cs::Strategy::name, Cs::Heuristic::name,
         Cs::Absorption::name, Cs::MediumKind::name, Cs::spectral, Cs::plain_global, Cs::uses_selection,
-        Cs::MajorantKind::bounding, Cs::MajorantKind::per_channel, Cs::MediumKind::emissive, &Cs::name}...};
+        Cs::MajorantKind::bounding, Cs::MajorantKind::per_channel, Cs::MediumKind::emissive, Cs::learns_nee_count,
+        &Cs::name}...};
 };
 }  // namespace detail
 

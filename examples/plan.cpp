@@ -35,10 +35,13 @@ std::vector<CombinationInfo> infos(std::string_view mode) {
     return out;
 }
 
-/// True when every field of `token` is a field of the row.
+/// True when every field of `token` is a field of the row; a learned-count row only for a token
+/// that names "learned" (so that the existing tokens select the same rows as before).
 bool matches(const Candidate& c, std::string_view token) {
+    const auto fields = split(token, '_');
+    if (c.learned && std::find(fields.begin(), fields.end(), "learned") == fields.end()) return false;
     if (token == "all") return true;
-    for (const auto t : split(token, '_'))
+    for (const auto t : fields)
         if (std::find(c.fields.begin(), c.fields.end(), t) == c.fields.end()) return false;
     return true;
 }
@@ -86,6 +89,14 @@ std::vector<Candidate> candidates(std::string_view mode, const std::vector<Selec
         if (info.emissive) c.fields.emplace_back("emissive");
         if (!info.uses_selection) {
             out.push_back(c);
+            if (info.learns_nee_count) {  // the same combination with learned NEE counts
+                Candidate l = c;
+                l.learned = true;
+                l.name += "_learned";
+                l.key += "_learned";
+                l.fields.emplace_back("learned");
+                out.push_back(std::move(l));
+            }
             continue;
         }
         for (const SelectionRule r : rules) {

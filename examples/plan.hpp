@@ -29,6 +29,9 @@ struct Candidate {
     std::string absorption;
     bool uses_selection = false;
     bool emissive = false;  ///< the emissive medium (the plume scene's)
+    /// The NEE count learned per pixel tile from a pilot (nsp::NeeCountLearner): the row's name
+    /// ends in "_learned"; only tokens that name "learned" select it.
+    bool learned = false;
 };
 
 /// The renders of one table: one set-up of one scene in one spectral mode.

@@ -140,6 +140,7 @@ int run(const Options& o) {
             for (int run = 0; run < o.runs; ++run) {
                 RenderRequest rq = request(t, o.seed + std::uint64_t(run), c.selection);
                 rq.pixel_stats = reference.has_value();
+                rq.learn_nee_counts = c.learned;
                 rq.label = label(o.runs > 1 ? file + " run " + std::to_string(run + 1) : file);
                 std::vector<float> rgb;
                 row.runs.push_back(render_in_mode(t.mode, c.index, rq, rgb));

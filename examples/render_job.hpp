@@ -44,6 +44,11 @@ struct RenderRequest {
     nsp::EstimatorOptions estimator;
     std::string label;  ///< for the progress line
     bool pixel_stats = false;  ///< also return every pixel's mean and sample variance (RenderStats)
+    /// Learn the NEE count per tile (combinations with learns_nee_count only): the first
+    /// pilot_spp samples of every pixel at count 1 with an nsp::NeeCountLearner per tile_size^2
+    /// tile, the rest at the tile's chosen count. Every sample, the pilot's too, is in the stats.
+    bool learn_nee_counts = false;
+    int pilot_spp = 16, tile_size = 16;
 };
 
 /// What one render measured. The estimates of each sample are taken as linear RGB (mono: the value
@@ -62,6 +67,8 @@ struct RenderStats {
     /// Only with RenderRequest::pixel_stats: per pixel and channel (interleaved RGB, row-major),
     /// the mean of the spp samples and their sample variance (per sample, not of the mean).
     std::vector<double> pixel_mean, pixel_variance;
+    /// With RenderRequest::learn_nee_counts: the NEE count chosen for each tile (row-major tiles).
+    std::vector<float> nee_counts;
 
     /// The mean over the 3 channels of channel_variance.
     double variance_per_channel() const {

@@ -147,14 +147,28 @@ typename C::Scene make_scene(const SceneChoice& choice, const LightOverrides& o,
                              std::move(lights));
 }
 
+/// One pixel's running statistics and random stream (kept across the two passes of a render with
+/// learned NEE counts).
+struct PixelState {
+    nsp::Pcg32 rng;
+    std::array<Welford, 3> channel{};
+    Welford channel_mean;
+    Eigen::Array3d sum = Eigen::Array3d::Zero();
+    int k = 0;  ///< samples so far
+};
+
 /// Renders `scene` with combination C's estimator: per pixel, `spp` jittered camera rays (and in
 /// Hero mode a wavelength draw per path); one Pcg32 stream per pixel (so images do not depend on
 /// the thread count); rows handed out to threads through an atomic counter. Writes the mean
-/// linear RGB into `rgb`.
+/// linear RGB into `rgb`. With rq.learn_nee_counts (C::learns_nee_count), a first pass renders
+/// each tile's pilot samples at NEE count 1 with an nsp::NeeCountLearner as their counter, tiles
+/// handed out to threads (a tile's statistics in one fixed order: the chosen counts do not depend
+/// on the thread count); the second pass renders the rest at each tile's count.
 template <class C>
 RenderStats render(const typename C::Scene& scene, const RenderRequest& rq, std::vector<float>& rgb) {
     using S = typename C::Spectral;
-    const typename C::Estimator estimator{rq.estimator};
+    using Estimator = typename C::Estimator;
+    const Estimator estimator{rq.estimator};
     const int w = rq.width, h = rq.height;
     const float aspect = float(w) / float(h);
     rgb.assign(std::size_t(w) * std::size_t(h) * 3u, 0.f);
@@ -167,89 +181,156 @@ RenderStats render(const typename C::Scene& scene, const RenderRequest& rq, std:
     const nsp::ChannelSelection<S> fixed_selection =
         rq.selection == SelectionRule::Luminance ? luminance_selection<S>({}) : nsp::ChannelSelection<S>{};
 
-    std::atomic<int> next_row{0}, rows_done{0};
-    std::vector<ThreadTotals> totals(std::size_t(rq.threads));
-    Progress progress(rq.label, isatty(STDERR_FILENO) != 0);
-
-    auto work = [&](ThreadTotals& out) {
-        ThreadTotals t;  // local: the counters of different threads must not share a cache line
-        const double cpu0 = thread_cpu_seconds();
-        for (int y; (y = next_row.fetch_add(1)) < h;) {
-            for (int x = 0; x < w; ++x) {
-                const std::size_t pixel = std::size_t(y) * std::size_t(w) + std::size_t(x);
-                nsp::Pcg32 rng(rq.seed, pixel);
-                std::array<Welford, 3> channel{};
-                Welford channel_mean;
-                Eigen::Array3d sum = Eigen::Array3d::Zero();
-                for (int k = 1; k <= rq.spp; ++k) {
-                    const float u = (float(x) + rng.uniform()) / float(w);
-                    const float v = 1.f - (float(y) + rng.uniform()) / float(h);
-                    typename S::Wavelengths lambda{};
-                    if constexpr (nsp::is_hero_v<S>) lambda = S::Wavelengths::sample(rng.uniform());
-                    const nsp::Ray ray = camera_ray(u, v, aspect);
-                    nsp::RadianceSample<S> r;
-                    if constexpr (!C::uses_selection) {
-                        r = estimator.radiance(scene, ray, lambda, rng, t.counter);
-                    } else if constexpr (nsp::is_hero_v<S>) {  // luminance at this path's wavelengths
-                        if (rq.selection == SelectionRule::Luminance)
-                            r = estimator.radiance(scene, ray, lambda, luminance_selection<S>(lambda), rng, t.counter);
-                        else
-                            r = estimator.radiance(scene, ray, lambda, fixed_selection, rng, t.counter);
-                    } else {
-                        r = estimator.radiance(scene, ray, lambda, fixed_selection, rng, t.counter);
-                    }
-                    if (r.status == nsp::Status::Aborted) ++t.aborted;
-                    else if (r.status == nsp::Status::NonFinite) ++t.nonfinite;
-                    else if (r.status == nsp::Status::Rejected) ++t.rejected;
-                    if ((r.value != 0.f).any()) ++t.nonzero;
-                    const Eigen::Array3d c = to_linear_rgb<S>(r.value, lambda);
-                    sum += c;
-                    for (int i = 0; i < 3; ++i) channel[std::size_t(i)].add(c[i], k);
-                    channel_mean.add(c.mean(), k);
-                }
-                const double n1 = double(rq.spp - 1);
-                t.variance_of_mean_sum += channel_mean.m2 / n1;
-                for (int i = 0; i < 3; ++i) {
-                    t.variance_sum[std::size_t(i)] += channel[std::size_t(i)].m2 / n1;
-                    t.mean_sum[std::size_t(i)] += channel[std::size_t(i)].mean;
-                    rgb[3 * pixel + std::size_t(i)] = float(sum[i] / double(rq.spp));
-                    if (rq.pixel_stats) {
-                        pixel_mean[3 * pixel + std::size_t(i)] = channel[std::size_t(i)].mean;
-                        pixel_variance[3 * pixel + std::size_t(i)] = channel[std::size_t(i)].m2 / n1;
-                    }
-                }
-            }
-            progress.update(rows_done.fetch_add(1) + 1, h);
+    // One sample of pixel (x, y) with estimator `est` and counter `counter`; returns the
+    // estimate's channel mean (what a NeeCountLearner records its contributions in).
+    auto sample = [&](const auto& est, auto& counter, PixelState& px, int x, int y, ThreadTotals& t) {
+        nsp::Pcg32& rng = px.rng;
+        const float u = (float(x) + rng.uniform()) / float(w);
+        const float v = 1.f - (float(y) + rng.uniform()) / float(h);
+        typename S::Wavelengths lambda{};
+        if constexpr (nsp::is_hero_v<S>) lambda = S::Wavelengths::sample(rng.uniform());
+        const nsp::Ray ray = camera_ray(u, v, aspect);
+        nsp::RadianceSample<S> r;
+        if constexpr (!C::uses_selection) {
+            r = est.radiance(scene, ray, lambda, rng, counter);
+        } else if constexpr (nsp::is_hero_v<S>) {  // luminance at this path's wavelengths
+            if (rq.selection == SelectionRule::Luminance)
+                r = est.radiance(scene, ray, lambda, luminance_selection<S>(lambda), rng, counter);
+            else
+                r = est.radiance(scene, ray, lambda, fixed_selection, rng, counter);
+        } else {
+            r = est.radiance(scene, ray, lambda, fixed_selection, rng, counter);
         }
-        t.cpu_seconds = thread_cpu_seconds() - cpu0;
-        out = t;
+        if (r.status == nsp::Status::Aborted) ++t.aborted;
+        else if (r.status == nsp::Status::NonFinite) ++t.nonfinite;
+        else if (r.status == nsp::Status::Rejected) ++t.rejected;
+        if ((r.value != 0.f).any()) ++t.nonzero;
+        const Eigen::Array3d c = to_linear_rgb<S>(r.value, lambda);
+        px.sum += c;
+        ++px.k;
+        for (int i = 0; i < 3; ++i) px.channel[std::size_t(i)].add(c[i], px.k);
+        px.channel_mean.add(c.mean(), px.k);
+        return double(r.value.mean());
+    };
+    auto finish_pixel = [&](const PixelState& px, std::size_t pixel, ThreadTotals& t) {
+        const double n1 = double(rq.spp - 1);
+        t.variance_of_mean_sum += px.channel_mean.m2 / n1;
+        for (int i = 0; i < 3; ++i) {
+            const Welford& ch = px.channel[std::size_t(i)];
+            t.variance_sum[std::size_t(i)] += ch.m2 / n1;
+            t.mean_sum[std::size_t(i)] += ch.mean;
+            rgb[3 * pixel + std::size_t(i)] = float(px.sum[i] / double(rq.spp));
+            if (rq.pixel_stats) {
+                pixel_mean[3 * pixel + std::size_t(i)] = ch.mean;
+                pixel_variance[3 * pixel + std::size_t(i)] = ch.m2 / n1;
+            }
+        }
     };
 
-    const auto t0 = std::chrono::steady_clock::now();
-    {
-        std::vector<std::jthread> pool;
-        for (int i = 1; i < rq.threads; ++i) pool.emplace_back(work, std::ref(totals[std::size_t(i)]));
-        work(totals[0]);
-    }
+    std::atomic<int> next_row{0}, rows_done{0};
+    std::vector<ThreadTotals> totals(std::size_t(rq.threads)), pilot_totals(std::size_t(rq.threads));
+    Progress progress(rq.label, isatty(STDERR_FILENO) != 0);
     RenderStats st;
+    const auto t0 = std::chrono::steady_clock::now();
+    auto run_pool = [&](auto& work, std::vector<ThreadTotals>& out) {
+        std::vector<std::jthread> pool;
+        for (int i = 1; i < rq.threads; ++i) pool.emplace_back(work, std::ref(out[std::size_t(i)]));
+        work(out[0]);
+    };
+
+    if constexpr (C::learns_nee_count) {
+        if (rq.learn_nee_counts) {
+            // Pass 1: the pilot, tile by tile, at count 1.
+            const int ts = rq.tile_size, tiles_x = (w + ts - 1) / ts, tiles_y = (h + ts - 1) / ts;
+            const int pilot = std::min(rq.pilot_spp, rq.spp);
+            std::vector<PixelState> px(std::size_t(w) * std::size_t(h));
+            for (std::size_t p = 0; p < px.size(); ++p) px[p].rng = nsp::Pcg32(rq.seed, p);
+            st.nee_counts.assign(std::size_t(tiles_x) * std::size_t(tiles_y), 1.f);
+            std::atomic<int> next_tile{0};
+            auto pilot_work = [&](ThreadTotals& out) {
+                ThreadTotals t;
+                const double cpu0 = thread_cpu_seconds();
+                for (int tile; (tile = next_tile.fetch_add(1)) < tiles_x * tiles_y;) {
+                    nsp::NeeCountLearner learner;
+                    const int x0 = (tile % tiles_x) * ts, y0 = (tile / tiles_x) * ts;
+                    for (int y = y0; y < std::min(h, y0 + ts); ++y)
+                        for (int x = x0; x < std::min(w, x0 + ts); ++x) {
+                            PixelState& state = px[std::size_t(y) * std::size_t(w) + std::size_t(x)];
+                            for (int k = 0; k < pilot; ++k) learner.end_sample(sample(estimator, learner, state, x, y, t));
+                            learner.end_pixel();
+                        }
+                    st.nee_counts[std::size_t(tile)] = learner.choose();
+                    t.counter.n += learner.count();
+                    t.counter.steps += learner.steps();
+                }
+                t.cpu_seconds = thread_cpu_seconds() - cpu0;
+                out = t;
+            };
+            run_pool(pilot_work, pilot_totals);
+            // Pass 2: the rest of each pixel's samples at its tile's count.
+            std::vector<Estimator> at_count;
+            for (int j = 0; j < nsp::NeeCountLearner::kCandidates; ++j) {
+                nsp::EstimatorOptions o = rq.estimator;
+                o.nee_count = nsp::NeeCountLearner::candidate(j);
+                at_count.emplace_back(o);
+            }
+            auto work = [&](ThreadTotals& out) {
+                ThreadTotals t;
+                const double cpu0 = thread_cpu_seconds();
+                for (int y; (y = next_row.fetch_add(1)) < h;) {
+                    for (int x = 0; x < w; ++x) {
+                        const std::size_t pixel = std::size_t(y) * std::size_t(w) + std::size_t(x);
+                        const float count = st.nee_counts[std::size_t((y / ts) * tiles_x + x / ts)];
+                        const Estimator& est = at_count[std::size_t(std::lround(-std::log2(count)))];
+                        PixelState& state = px[pixel];
+                        while (state.k < rq.spp) sample(est, t.counter, state, x, y, t);
+                        finish_pixel(state, pixel, t);
+                    }
+                    progress.update(rows_done.fetch_add(1) + 1, h);
+                }
+                t.cpu_seconds = thread_cpu_seconds() - cpu0;
+                out = t;
+            };
+            run_pool(work, totals);
+        }
+    }
+    if (!rq.learn_nee_counts || !C::learns_nee_count) {
+        auto work = [&](ThreadTotals& out) {
+            ThreadTotals t;  // local: the counters of different threads must not share a cache line
+            const double cpu0 = thread_cpu_seconds();
+            for (int y; (y = next_row.fetch_add(1)) < h;) {
+                for (int x = 0; x < w; ++x) {
+                    const std::size_t pixel = std::size_t(y) * std::size_t(w) + std::size_t(x);
+                    PixelState state{nsp::Pcg32(rq.seed, pixel)};
+                    for (int k = 1; k <= rq.spp; ++k) sample(estimator, t.counter, state, x, y, t);
+                    finish_pixel(state, pixel, t);
+                }
+                progress.update(rows_done.fetch_add(1) + 1, h);
+            }
+            t.cpu_seconds = thread_cpu_seconds() - cpu0;
+            out = t;
+        };
+        run_pool(work, totals);
+    }
     st.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     st.samples = std::uint64_t(w) * std::uint64_t(h) * std::uint64_t(rq.spp);
     double var_mean = 0.0;
     std::array<double, 3> var_channel{}, mean{};
-    for (const ThreadTotals& t : totals) {
-        st.lookups += t.counter.count();
-        st.steps += t.counter.steps;
-        st.aborted += t.aborted;
-        st.nonfinite += t.nonfinite;
-        st.rejected += t.rejected;
-        st.nonzero += t.nonzero;
-        st.cpu_seconds += t.cpu_seconds;
-        var_mean += t.variance_of_mean_sum;
-        for (int i = 0; i < 3; ++i) {
-            var_channel[std::size_t(i)] += t.variance_sum[std::size_t(i)];
-            mean[std::size_t(i)] += t.mean_sum[std::size_t(i)];
+    for (const auto* list : {&totals, &pilot_totals})
+        for (const ThreadTotals& t : *list) {
+            st.lookups += t.counter.count();
+            st.steps += t.counter.steps;
+            st.aborted += t.aborted;
+            st.nonfinite += t.nonfinite;
+            st.rejected += t.rejected;
+            st.nonzero += t.nonzero;
+            st.cpu_seconds += t.cpu_seconds;
+            var_mean += t.variance_of_mean_sum;
+            for (int i = 0; i < 3; ++i) {
+                var_channel[std::size_t(i)] += t.variance_sum[std::size_t(i)];
+                mean[std::size_t(i)] += t.mean_sum[std::size_t(i)];
+            }
         }
-    }
     const double pixels = double(w) * double(h);
     st.variance_of_mean = var_mean / pixels;
     for (int i = 0; i < 3; ++i) {

@@ -116,6 +116,22 @@ void print_majorant_comparison(const std::vector<Row>& rows, const Metrics& m) {
     }
 }
 
+/// For each row with learned NEE counts, how many tiles (of the first run) chose each count.
+void print_learned_counts(const std::vector<Row>& rows) {
+    for (const Row& r : rows) {
+        if (!r.c.learned || r.runs.empty()) continue;
+        const RenderRequest defaults;
+        std::printf("learned NEE counts (%s, %d-spp pilot at count 1 per %dx%d tile, nsp::NeeCountLearner): tiles at",
+                    r.c.name.c_str(), defaults.pilot_spp, defaults.tile_size, defaults.tile_size);
+        for (int j = 0; j < nsp::NeeCountLearner::kCandidates; ++j) {
+            const float c = nsp::NeeCountLearner::candidate(j);
+            const auto n = std::count(r.runs[0].nee_counts.begin(), r.runs[0].nee_counts.end(), c);
+            if (n > 0) std::printf(" 1/%d: %lld", 1 << j, (long long)n);
+        }
+        std::printf("\n");
+    }
+}
+
 /// Footer lines every table shares: medians, status counts, majorants, rarely nonzero rows.
 void print_common_footer(const TablePlan& t, const Options& o, const std::vector<Row>& rows) {
     if (o.runs > 1)
@@ -147,6 +163,7 @@ void print_common_footer(const TablePlan& t, const Options& o, const std::vector
                         "variance and mean rest on those few and are themselves very noisy\n",
                         r.c.name.c_str(), (unsigned long long)r.nonzero(), (unsigned long long)samples);
     }
+    print_learned_counts(rows);
 }
 
 /// What the eff var/spl columns are (--reference-spp), and the reference they were measured against.

@@ -201,6 +201,13 @@ std::string summary_line(const TablePlan& t, const std::vector<Row>& rows) {
                 ratio_text(tv(*mis_t), tv(*single_t)) + (mis_t == mis_l && single_t == single_l
                                                              ? std::string()
                                                              : " (" + mis_t->c.name + " / " + single_t->c.name + ")");
+    // The same MIS with NEE counts learned per tile (nsp::NeeCountLearner), where the table has it.
+    const auto is_learned = [&](const Row& r) { return r.c.key == e.mis_key + "_learned"; };
+    const Row* learned_t = lowest(tv, is_learned);
+    const Row* learned_l = lowest(ltuv, is_learned);
+    if (learned_t && learned_l && single_t && single_l)
+        line += "; learned NEE counts / best single: time x variance " + ratio_text(tv(*learned_t), tv(*single_t)) +
+                " (" + learned_t->c.name + "), LTUV " + ratio_text(ltuv(*learned_l), ltuv(*single_l));
     if (best && !best->effective.empty()) line += "; effective variances";
     return line;
 }

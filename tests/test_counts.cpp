@@ -259,14 +259,18 @@ Prediction predict_and_measure(const Sc& scene, const Ray& ray, int spp, std::ui
     }
     for (int j = 0; j < kC; ++j) {
         const PathEstimator<strategy::NullScatteringMis, mis::Balance> est(with_count(NeeCountLearner::candidate(j)));
-        LookupCount lookups;
-        double n = 0.0;
+        // A learner as the counter measures the run's work in the cost model's units: at its
+        // first candidate (count 1, no scaling) predicted_cost is the work per sample it saw.
+        NeeCountLearner work;
         for (int b = 0; b < kBatches; ++b) {
             Pcg32 rng(seed + 1000, std::uint64_t(b * kC + j));
             Stat s;
-            for (int i = 0; i < spp; ++i) s.add(double(est.radiance(scene, ray, {}, rng, lookups).value.mean()));
+            for (int i = 0; i < spp; ++i) {
+                const double v = double(est.radiance(scene, ray, {}, rng, work).value.mean());
+                s.add(v);
+                work.end_sample(v);
+            }
             meas[std::size_t(j)].add(s.variance());
-            n += s.n;
         }
         const auto k = std::size_t(j);
         out.predicted[k] = all.predicted_variance(j);
@@ -274,7 +278,7 @@ Prediction predict_and_measure(const Sc& scene, const Ray& ray, int spp, std::ui
         out.measured[k] = meas[k].mean;
         out.measured_se[k] = meas[k].se();
         out.predicted_cost[k] = all.predicted_cost(j);
-        out.measured_cost[k] = double(lookups.count()) / n + 1.0;
+        out.measured_cost[k] = work.predicted_cost(0);
     }
     out.chosen = all.choose();
     return out;
@@ -285,8 +289,8 @@ Prediction predict_and_measure(const Sc& scene, const Ray& ray, int spp, std::ui
 TEST_CASE("NeeCountLearner: the variance predicted from a count-1 pilot is the variance measured at each count") {
     // The prediction is exact in expectation (law of total variance over the NEE draws, THEORY
     // 5.9), covariances within a path included: checked against independent runs at every
-    // candidate count within 5 combined SE (from 10 batches each), the lookups per sample within
-    // 3 % (their SE is below 1 % here). Three scenes, each where a different answer wins:
+    // candidate count within 5 combined SE (from 10 batches each), the work per sample (lookups,
+    // DDA steps, shadow walks) within 3 % (its SE is below 1 % here). Three scenes, each where a different answer wins:
     // a thin isotropic cloud under a uniform sky (variance falls as NEE is drawn less: tracking's
     // escape and scattering are anticorrelated, NEE's transmittance estimates are not), a dense
     // forward-scattering cloud in front of a large dim sphere (variance almost flat, cost falls),
@@ -321,9 +325,12 @@ TEST_CASE("NeeCountLearner: the variance predicted from a count-1 pilot is the v
                                    "dense cloud, large sphere", 1000);
     const Prediction p_small = check(Scene(thin, GlobalMajorant<M>(thin), HenyeyGreensteinPhase(0.5f), small),
                                      "thin cloud, small sphere", 2000);
+    // a grid majorant: the DDA steps are part of the work
+    const Prediction p_grid = check(Scene(dense, GridMajorant<M>(dense, 8), HenyeyGreensteinPhase(0.9f), big),
+                                    "dense cloud, large sphere, grid majorant", 1000);
     // The choice is the measured best: variance x cost at the chosen count within 10 % of the
     // best measured candidate's (the measured products' own SE is ~3 %).
-    for (const Prediction* p : {&p_sky, &p_big, &p_small}) {
+    for (const Prediction* p : {&p_sky, &p_big, &p_small, &p_grid}) {
         double best = INFINITY, at_chosen = 0.0;
         for (int j = 0; j < NeeCountLearner::kCandidates; ++j) {
             const auto k = std::size_t(j);
@@ -353,7 +360,7 @@ TEST_CASE("NeeCountLearner: bookkeeping") {
             const float u = i % 2 ? 3.f : 1.f;
             for (int k = 0; k < 10; ++k) l.lookup();
             l.record_light(u, 0.f, 1.f, 0.f, 1.f, LightTechnique::Nee);
-            l.record_nee_lookups(5);
+            l.record_nee_work(5.0);  // + kShadowRayCost 1
             l.end_sample(double(u));
         }
         l.end_pixel();
@@ -361,7 +368,9 @@ TEST_CASE("NeeCountLearner: bookkeeping") {
         // At count c the estimate is B u / c: expectation u, variance E[u^2] (1 - c) / c on top.
         CHECK(l.predicted_variance(0) == doctest::Approx(100.0 / 99.0).epsilon(1e-9));
         CHECK(l.predicted_variance(1) == doctest::Approx(100.0 / 99.0 + 5.0).epsilon(1e-9));
-        CHECK(l.predicted_cost(1) == doctest::Approx(5.0 + 2.5 + 1.0).epsilon(1e-9));
+        // work 10 lookups + 1 fixed per sample, NEE's 6 of it: at count 1/2, 5 + 3 + the camera ray's 1
+        CHECK(l.predicted_cost(0) == doctest::Approx(11.0 + 1.0).epsilon(1e-9));
+        CHECK(l.predicted_cost(1) == doctest::Approx(5.0 + 3.0 + 1.0).epsilon(1e-9));
     }
     SUBCASE("a pilot at a count other than 1 is refused") {
         NeeCountLearner l;

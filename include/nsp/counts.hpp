@@ -21,7 +21,8 @@
 // paths, covariances within a path included (the ones that matter where tracking alone is nearly
 // noiseless, as in a furnace). NeeCountLearner keeps that for a ladder of candidate counts over a
 // pixel tile and picks the count that minimises variance x cost, the cost being density lookups
-// (deterministic, unlike time) with the shadow rays' share scaled by n (THEORY 5.9).
+// and DDA steps (deterministic, unlike time; a shadow walk's fixed work counted as one lookup) with
+// the shadow walks' share scaled by n (THEORY 5.9).
 #pragma once
 
 #include <array>
@@ -59,10 +60,10 @@ enum class LightTechnique : std::uint8_t {
 /// both tracking and NEE can make and the lookups of NEE's shadow rays. The estimators call these
 /// only on such counters; with any other counter they compile to nothing.
 template <class C>
-concept MisRecorder = LookupCounter<C> && requires(C& c, float f, LightTechnique t, std::uint64_t n) {
+concept MisRecorder = LookupCounter<C> && requires(C& c, float f, LightTechnique t, double w) {
     { c.record_light(f, f, f, f, f, t) } noexcept;
-    { c.record_nee_lookups(n) } noexcept;
-    { c.count() } -> std::convertible_to<std::uint64_t>;
+    { c.record_nee_work(w) } noexcept;
+    { c.work() } -> std::convertible_to<double>;
 };
 
 namespace detail {
@@ -78,17 +79,17 @@ void record_light(C& counter, float f_over_ref, float p_hit, float p_nee, float 
     if constexpr (MisRecorder<C>) counter.record_light(f_over_ref, p_hit, p_nee, p_other, count, t);
     else (void)counter, (void)f_over_ref, (void)p_hit, (void)p_nee, (void)p_other, (void)count, (void)t;
 }
-/// The lookups counted since `before` as NEE's, on a MisRecorder (else nothing).
+/// The work counted since `before` as one NEE shadow walk's, on a MisRecorder (else nothing).
 template <class C>
-void record_nee_lookups(C& counter, std::uint64_t before) noexcept {
-    if constexpr (MisRecorder<C>) counter.record_nee_lookups(counter.count() - before);
+void record_nee_work(C& counter, double before) noexcept {
+    if constexpr (MisRecorder<C>) counter.record_nee_work(counter.work() - before);
     else (void)counter, (void)before;
 }
-/// counter.count() on a MisRecorder, else 0 (what record_nee_lookups takes as `before`).
+/// counter.work() on a MisRecorder, else 0 (what record_nee_work takes as `before`).
 template <class C>
-std::uint64_t recorder_count(const C& counter) noexcept {
-    if constexpr (MisRecorder<C>) return counter.count();
-    else return (void)counter, 0;
+double recorder_work(const C& counter) noexcept {
+    if constexpr (MisRecorder<C>) return counter.work();
+    else return (void)counter, 0.0;
 }
 }  // namespace detail
 
@@ -105,9 +106,17 @@ public:
     /// The j-th candidate count, 2^-j.
     static constexpr float candidate(int j) noexcept { return 1.f / float(1 << j); }
 
+    /// A shadow walk's work besides its lookups and steps (the light sample, the phase or BSDF
+    /// evaluation, the walk's set-up), in lookups: an assumption of the cost model, about what a
+    /// lookup costs.
+    static constexpr double kShadowRayCost = 1.0;
+
     void lookup() noexcept { ++lookups_; }
-    void majorant_steps(std::uint64_t) noexcept {}
+    void majorant_steps(std::uint64_t k) noexcept { steps_ += k; }
     std::uint64_t count() const noexcept { return lookups_; }
+    std::uint64_t steps() const noexcept { return steps_; }  ///< grid-majorant DDA steps (as LookupCount's)
+    /// The work so far in lookups: lookups + kDdaStepCost x DDA steps.
+    double work() const noexcept { return double(lookups_) + double(kDdaStepCost) * double(steps_); }
 
     /// Called by the estimator for every light contribution both techniques can make (see
     /// detail::record_light). A pilot at a count other than 1 has no NEE sample at some vertices:
@@ -134,8 +143,11 @@ public:
             }
         }
     }
-    /// Called by the estimator after each NEE shadow walk with the lookups it took.
-    void record_nee_lookups(std::uint64_t n) noexcept { nee_lookups_ += n; }
+    /// Called by the estimator after each NEE shadow walk with the work (work()) it took.
+    void record_nee_work(double w) noexcept {
+        nee_work_ += w + kShadowRayCost;
+        fixed_work_ += kShadowRayCost;
+    }
 
     /// The host, after each pilot sample: its estimate (the channel mean the render measures).
     void end_sample(double estimate) noexcept {
@@ -170,7 +182,9 @@ public:
     /// Adds another learner's statistics (a tile learned in pieces; both after end_pixel).
     void merge(const NeeCountLearner& o) noexcept {
         lookups_ += o.lookups_;
-        nee_lookups_ += o.nee_lookups_;
+        steps_ += o.steps_;
+        nee_work_ += o.nee_work_;
+        fixed_work_ += o.fixed_work_;
         samples_ += o.samples_;
         variance_samples_ += o.variance_samples_;
         invalid_ = invalid_ || o.invalid_;
@@ -187,11 +201,13 @@ public:
         const double b = samples_ > 0 ? bernoulli_[std::size_t(j)] / double(samples_) : 0.0;
         return a + b;
     }
-    /// Predicted lookups per sample at candidate j (+1 per sample for the camera ray, so that a
-    /// tile whose paths never meet the medium still has a cost).
+    /// Predicted work per sample at candidate j in lookups: lookups and DDA steps (work()), with
+    /// NEE's share (its shadow walks' work and kShadowRayCost each) scaled by the count, +1 per
+    /// sample for the camera ray (so that a tile whose paths never meet the medium has a cost).
     double predicted_cost(int j) const noexcept {
         if (samples_ == 0) return 1.0;
-        return (double(lookups_ - nee_lookups_) + double(candidate(j)) * double(nee_lookups_)) / double(samples_) + 1.0;
+        const double base = work() + fixed_work_ - nee_work_;
+        return (base + double(candidate(j)) * nee_work_) / double(samples_) + 1.0;
     }
 
     /// The candidate count with the smallest predicted variance x cost; 1 when there is nothing to
@@ -210,11 +226,12 @@ public:
 
     bool invalid_pilot() const noexcept { return invalid_; }
     std::uint64_t samples() const noexcept { return samples_; }
-    std::uint64_t nee_lookups() const noexcept { return nee_lookups_; }
+    double nee_work() const noexcept { return nee_work_; }  ///< NEE's work in lookups (see predicted_cost)
 
 private:
     using PerCandidate = std::array<double, kCandidates>;
-    std::uint64_t lookups_ = 0, nee_lookups_ = 0, samples_ = 0, variance_samples_ = 0;
+    std::uint64_t lookups_ = 0, steps_ = 0, samples_ = 0, variance_samples_ = 0;
+    double nee_work_ = 0.0, fixed_work_ = 0.0;
     int pixel_n_ = 0;
     bool invalid_ = false;
     PerCandidate path_delta_{}, path_bernoulli_{};         // the current sample

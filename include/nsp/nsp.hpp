@@ -5,6 +5,7 @@
 #include "camera.hpp"
 #include "channel_tracking.hpp"
 #include "color.hpp"
+#include "counts.hpp"
 #include "core/counter.hpp"
 #include "core/error.hpp"
 #include "core/math.hpp"

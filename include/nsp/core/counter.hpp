@@ -16,6 +16,11 @@ concept LookupCounter = requires(C& c) {
     { C::enabled } -> std::convertible_to<bool>;
 };
 
+/// A grid majorant's DDA step's cost in density lookups, for the cost models that weigh both
+/// (majorants/choose.hpp, counts.hpp): a step about 20 ns, a tracked trilinear lookup about 60 ns
+/// on the 2-core CI machine (docs/majorants.md).
+inline constexpr float kDdaStepCost = 0.3f;
+
 /// Counts nothing and costs nothing.
 struct NoLookupCount {
     static constexpr bool enabled = false;

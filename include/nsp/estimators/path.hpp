@@ -243,9 +243,9 @@ private:
         if (!(ls.pdf > 0.f)) return Status::Ok;
         const Ray shadow{x, ls.wi};
         if (ls.occludable_by_sphere && scene.lights.sphere_blocks(shadow, ls.distance)) return Status::Ok;
-        const std::uint64_t before = detail::recorder_count(counter);
+        const double before = detail::recorder_work(counter);
         const auto tr = kernels_.shadow(scene.medium, scene.majorant, shadow, ls.distance, lambda, rng, counter);
-        detail::record_nee_lookups(counter, before);
+        detail::record_nee_work(counter, before);
         if (tr.status != Status::Ok) return tr.status;
         if (!(tr.transmittance != 0.f).any()) return Status::Ok;
         const float count = equiangular_drawn ? 1.f : kernels_.nee_count();

@@ -91,10 +91,10 @@ Status light_event(const K& k, const Sc& sc, const SceneVertex& v, const Vec3& x
     if (!(ls.sample.pdf > 0.f)) return Status::Ok;
     const auto f = eval_vertex(sc, v, wo, ls.sample.wi, lambda);
     if (!(f.value != 0.f).any()) return Status::Ok;
-    const std::uint64_t before = recorder_count(counter);
+    const double before = recorder_work(counter);
     const auto sh = shadow_through(k, sc, Ray{x, f.wi}, shadow_distance(ls.sample.distance), start_medium(f.wi), lambda,
                                    rng, counter);
-    record_nee_lookups(counter, before);
+    record_nee_work(counter, before);
     if (sh.status != Status::Ok) return sh.status;
     if (!(sh.transmittance != 0.f).any()) return Status::Ok;
     // NEE from a tracked vertex or a surface ran with the expected count nee_count; from an

@@ -28,9 +28,9 @@
 
 namespace nsp {
 
-/// A DDA step's cost in density lookups that choose_grid_resolution assumes by default: a step
-/// about 20 ns, a tracked trilinear lookup about 60 ns on this machine (docs/majorants.md).
-inline constexpr float kDefaultStepCost = 0.3f;
+/// The DDA step's cost in density lookups that choose_grid_resolution assumes by default
+/// (core/counter.hpp: kDdaStepCost).
+inline constexpr float kDefaultStepCost = kDdaStepCost;
 
 /// What the cost model expects of a majorant per random line through the medium's bounds.
 struct MajorantCost {
