@@ -383,15 +383,15 @@ TEST_CASE("NeeCountLearner: bookkeeping") {
     }
 }
 
-TEST_CASE("NEE counts: a count outside (0, 1] is rejected by name; estimators without counts reject any but 1") {
+TEST_CASE("NEE counts: a count outside (0, 1] is rejected by name; BDPT rejects any but 1") {
     for (const float bad : {0.f, -0.5f, 1.5f, std::nanf("")}) {
         CAPTURE(bad);
         CHECK_THROWS_WITH_AS((PathEstimator<strategy::NullScatteringMis, mis::Balance>(with_count(bad))),
                              doctest::Contains("nee_count"), InvalidArgument);
     }
     CHECK_THROWS_WITH_AS((SpectralPathEstimator<channels::SpectralMis, strategy::NullScatteringMis, mis::Balance>(
-                             with_count(0.5f))),
-                         doctest::Contains("nsp::SpectralPathEstimator"), InvalidArgument);
+                             with_count(1.5f))),
+                         doctest::Contains("nee_count"), InvalidArgument);
     CHECK_THROWS_WITH_AS((BdptEstimator<bdpt::NullScattering, mis::Balance>(with_count(0.5f, BdptEstimator<>::default_options()))),
                          doctest::Contains("nsp::BdptEstimator"), InvalidArgument);
     CHECK_NOTHROW((PathEstimator<strategy::NullScatteringMis, mis::Balance>(with_count(1e-3f))));

@@ -134,11 +134,12 @@ Stat mono_reference(float sa, float ss, const Ray& ray, int n, bool grid) {
     return stat_of(make_medium<HomogeneousMedium<Mono>>(kBox, 1.f, grey<Mono>(sa), grey<Mono>(ss)));
 }
 
-TEST_CASE_TEMPLATE_DEFINE("spectral estimators: an Rgb medium agrees with three Mono media, one per channel "
-                          "(uniform and non-uniform channel selection)", E, rgb_as_three_mono) {
+/// Estimator `est` on an Rgb medium against three Mono media at NEE count 1, one per channel.
+template <class E>
+void check_rgb_as_three_mono(const E& est) {
     const std::string name = spectral_estimator_name<E>();
     CAPTURE(name);
-    const E est;
+    CAPTURE(est.options().nee_count);
     // Albedo 0.8, extinction 0.5 : 1 : 2 per unit density.
     const float ext[3] = {0.5f, 1.f, 2.f};
     const Ray ray{Vec3(0.2f, -0.1f, -3.f), glm::normalize(Vec3(-0.05f, 0.1f, 1.f))};
@@ -173,8 +174,21 @@ TEST_CASE_TEMPLATE_DEFINE("spectral estimators: an Rgb medium agrees with three 
     }
 }
 
+TEST_CASE_TEMPLATE_DEFINE("spectral estimators: an Rgb medium agrees with three Mono media, one per channel "
+                          "(uniform and non-uniform channel selection)", E, rgb_as_three_mono) {
+    check_rgb_as_three_mono(E{});
+}
+
+TEST_CASE_TEMPLATE_DEFINE("spectral estimators at NEE count 0.3 (THEORY 5.9) agree with three Mono media at count 1",
+                          E, rgb_counts) {
+    EstimatorOptions o;
+    o.nee_count = 0.3f;
+    check_rgb_as_three_mono(E(o));
+}
+
 using AbsorbWeightSpectralEstimators = SpectralEstimatorsWith<absorption::Weight>;
 TEST_CASE_TEMPLATE_APPLY(rgb_as_three_mono, AbsorbWeightSpectralEstimators);
+TEST_CASE_TEMPLATE_APPLY(rgb_counts, AbsorbWeightSpectralEstimators);
 
 TEST_CASE_TEMPLATE_DEFINE("a grey medium gives the same mean in every mode and tracker", E, grey_every_mode) {
     const std::string name = spectral_estimator_name<E>();

@@ -110,6 +110,16 @@ TEST_CASE_TEMPLATE_DEFINE("spectral surfaces: the white furnace gives 1 in every
 TEST_CASE_TEMPLATE_APPLY(spectral_white_furnace, SpectralEstimatorsWith<absorption::Weight>);
 TEST_CASE_TEMPLATE_APPLY(spectral_white_furnace, SpectralEquiangular);
 
+TEST_CASE_TEMPLATE_DEFINE("spectral surfaces: the white furnace gives 1 at NEE count 0.3 (Rgb, THEORY 5.9)", E,
+                          spectral_white_furnace_counts) {
+    CAPTURE(spectral_estimator_name<E>());
+    EstimatorOptions o;
+    o.nee_count = 0.3f;
+    check_zero_error(run(E(o), white_furnace<E, Rgb>(), 12000, 45, furnace_ray, Rgb::Spectrum::Ones()));
+}
+TEST_CASE_TEMPLATE_APPLY(spectral_white_furnace_counts, SpectralEstimatorsWith<absorption::Weight>);
+TEST_CASE_TEMPLATE_APPLY(spectral_white_furnace_counts, SpectralEquiangular);
+
 TEST_CASE("spectral surfaces: the white furnace gives 1 at every wavelength (Hero<4>)") {
     using H = Hero<4>;
     using E1 = SpectralPathEstimator<channels::SpectralMis, strategy::NullScatteringMis, mis::Balance>;

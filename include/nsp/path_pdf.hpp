@@ -20,6 +20,7 @@
 #include <type_traits>
 
 #include "core/error.hpp"
+#include "counts.hpp"
 #include "spectrum.hpp"
 
 namespace nsp {
@@ -254,6 +255,27 @@ Spec channel_estimate(const Spec& f, const Spec& pdf, const Spec& q, int c) noex
         const float d = q[c] * pdf[c];
         if (d > 0.f) out[c] = f[c] / d;
         return out;
+    }
+}
+
+/// Records a light contribution of the spectral estimators on a MisRecorder (counts.hpp; else
+/// nothing): channel_estimate's numerator `f` (every channel, the light's radiance included) and
+/// its denominator split into the techniques' pdf sums, tracking that hits the light `uni`, NEE
+/// from a tracked vertex or a surface without its count `nee`, and a technique of fixed count
+/// `other` (equiangular + NEE). Under either policy the contribution is u / (d_uni + count d_nee +
+/// d_other), u the channel mean of the numerator, which is what the learner needs.
+template <ChannelPolicy CP, class C, class Spec>
+void record_channels(C& counter, const Spec& f, const Spec& uni, const Spec& nee, const Spec& other, const Spec& q,
+                     int c, float count, LightTechnique t) noexcept {
+    if constexpr (MisRecorder<C>) {
+        if constexpr (CP::mis_over_channels) {
+            detail::record_light(counter, f.mean(), (q * uni).sum(), (q * nee).sum(), (q * other).sum(), count, t);
+        } else {
+            detail::record_light(counter, f[c] / float(Spec::SizeAtCompileTime), q[c] * uni[c], q[c] * nee[c],
+                                 q[c] * other[c], count, t);
+        }
+    } else {
+        (void)counter, (void)f, (void)uni, (void)nee, (void)other, (void)q, (void)c, (void)count, (void)t;
     }
 }
 

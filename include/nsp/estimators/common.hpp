@@ -95,9 +95,9 @@ struct EstimatorOptions {
     /// counts.hpp): NEE runs there with this probability, its estimate divided by it, and the MIS
     /// weights of both techniques take nee_count x the light pdf. 1: NEE at every vertex. Below 1
     /// it trades variance for the shadow rays' cost where tracking finds the light well (a large
-    /// light, an environment); NeeCountLearner chooses it per pixel tile. nsp::PathEstimator
-    /// (every strategy that samples lights, NEE from equiangular vertices excepted: they exist for
-    /// it); the spectral and bidirectional estimators reject a value other than 1.
+    /// light, an environment); NeeCountLearner chooses it per pixel tile. nsp::PathEstimator and
+    /// nsp::SpectralPathEstimator (every strategy that samples lights, NEE from equiangular
+    /// vertices excepted: they exist for it); nsp::BdptEstimator rejects a value other than 1.
     float nee_count = 1.f;
 };
 

@@ -62,10 +62,7 @@ public:
     using Absorption = A;
 
     /// Throws InvalidArgument on the option values PathEstimator rejects.
-    explicit SpectralPathEstimator(EstimatorOptions opts = {}) : opts_(opts) {
-        validate(opts);
-        require_unit_nee_count(opts, "nsp::SpectralPathEstimator");
-    }
+    explicit SpectralPathEstimator(EstimatorOptions opts = {}) : opts_(opts) { validate(opts); }
 
     const EstimatorOptions& options() const noexcept { return opts_; }
 
@@ -129,7 +126,7 @@ private:
                     const Interval in = scene.medium.bounds().clip(ray, 0.f, hit.t);
                     eq = EquiangularSampler(ray, *target, in.t0, in.t1);
                     eq_select = equiangular_selection<St>(opts_, scene, ray, eq, lambda);
-                    if (depth < opts_.max_depth && (eq_select >= 1.f || rng.uniform() < eq_select)) {
+                    if (depth < opts_.max_depth && draw_technique(eq_select, rng)) {
                         const Status es =
                             equiangular_vertex(scene, ray, eq, eq_select, depth + 1, lambda, q, c, st, rng, counter, L);
                         if (es == Status::NonFinite) return {Spectrum::Zero(), es};  // an overflowed flight: see below
@@ -173,12 +170,19 @@ private:
             }
             if (seg.end == SegmentEnd::Passed) {
                 if (from_camera || St::hits_lights) {
+                    // NEE's pdf with its expected count (THEORY 5.9; equiangular + NEE has count 1)
+                    const float n = opts_.nee_count;
                     Spectrum pdf = st.uni;
+                    const Spectrum le = scene.lights.emitted(hit, lambda);
                     if (nee_alternative) {
-                        if constexpr (St::equiangular) pdf += scene.lights.pdf(prev_x, hit) * (st.nee + st.eq.nee);
-                        else pdf += scene.lights.pdf(prev_x, hit) * st.nee;
+                        const float p_light = scene.lights.pdf(prev_x, hit);
+                        Spectrum other = Spectrum::Zero();
+                        if constexpr (St::equiangular) other = p_light * st.eq.nee;
+                        pdf += n * p_light * st.nee + other;
+                        record_channels<CP>(counter, Spectrum(st.f * le), st.uni, Spectrum(p_light * st.nee), other, q, c,
+                                            n, LightTechnique::Hit);
                     }
-                    L += channel_estimate<CP>(st.f, pdf, q, c) * scene.lights.emitted(hit, lambda);
+                    L += channel_estimate<CP>(st.f, pdf, q, c) * le;
                 }
                 break;
             }
@@ -198,8 +202,10 @@ private:
                 rr = std::min(opts_.rr_max_survival, channel_estimate<CP>(st.f, st.uni, q, c).abs().maxCoeff());
             if constexpr (St::samples_lights) {
                 // Equiangular + NEE alone leaves the lights to its own vertices when it has a target.
-                if (St::combines || !St::equiangular || !target) {
-                    const Status ns = next_event(scene, x, ray.d, rr, lambda, q, c, st.f, st.uni, eq_pdf, rng, counter, L);
+                // NEE at the expected count EstimatorOptions::nee_count (THEORY 5.9).
+                if ((St::combines || !St::equiangular || !target) && draw_technique(opts_.nee_count, rng)) {
+                    const Status ns =
+                        next_event(scene, x, ray.d, rr, lambda, q, c, st.f, st.uni, eq_pdf, false, rng, counter, L);
                     if (ns == Status::NonFinite) return {Spectrum::Zero(), ns};  // an overflowed flight: see below
                     if (ns != Status::Ok) status = ns;
                 }
@@ -240,35 +246,40 @@ private:
     /// Adds NEE's contribution at real vertex x (arrived along wo, roulette survival rr) to L:
     /// `f` is every channel's contribution of the path up to x, `p_track` its tracking pdf and
     /// `p_eq` its equiangular pdf (0 without equiangular sampling), all relative to one
-    /// normaliser. Returns Aborted or Rejected if the shadow flight was, else Ok.
+    /// normaliser; `equiangular_drawn` says x is an equiangular vertex (NEE there has count 1,
+    /// from a tracked vertex nee_count: tracking + NEE's pdf carries it either way). Returns
+    /// Aborted or Rejected if the shadow flight was, else Ok.
     template <class Sc, UniformRng R, LookupCounter C>
     Status next_event(const Sc& scene, const Vec3& x, const Vec3& wo, float rr,
                       const typename Sc::Spectral::Wavelengths& lambda, const typename Sc::Spectrum& q, int c,
                       const typename Sc::Spectrum& f_x, const typename Sc::Spectrum& p_track,
-                      const typename Sc::Spectrum& p_eq, R& rng, C& counter, typename Sc::Spectrum& L) const {
+                      const typename Sc::Spectrum& p_eq, bool equiangular_drawn, R& rng, C& counter,
+                      typename Sc::Spectrum& L) const {
         const float u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
         const LightSample<typename Sc::Spectral> ls = scene.lights.sample(x, u0, u1, u2, lambda);
         if (!(ls.pdf > 0.f)) return Status::Ok;
         const Ray shadow{x, ls.wi};
         if (ls.occludable_by_sphere && scene.lights.sphere_blocks(shadow, ls.distance)) return Status::Ok;
         const bool uni_alternative = St::combines && !ls.delta;  // a point light cannot be hit
+        const double before = detail::recorder_work(counter);
         const auto sh = track_channels_ratio<CP, A>(scene.medium, scene.majorant, shadow, ls.distance, lambda, c,
                                                     f_x, uni_alternative, rng, counter);
+        detail::record_nee_work(counter, before);
         if (const Status fs = flight_status(sh.end); fs != Status::Ok) return fs;
         if (sh.end == SegmentEnd::Terminated) return Status::Ok;
         using Spectrum = typename Sc::Spectrum;
         const Spectrum f = f_x * sh.f * scene.phase.eval(wo, ls.wi);
-        Spectrum pdf;
-        if constexpr (St::equiangular) {
-            // Tracking + NEE, equiangular + NEE, tracking + hit (THEORY 5.4 with 5.1, 5.3).
-            pdf = (p_track + p_eq) * (ls.pdf * sh.nee);
-            if (uni_alternative) pdf += p_track * ((rr * scene.phase.pdf(wo, ls.wi)) * sh.uni);
-        } else {
-            Spectrum seg_pdf = ls.pdf * sh.nee;
-            if (uni_alternative) seg_pdf += (rr * scene.phase.pdf(wo, ls.wi)) * sh.uni;
-            pdf = p_track * seg_pdf;
-        }
-        L += channel_estimate<CP, Spectrum>(f, pdf, q, c) * ls.radiance;
+        // Tracking + NEE (its count n), tracking + hit, and equiangular + NEE (count 1) (THEORY 5.4
+        // with 5.1, 5.3, 5.9); p_eq is 0 without equiangular sampling.
+        const float n = opts_.nee_count;
+        const Spectrum nee = p_track * (ls.pdf * sh.nee);
+        Spectrum uni = Spectrum::Zero(), other = Spectrum::Zero();
+        if (uni_alternative) uni = p_track * ((rr * scene.phase.pdf(wo, ls.wi)) * sh.uni);
+        if constexpr (St::equiangular) other = p_eq * (ls.pdf * sh.nee);
+        else (void)p_eq;
+        record_channels<CP>(counter, Spectrum(f * ls.radiance), uni, nee, other, q, c, n,
+                            equiangular_drawn ? LightTechnique::Other : LightTechnique::Nee);
+        L += channel_estimate<CP, Spectrum>(f, Spectrum(n * nee + uni + other), q, c) * ls.radiance;
         return Status::Ok;
     }
 
@@ -407,7 +418,7 @@ private:
             if (opts_.russian_roulette && depth >= opts_.rr_start_depth)
                 rr = std::min(opts_.rr_max_survival, channel_estimate<CP>(f_x, p_track, q, c).abs().maxCoeff());
         }
-        return next_event(scene, x, ray.d, rr, lambda, q, c, f_x, p_track, p_eq, rng, counter, L);
+        return next_event(scene, x, ray.d, rr, lambda, q, c, f_x, p_track, p_eq, true, rng, counter, L);
     }
 
     EstimatorOptions opts_;

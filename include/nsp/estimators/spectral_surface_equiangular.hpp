@@ -86,8 +86,8 @@ template <ChannelPolicy CP, PathStrategy St, AbsorptionPolicy A, class Sc, class
 Status channel_light_event(const Sc& sc, const SceneVertex& v, const Vec3& x, const Vec3& wo, float rr,
                            StartMedium start_medium, const typename Sc::Spectral::Wavelengths& lambda,
                            const typename Sc::Spectrum& q, int c, const typename Sc::Spectrum& f_x,
-                           const typename Sc::Spectrum& p_track, const typename Sc::Spectrum& p_eq, R& rng, C& counter,
-                           typename Sc::Spectrum& L) {
+                           const typename Sc::Spectrum& p_track, const typename Sc::Spectrum& p_eq, float nee_count,
+                           bool eq_drawn, R& rng, C& counter, typename Sc::Spectrum& L) {
     using Spectrum = typename Sc::Spectrum;
     const float u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
     if (v.on_surface() && sc.materials.is_delta(v.material)) return Status::Ok;
@@ -96,22 +96,23 @@ Status channel_light_event(const Sc& sc, const SceneVertex& v, const Vec3& x, co
     const auto fv = eval_vertex(sc, v, wo, ls.sample.wi, lambda);
     if (!(fv.value != 0.f).any()) return Status::Ok;
     const bool uni_alternative = St::combines && !ls.sample.delta;
+    const double before = recorder_work(counter);
     const auto sh = channel_shadow_through<CP, A>(sc, Ray{x, fv.wi}, shadow_distance(ls.sample.distance),
                                                   start_medium(fv.wi), lambda, c, f_x, uni_alternative, rng, counter);
+    record_nee_work(counter, before);
     if (sh.end != SegmentEnd::Passed) return shadow_status(sh.end);
     if (!(sh.f != 0.f).any()) return Status::Ok;
-    Spectrum pdf;
-    if constexpr (St::equiangular) {
-        // Tracking + NEE, equiangular + NEE, tracking + hit (THEORY 5.4 with 5.1, 5.3).
-        pdf = (p_track + p_eq) * (ls.sample.pdf * sh.nee);
-        if (uni_alternative) pdf += p_track * ((rr * fv.pdf) * sh.uni);
-    } else {
-        (void)p_eq;
-        Spectrum seg_pdf = ls.sample.pdf * sh.nee;
-        if (uni_alternative) seg_pdf += (rr * fv.pdf) * sh.uni;
-        pdf = p_track * seg_pdf;
-    }
-    L += channel_estimate<CP>(Spectrum(f_x * sh.f * fv.value), pdf, q, c) * ls.sample.radiance;
+    // Tracking + NEE (its expected count), tracking + hit, and equiangular + NEE (count 1)
+    // (THEORY 5.4 with 5.1, 5.3, 5.9); p_eq is 0 without equiangular sampling.
+    const Spectrum nee = p_track * (ls.sample.pdf * sh.nee);
+    Spectrum uni = Spectrum::Zero(), other = Spectrum::Zero();
+    if (uni_alternative) uni = p_track * ((rr * fv.pdf) * sh.uni);
+    if constexpr (St::equiangular) other = p_eq * (ls.sample.pdf * sh.nee);
+    else (void)p_eq;
+    const Spectrum f = f_x * sh.f * fv.value;
+    record_channels<CP>(counter, Spectrum(f * ls.sample.radiance), uni, nee, other, q, c, nee_count,
+                        eq_drawn ? LightTechnique::Other : LightTechnique::Nee);
+    L += channel_estimate<CP>(f, Spectrum(nee_count * nee + uni + other), q, c) * ls.sample.radiance;
     return Status::Ok;
 }
 
@@ -154,7 +155,7 @@ Status channel_equiangular_event(const EstimatorOptions& opts, const Sc& sc, int
     }
     const SceneVertex xv{-1, index, Vec3(0.f, 0.f, 1.f)};
     return channel_light_event<CP, St, A>(sc, xv, ray.at(ds.t), ray.d, rr, [&](const Vec3&) { return index; }, lambda,
-                                          q, c, f_x, p_track, p_eq, rng, counter, L);
+                                          q, c, f_x, p_track, p_eq, opts.nee_count, true, rng, counter, L);
 }
 
 }  // namespace nsp::detail

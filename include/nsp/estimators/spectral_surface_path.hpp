@@ -72,7 +72,7 @@ RadianceSample<typename Sc::Spectral> spectral_surface_radiance(const EstimatorO
                 eq = PieceEquiangular<Sc>(sc, ray, in.t0, in.t1);
                 if (eq.valid()) {
                     eq_select = eq.template selection<St, typename Sc::MediumType>(opts, m.majorant, lambda);
-                    if (depth < opts.max_depth && (eq_select >= 1.f || rng.uniform() < eq_select)) {
+                    if (depth < opts.max_depth && draw_technique(eq_select, rng)) {
                         const Status es = channel_equiangular_event<CP, St, A>(opts, sc, medium, ray, eq, eq_select,
                                                                                depth + 1, lambda, q, c, st, rng, counter, L);
                         if (es == Status::NonFinite) return {Spectrum::Zero(), es};  // an overflowed flight
@@ -106,13 +106,19 @@ RadianceSample<typename Sc::Spectral> spectral_surface_radiance(const EstimatorO
             if constexpr (kEq) st.eq.vertex.setZero();  // the piece's alone
         }
         // An emitter reached: every channel's pdf of the path, tracking and (where it exists) NEE.
+        // NEE's pdf carries its expected count (THEORY 5.9; equiangular + NEE has count 1).
         auto add_emitter = [&](int light) {
             Spectrum pdf = st.uni;
+            const Spectrum le = sc.lights.emitted(light, ray.d, lambda);
             if (nee_alternative) {
-                if constexpr (St::equiangular) pdf += sc.lights.pdf(light, prev, ray.d) * (st.nee + st.eq.nee);
-                else pdf += sc.lights.pdf(light, prev, ray.d) * st.nee;
+                const float p_light = sc.lights.pdf(light, prev, ray.d);
+                Spectrum other = Spectrum::Zero();
+                if constexpr (St::equiangular) other = p_light * st.eq.nee;
+                pdf += opts.nee_count * p_light * st.nee + other;
+                record_channels<CP>(counter, Spectrum(st.f * le), st.uni, Spectrum(p_light * st.nee), other, q, c,
+                                    opts.nee_count, LightTechnique::Hit);
             }
-            L += channel_estimate<CP>(st.f, pdf, q, c) * sc.lights.emitted(light, ray.d, lambda);
+            L += channel_estimate<CP>(st.f, pdf, q, c) * le;
         };
         int material = -1;
         Vec3 x;
@@ -148,9 +154,10 @@ RadianceSample<typename Sc::Spectral> spectral_surface_radiance(const EstimatorO
         if constexpr (St::samples_lights) {
             auto side = [&](const Vec3& wi) { return v.on_surface() ? hit.medium_entered(wi) : medium; };
             // Equiangular + NEE alone leaves the lights of a vertex its own vertices cover to them.
-            if (St::combines || !St::equiangular || !eq_covers) {
+            // NEE at the expected count EstimatorOptions::nee_count (THEORY 5.9).
+            if ((St::combines || !St::equiangular || !eq_covers) && draw_technique(opts.nee_count, rng)) {
                 const Status ns = channel_light_event<CP, St, A>(sc, v, x, ray.d, rr, side, lambda, q, c, st.f, st.uni,
-                                                                 eq_pdf, rng, counter, L);
+                                                                 eq_pdf, opts.nee_count, false, rng, counter, L);
                 if (ns == Status::NonFinite) return {Spectrum::Zero(), ns};  // an overflowed flight
                 if (ns != Status::Ok) status = ns;
             }
