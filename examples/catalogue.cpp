@@ -42,7 +42,8 @@ std::vector<SceneEntry> make_catalogue() {
                   "ratio-nee_spectral-mis_per-channel_absorb-weight_uniform",
                   "uni-nee-mis_spectral-mis_per-channel_absorb-weight",
                   "unidirectional_spectral-mis_global_absorb-weight_uniform",
-                  "uni-nee-mis_spectral-mis_global_absorb-weight"},
+                  "uni-nee-mis_spectral-mis_global_absorb-weight",
+                  "uni-nee-mis_spectral-mis_absorb-weight_uniform_learned"},
                  {"global", "per-channel"},
                  // unbiased, finite variance there (one shared pdf under the grey majorant, weights
                  // mu_c / (mu_bar P) bounded), and none of the compared rows

@@ -238,12 +238,11 @@ struct Combination<tl::list<S, CP, Maj, St, H, A, Med>> {
         else return false;
     }();
 
-    /// True for nsp::PathEstimator rows that combine NEE with tracking under the balance heuristic:
-    /// the rows whose NEE count nsp::NeeCountLearner can learn (render_job_impl.hpp, "_learned").
-    static constexpr bool learns_nee_count = [] {
-        if constexpr (spectral) return false;
-        else return St::combines && St::samples_lights && std::is_same_v<H, nsp::mis::Balance>;
-    }();
+    /// True for rows that combine NEE with tracking under the balance heuristic (PathEstimator and
+    /// SpectralPathEstimator): the rows whose NEE count nsp::NeeCountLearner can learn
+    /// (render_job_impl.hpp, "_learned").
+    static constexpr bool learns_nee_count =
+        St::combines && St::samples_lights && std::is_same_v<H, nsp::mis::Balance>;
 
     /// True for the grey estimator with the plain global majorant (the rows of the first tables).
     static constexpr bool plain_global = !spectral && std::is_same_v<Maj, GlobalMajorantPolicy<>>;

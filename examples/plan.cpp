@@ -87,16 +87,18 @@ std::vector<Candidate> candidates(std::string_view mode, const std::vector<Selec
         if (!info.spectral) c.fields.emplace_back("grey");
         if (info.plain_global) c.fields.emplace_back("global");
         if (info.emissive) c.fields.emplace_back("emissive");
+        // Each row, then (where it can learn them) the same row with learned NEE counts.
+        auto push = [&](Candidate row) {
+            out.push_back(row);
+            if (!info.learns_nee_count) return;
+            row.learned = true;
+            row.name += "_learned";
+            row.key += "_learned";
+            row.fields.emplace_back("learned");
+            out.push_back(std::move(row));
+        };
         if (!info.uses_selection) {
-            out.push_back(c);
-            if (info.learns_nee_count) {  // the same combination with learned NEE counts
-                Candidate l = c;
-                l.learned = true;
-                l.name += "_learned";
-                l.key += "_learned";
-                l.fields.emplace_back("learned");
-                out.push_back(std::move(l));
-            }
+            push(c);
             continue;
         }
         for (const SelectionRule r : rules) {
@@ -109,7 +111,7 @@ std::vector<Candidate> candidates(std::string_view mode, const std::vector<Selec
             } else {
                 s.fields.emplace_back("uniform");
             }
-            out.push_back(std::move(s));
+            push(std::move(s));
         }
     }
     return out;

@@ -6,6 +6,7 @@
 // (render_mono.cpp, render_rgb.cpp, render_hero.cpp) so that they compile in parallel.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -45,10 +46,14 @@ struct RenderRequest {
     std::string label;  ///< for the progress line
     bool pixel_stats = false;  ///< also return every pixel's mean and sample variance (RenderStats)
     /// Learn the NEE count per tile (combinations with learns_nee_count only): the first
-    /// pilot_spp samples of every pixel at count 1 with an nsp::NeeCountLearner per tile_size^2
-    /// tile, the rest at the tile's chosen count. Every sample, the pilot's too, is in the stats.
+    /// pilot_spp(spp) samples of every pixel at count 1 with an nsp::NeeCountLearner per
+    /// tile_size^2 tile, the rest at the tile's chosen count. Every sample, the pilot's too, is in
+    /// the stats.
     bool learn_nee_counts = false;
-    int pilot_spp = 16, tile_size = 16;
+    int tile_size = 16;
+    /// The pilot's samples per pixel: spp / 16, at least 4 and at most 16 (a 16x16 tile then
+    /// learns from 1024 to 4096 samples; the pilot costs 1/16 of the render at full NEE cost).
+    static int pilot_spp(int spp) { return std::min(spp, std::clamp(spp / 16, 4, 16)); }
 };
 
 /// What one render measured. The estimates of each sample are taken as linear RGB (mono: the value
@@ -57,6 +62,7 @@ struct RenderStats {
     double wall_seconds = 0.0;
     double cpu_seconds = 0.0;             ///< summed over worker threads
     std::uint64_t samples = 0;
+    std::size_t pixels = 0;               ///< width x height
     std::uint64_t lookups = 0;            ///< density lookups, summed over threads
     std::uint64_t steps = 0;              ///< DDA steps of grid majorants, summed over threads
     std::uint64_t aborted = 0, nonfinite = 0, rejected = 0;  ///< paths by nsp::Status

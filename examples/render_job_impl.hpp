@@ -242,7 +242,7 @@ RenderStats render(const typename C::Scene& scene, const RenderRequest& rq, std:
         if (rq.learn_nee_counts) {
             // Pass 1: the pilot, tile by tile, at count 1.
             const int ts = rq.tile_size, tiles_x = (w + ts - 1) / ts, tiles_y = (h + ts - 1) / ts;
-            const int pilot = std::min(rq.pilot_spp, rq.spp);
+            const int pilot = RenderRequest::pilot_spp(rq.spp);
             std::vector<PixelState> px(std::size_t(w) * std::size_t(h));
             for (std::size_t p = 0; p < px.size(); ++p) px[p].rng = nsp::Pcg32(rq.seed, p);
             st.nee_counts.assign(std::size_t(tiles_x) * std::size_t(tiles_y), 1.f);
@@ -314,6 +314,7 @@ RenderStats render(const typename C::Scene& scene, const RenderRequest& rq, std:
     }
     st.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     st.samples = std::uint64_t(w) * std::uint64_t(h) * std::uint64_t(rq.spp);
+    st.pixels = std::size_t(w) * std::size_t(h);
     double var_mean = 0.0;
     std::array<double, 3> var_channel{}, mean{};
     for (const auto* list : {&totals, &pilot_totals})

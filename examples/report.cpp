@@ -121,8 +121,11 @@ void print_learned_counts(const std::vector<Row>& rows) {
     for (const Row& r : rows) {
         if (!r.c.learned || r.runs.empty()) continue;
         const RenderRequest defaults;
+        const int spp = r.runs[0].samples > 0 && !r.runs[0].nee_counts.empty()
+                            ? int(r.runs[0].samples / std::uint64_t(std::max<std::size_t>(1, r.runs[0].pixels)))
+                            : 0;
         std::printf("learned NEE counts (%s, %d-spp pilot at count 1 per %dx%d tile, nsp::NeeCountLearner): tiles at",
-                    r.c.name.c_str(), defaults.pilot_spp, defaults.tile_size, defaults.tile_size);
+                    r.c.name.c_str(), RenderRequest::pilot_spp(spp), defaults.tile_size, defaults.tile_size);
         for (int j = 0; j < nsp::NeeCountLearner::kCandidates; ++j) {
             const float c = nsp::NeeCountLearner::candidate(j);
             const auto n = std::count(r.runs[0].nee_counts.begin(), r.runs[0].nee_counts.end(), c);
