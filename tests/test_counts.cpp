@@ -173,17 +173,6 @@ TEST_CASE("NEE counts: multiple scattering with roulette, a sphere light and a s
 
 TEST_CASE("NEE counts: surfaces: the white furnace (L = 1) and the lit cube over a floor at count 0.3") {
     using namespace nsp_test::grey_scenes;
-    auto estimate = [](const auto& est, const auto& sc, int n, std::uint64_t seed, auto make_ray) {
-        Pcg32 rng(seed, 5);
-        LookupCount counter;
-        Stat s;
-        for (int i = 0; i < n; ++i) {
-            const auto res = est.radiance(sc, make_ray(rng), {}, rng, counter);
-            REQUIRE(res.status == Status::Ok);
-            s.add(res.value[0]);
-        }
-        return s;
-    };
     {  // nothing absorbs: albedo-1 floor, a mirror, a cube of albedo-1 medium, a sky of radiance 1
         Shapes shapes;
         shapes.boxes.push_back({Vec3(-1.f), Vec3(1.f), {-1, -1, 0, -1}});

@@ -23,19 +23,6 @@ using namespace nsp_test::grey_scenes;
 // k = 5 standard errors, estimated from the samples, with fixed seeds: deterministic.
 constexpr double kSigmas = 5.0;
 
-template <class E, class Scene, class Make>
-Stat estimate(const E& est, const Scene& sc, int n, std::uint64_t seed, Make make_ray) {
-    Pcg32 rng(seed, 5);
-    LookupCount counter;
-    Stat s;
-    for (int i = 0; i < n; ++i) {
-        const auto r = est.radiance(sc, make_ray(rng), {}, rng, counter);
-        REQUIRE(r.status == Status::Ok);
-        s.add(r.value[0]);
-    }
-    return s;
-}
-
 /// Runs `check(estimator, name)` for every strategy PathEstimator renders surfaces with.
 template <class F>
 void for_each_strategy(F check) {

@@ -9,6 +9,7 @@
 
 #include <nsp/nsp.hpp>
 
+#include "common.hpp"
 #include "host/shapes.hpp"
 #include "surfaces.hpp"
 
@@ -66,6 +67,21 @@ inline Sc nested_media() {
     shapes.quads.push_back({lamp.corner, lamp.edge_u, lamp.edge_v, {-1, 0, -1, -1}});
     return Sc(shapes, {medium(Box{Vec3(-1.f), Vec3(1.f)}, 0.5f, 0.f), medium(Box{Vec3(-0.5f), Vec3(0.5f)}, 1.f, 0.f)},
               materials(), Ls(LightSelection::Uniform, 3.f, {lamp}, {}), -1);
+}
+
+/// The statistics of n estimates of `est` over a SurfaceScene along rays from make_ray(rng) (Mono:
+/// channel 0), every one of status Ok; one Pcg32 (seed, stream 5).
+template <class E, class Scene, class Make>
+Stat estimate(const E& est, const Scene& sc, int n, std::uint64_t seed, Make make_ray) {
+    Pcg32 rng(seed, 5);
+    LookupCount counter;
+    Stat s;
+    for (int i = 0; i < n; ++i) {
+        const auto r = est.radiance(sc, make_ray(rng), {}, rng, counter);
+        REQUIRE(r.status == Status::Ok);
+        s.add(r.value[0]);
+    }
+    return s;
 }
 
 }  // namespace nsp_test::grey_scenes
