@@ -230,14 +230,15 @@ struct Prediction {
     float chosen = 0.f;
 };
 
-template <class Sc>
+template <class Strategy = strategy::NullScatteringMis, class Sc>
 Prediction predict_and_measure(const Sc& scene, const Ray& ray, int spp, std::uint64_t seed) {
+    using Est = PathEstimator<Strategy, mis::Balance>;
     constexpr int kBatches = 10;
     constexpr int kC = NeeCountLearner::kCandidates;
     Prediction out;
     NeeCountLearner all;
     std::array<Stat, kC> pred, meas;
-    const PathEstimator<strategy::NullScatteringMis, mis::Balance> pilot;
+    const Est pilot;
     for (int b = 0; b < kBatches; ++b) {
         NeeCountLearner batch;
         Pcg32 rng(seed, std::uint64_t(b));
@@ -247,7 +248,7 @@ Prediction predict_and_measure(const Sc& scene, const Ray& ray, int spp, std::ui
         all.merge(batch);
     }
     for (int j = 0; j < kC; ++j) {
-        const PathEstimator<strategy::NullScatteringMis, mis::Balance> est(with_count(NeeCountLearner::candidate(j)));
+        const Est est(with_count(NeeCountLearner::candidate(j)));
         // A learner as the counter measures the run's work in the cost model's units: at its
         // first candidate (count 1, no scaling) predicted_cost is the work per sample it saw.
         NeeCountLearner work;
@@ -293,8 +294,9 @@ TEST_CASE("NeeCountLearner: the variance predicted from a count-1 pilot is the v
     big.set(SphereLight<Mono>{Vec3(3.f, 0.f, 0.f), 1.5f, grey<Mono>(1.f)});
     small.set(SphereLight<Mono>{Vec3(0.f, 3.f, 0.f), 0.1f, grey<Mono>(100.f)});
     const Ray ray{Vec3(-3.f, 0.1f, 0.f), Vec3(1.f, 0.f, 0.f)};
-    auto check = [&](const auto& scene, const char* name, int spp) {
-        const Prediction p = predict_and_measure(scene, ray, spp, 77);
+    auto check = [&]<class Strategy = strategy::NullScatteringMis>(const auto& scene, const char* name, int spp,
+                                                                    Strategy = {}) {
+        const Prediction p = predict_and_measure<Strategy>(scene, ray, spp, 77);
         for (int j = 0; j < NeeCountLearner::kCandidates; ++j) {
             const auto k = std::size_t(j);
             CAPTURE(std::string(name));
@@ -317,9 +319,16 @@ TEST_CASE("NeeCountLearner: the variance predicted from a count-1 pilot is the v
     // a grid majorant: the DDA steps are part of the work
     const Prediction p_grid = check(Scene(dense, GridMajorant<M>(dense, 8), HenyeyGreensteinPhase(0.9f), big),
                                     "dense cloud, large sphere, grid majorant", 1000);
+    // uni + NEE + equiangular MIS: the equiangular vertices' NEE runs at every count, so its
+    // shadow walks' work is not NEE's to save (record_shadow_walk's `counted`), nor is its
+    // variance (LightTechnique::Other).
+    const Prediction p_eq = check(Scene(thin, GlobalMajorant<M>(thin), HenyeyGreensteinPhase(0.5f), small),
+                                  "thin cloud, small sphere, equiangular MIS", 2000, strategy::EquiangularMis{});
+    const Prediction p_eq_big = check(Scene(dense, GlobalMajorant<M>(dense), HenyeyGreensteinPhase(0.9f), big),
+                                      "dense cloud, large sphere, equiangular MIS", 1000, strategy::EquiangularMis{});
     // The choice is the measured best: variance x cost at the chosen count within 10 % of the
     // best measured candidate's (the measured products' own SE is ~3 %).
-    for (const Prediction* p : {&p_sky, &p_big, &p_small, &p_grid}) {
+    for (const Prediction* p : {&p_sky, &p_big, &p_small, &p_grid, &p_eq, &p_eq_big}) {
         double best = INFINITY, at_chosen = 0.0;
         for (int j = 0; j < NeeCountLearner::kCandidates; ++j) {
             const auto k = std::size_t(j);
@@ -349,7 +358,8 @@ TEST_CASE("NeeCountLearner: bookkeeping") {
             const float u = i % 2 ? 3.f : 1.f;
             for (int k = 0; k < 10; ++k) l.lookup();
             l.record_light(u, 0.f, 1.f, 0.f, 1.f, LightTechnique::Nee);
-            l.record_nee_work(5.0);  // + kShadowRayCost 1
+            l.record_shadow_walk(5.0, true);   // + kShadowRayCost 1: scales with the count
+            l.record_shadow_walk(2.0, false);  // an equiangular vertex's: its 1 fixed stays at any count
             l.end_sample(double(u));
         }
         l.end_pixel();
@@ -357,9 +367,9 @@ TEST_CASE("NeeCountLearner: bookkeeping") {
         // At count c the estimate is B u / c: expectation u, variance E[u^2] (1 - c) / c on top.
         CHECK(l.predicted_variance(0) == doctest::Approx(100.0 / 99.0).epsilon(1e-9));
         CHECK(l.predicted_variance(1) == doctest::Approx(100.0 / 99.0 + 5.0).epsilon(1e-9));
-        // work 10 lookups + 1 fixed per sample, NEE's 6 of it: at count 1/2, 5 + 3 + the camera ray's 1
-        CHECK(l.predicted_cost(0) == doctest::Approx(11.0 + 1.0).epsilon(1e-9));
-        CHECK(l.predicted_cost(1) == doctest::Approx(5.0 + 3.0 + 1.0).epsilon(1e-9));
+        // work 10 lookups + 2 fixed per sample, NEE's counted 6 of it: at count 1/2, 6 + 3 + the camera ray's 1
+        CHECK(l.predicted_cost(0) == doctest::Approx(12.0 + 1.0).epsilon(1e-9));
+        CHECK(l.predicted_cost(1) == doctest::Approx(6.0 + 3.0 + 1.0).epsilon(1e-9));
     }
     SUBCASE("a pilot at a count other than 1 is refused") {
         NeeCountLearner l;

@@ -57,12 +57,13 @@ enum class LightTechnique : std::uint8_t {
 };
 
 /// A lookup counter that also records what NeeCountLearner needs: every light contribution that
-/// both tracking and NEE can make and the lookups of NEE's shadow rays. The estimators call these
-/// only on such counters; with any other counter they compile to nothing.
+/// both tracking and NEE can make and the work of every NEE shadow walk (whether the NEE count
+/// scales it or not). The estimators call these only on such counters; with any other counter
+/// they compile to nothing.
 template <class C>
-concept MisRecorder = LookupCounter<C> && requires(C& c, float f, LightTechnique t, double w) {
+concept MisRecorder = LookupCounter<C> && requires(C& c, float f, LightTechnique t, double w, bool b) {
     { c.record_light(f, f, f, f, f, t) } noexcept;
-    { c.record_nee_work(w) } noexcept;
+    { c.record_shadow_walk(w, b) } noexcept;
     { c.work() } -> std::convertible_to<double>;
 };
 
@@ -79,13 +80,15 @@ void record_light(C& counter, float f_over_ref, float p_hit, float p_nee, float 
     if constexpr (MisRecorder<C>) counter.record_light(f_over_ref, p_hit, p_nee, p_other, count, t);
     else (void)counter, (void)f_over_ref, (void)p_hit, (void)p_nee, (void)p_other, (void)count, (void)t;
 }
-/// The work counted since `before` as one NEE shadow walk's, on a MisRecorder (else nothing).
+/// The work counted since `before` as one NEE shadow walk's, on a MisRecorder (else nothing):
+/// `counted` when the walk ran with the NEE count (from a tracked vertex or a surface), false when
+/// it runs whatever the count (from an equiangular vertex).
 template <class C>
-void record_nee_work(C& counter, double before) noexcept {
-    if constexpr (MisRecorder<C>) counter.record_nee_work(counter.work() - before);
-    else (void)counter, (void)before;
+void record_shadow_walk(C& counter, double before, bool counted) noexcept {
+    if constexpr (MisRecorder<C>) counter.record_shadow_walk(counter.work() - before, counted);
+    else (void)counter, (void)before, (void)counted;
 }
-/// counter.work() on a MisRecorder, else 0 (what record_nee_work takes as `before`).
+/// counter.work() on a MisRecorder, else 0 (what record_shadow_walk takes as `before`).
 template <class C>
 double recorder_work(const C& counter) noexcept {
     if constexpr (MisRecorder<C>) return counter.work();
@@ -143,9 +146,11 @@ public:
             }
         }
     }
-    /// Called by the estimator after each NEE shadow walk with the work (work()) it took.
-    void record_nee_work(double w) noexcept {
-        nee_work_ += w + kShadowRayCost;
+    /// Called by the estimator after each NEE shadow walk with the work (work()) it took;
+    /// `counted`: the walk runs with the NEE count, so its share of the cost scales with it (the
+    /// walks from equiangular vertices run at any count: their work stays in the base).
+    void record_shadow_walk(double w, bool counted) noexcept {
+        if (counted) nee_work_ += w + kShadowRayCost;
         fixed_work_ += kShadowRayCost;
     }
 

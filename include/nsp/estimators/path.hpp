@@ -245,7 +245,7 @@ private:
         if (ls.occludable_by_sphere && scene.lights.sphere_blocks(shadow, ls.distance)) return Status::Ok;
         const double before = detail::recorder_work(counter);
         const auto tr = kernels_.shadow(scene.medium, scene.majorant, shadow, ls.distance, lambda, rng, counter);
-        detail::record_nee_work(counter, before);
+        detail::record_shadow_walk(counter, before, !equiangular_drawn);
         if (tr.status != Status::Ok) return tr.status;
         if (!(tr.transmittance != 0.f).any()) return Status::Ok;
         const float count = equiangular_drawn ? 1.f : kernels_.nee_count();

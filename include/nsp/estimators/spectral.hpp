@@ -264,7 +264,7 @@ private:
         const double before = detail::recorder_work(counter);
         const auto sh = track_channels_ratio<CP, A>(scene.medium, scene.majorant, shadow, ls.distance, lambda, c,
                                                     f_x, uni_alternative, rng, counter);
-        detail::record_nee_work(counter, before);
+        detail::record_shadow_walk(counter, before, !equiangular_drawn);
         if (const Status fs = flight_status(sh.end); fs != Status::Ok) return fs;
         if (sh.end == SegmentEnd::Terminated) return Status::Ok;
         using Spectrum = typename Sc::Spectrum;

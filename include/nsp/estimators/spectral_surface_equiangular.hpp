@@ -99,7 +99,7 @@ Status channel_light_event(const Sc& sc, const SceneVertex& v, const Vec3& x, co
     const double before = recorder_work(counter);
     const auto sh = channel_shadow_through<CP, A>(sc, Ray{x, fv.wi}, shadow_distance(ls.sample.distance),
                                                   start_medium(fv.wi), lambda, c, f_x, uni_alternative, rng, counter);
-    record_nee_work(counter, before);
+    record_shadow_walk(counter, before, !eq_drawn);
     if (sh.end != SegmentEnd::Passed) return shadow_status(sh.end);
     if (!(sh.f != 0.f).any()) return Status::Ok;
     // Tracking + NEE (its expected count), tracking + hit, and equiangular + NEE (count 1)

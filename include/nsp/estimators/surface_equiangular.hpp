@@ -94,7 +94,7 @@ Status light_event(const K& k, const Sc& sc, const SceneVertex& v, const Vec3& x
     const double before = recorder_work(counter);
     const auto sh = shadow_through(k, sc, Ray{x, f.wi}, shadow_distance(ls.sample.distance), start_medium(f.wi), lambda,
                                    rng, counter);
-    record_nee_work(counter, before);
+    record_shadow_walk(counter, before, !eq_drawn);
     if (sh.status != Status::Ok) return sh.status;
     if (!(sh.transmittance != 0.f).any()) return Status::Ok;
     // NEE from a tracked vertex or a surface ran with the expected count nee_count; from an
