@@ -51,9 +51,10 @@ struct RenderRequest {
     /// the stats.
     bool learn_nee_counts = false;
     int tile_size = 16;
-    /// The pilot's samples per pixel: spp / 16, at least 4 and at most 16 (a 16x16 tile then
-    /// learns from 1024 to 4096 samples; the pilot costs 1/16 of the render at full NEE cost).
-    static int pilot_spp(int spp) { return std::min(spp, std::clamp(spp / 16, 4, 16)); }
+    /// The pilot's samples per pixel: spp / 32, at least 2 (a pixel's sample variance needs two)
+    /// and at most 16 (a 16x16 tile then learns from 512 to 4096 samples; the pilot costs 1/32 of
+    /// the render at full NEE cost).
+    static int pilot_spp(int spp) { return std::min(spp, std::clamp(spp / 32, 2, 16)); }
 };
 
 /// What one render measured. The estimates of each sample are taken as linear RGB (mono: the value
