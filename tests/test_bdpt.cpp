@@ -27,19 +27,6 @@ using namespace nsp_test::grey_scenes;
 // k = 5 standard errors, estimated from the samples, with fixed seeds: deterministic.
 constexpr double kSigmas = 5.0;
 
-template <class E, class Scene, class Make>
-Stat estimate(const E& est, const Scene& sc, int n, std::uint64_t seed, Make make_ray) {
-    Pcg32 rng(seed, 5);
-    LookupCount counter;
-    Stat s;
-    for (int i = 0; i < n; ++i) {
-        const auto r = est.radiance(sc, make_ray(rng), {}, rng, counter);
-        REQUIRE(r.status == Status::Ok);
-        s.add(r.value[0]);
-    }
-    return s;
-}
-
 /// The image's average over uniform (u, v) through `camera` with light tracing: each sample's
 /// return plus the splats of its light subpath (wherever they land), n samples.
 template <class E, class Scene>

@@ -36,17 +36,10 @@ constexpr double kSigmas = 5.0;
 // The combined strategies keep the variance finite (the collision estimator takes over near x).
 // The floor under an emitting sphere below, where every NEE distance is >= 1, checks it.
 
+/// grey_scenes::estimate on this file's stream 7.
 template <class E, class Make>
 Stat estimate(const E& est, const Sc& sc, int n, std::uint64_t seed, Make make_ray) {
-    Pcg32 rng(seed, 7);
-    LookupCount counter;
-    Stat s;
-    for (int i = 0; i < n; ++i) {
-        const auto r = est.radiance(sc, make_ray(rng), {}, rng, counter);
-        REQUIRE(r.status == Status::Ok);
-        s.add(r.value[0]);
-    }
-    return s;
+    return nsp_test::grey_scenes::estimate(est, sc, n, seed, make_ray, 7);
 }
 
 template <class F>

@@ -70,10 +70,10 @@ inline Sc nested_media() {
 }
 
 /// The statistics of n estimates of `est` over a SurfaceScene along rays from make_ray(rng) (Mono:
-/// channel 0), every one of status Ok; one Pcg32 (seed, stream 5).
+/// channel 0), every one of status Ok; one Pcg32 (seed, stream).
 template <class E, class Scene, class Make>
-Stat estimate(const E& est, const Scene& sc, int n, std::uint64_t seed, Make make_ray) {
-    Pcg32 rng(seed, 5);
+Stat estimate(const E& est, const Scene& sc, int n, std::uint64_t seed, Make make_ray, std::uint64_t stream = 5) {
+    Pcg32 rng(seed, stream);
     LookupCount counter;
     Stat s;
     for (int i = 0; i < n; ++i) {
