@@ -9,6 +9,7 @@
 #include <cmath>
 #include <string>
 #include <tuple>
+#include <vector>
 
 #include "common.hpp"
 #include "grey_surface_scenes.hpp"
@@ -230,8 +231,11 @@ struct Prediction {
     float chosen = 0.f;
 };
 
+/// Which count predict_and_measure varies (the other stays 1).
+enum class Axis { Nee, Segment };
+
 template <class Strategy = strategy::NullScatteringMis, class Sc>
-Prediction predict_and_measure(const Sc& scene, const Ray& ray, int spp, std::uint64_t seed) {
+Prediction predict_and_measure(const Sc& scene, const Ray& ray, int spp, std::uint64_t seed, Axis axis = Axis::Nee) {
     using Est = PathEstimator<Strategy, mis::Balance>;
     constexpr int kBatches = 10;
     constexpr int kC = NeeCountLearner::kCandidates;
@@ -244,11 +248,14 @@ Prediction predict_and_measure(const Sc& scene, const Ray& ray, int spp, std::ui
         Pcg32 rng(seed, std::uint64_t(b));
         for (int i = 0; i < spp; ++i) batch.end_sample(double(pilot.radiance(scene, ray, {}, rng, batch).value.mean()));
         batch.end_pixel();
-        for (int j = 0; j < kC; ++j) pred[std::size_t(j)].add(batch.predicted_variance(j));
+        for (int j = 0; j < kC; ++j)
+            pred[std::size_t(j)].add(axis == Axis::Nee ? batch.predicted_variance(j, 0) : batch.predicted_variance(0, j));
         all.merge(batch);
     }
     for (int j = 0; j < kC; ++j) {
-        const Est est(with_count(NeeCountLearner::candidate(j)));
+        EstimatorOptions o;
+        (axis == Axis::Nee ? o.nee_count : o.emission_segment_count) = NeeCountLearner::candidate(j);
+        const Est est(o);
         // A learner as the counter measures the run's work in the cost model's units: at its
         // first candidate (count 1, no scaling) predicted_cost is the work per sample it saw.
         NeeCountLearner work;
@@ -263,15 +270,52 @@ Prediction predict_and_measure(const Sc& scene, const Ray& ray, int spp, std::ui
             meas[std::size_t(j)].add(s.variance());
         }
         const auto k = std::size_t(j);
-        out.predicted[k] = all.predicted_variance(j);
+        out.predicted[k] = axis == Axis::Nee ? all.predicted_variance(j, 0) : all.predicted_variance(0, j);
         out.predicted_se[k] = pred[k].se();
         out.measured[k] = meas[k].mean;
         out.measured_se[k] = meas[k].se();
-        out.predicted_cost[k] = all.predicted_cost(j);
-        out.measured_cost[k] = work.predicted_cost(0);
+        out.predicted_cost[k] = axis == Axis::Nee ? all.predicted_cost(j, 0) : all.predicted_cost(0, j);
+        out.measured_cost[k] = work.predicted_cost(0, 0);
     }
-    out.chosen = all.choose();
+    const TechniqueCounts chosen = all.choose_counts();
+    out.chosen = axis == Axis::Nee ? chosen.nee : chosen.emission_segment;
+    if (axis == Axis::Segment) CHECK(chosen.nee == 1.f);  // no lights: nothing for NEE to save
     return out;
+}
+
+/// Checks a Prediction at every candidate: the measured variance positive, the predicted one
+/// within kSigmas combined SE of it, the predicted work within 3 % of the measured; reports them.
+void check_prediction(const Prediction& p, const std::string& name) {
+    for (int j = 0; j < NeeCountLearner::kCandidates; ++j) {
+        const auto k = std::size_t(j);
+        CAPTURE(name);
+        CAPTURE(NeeCountLearner::candidate(j));
+        CAPTURE(p.predicted[k]);
+        CAPTURE(p.predicted_se[k]);
+        CAPTURE(p.measured[k]);
+        CAPTURE(p.measured_se[k]);
+        CHECK(p.measured[k] > 0.0);
+        CHECK(std::abs(p.predicted[k] - p.measured[k]) <= kSigmas * std::hypot(p.predicted_se[k], p.measured_se[k]));
+        CHECK(p.predicted_cost[k] == doctest::Approx(p.measured_cost[k]).epsilon(0.03));
+    }
+    MESSAGE(name << ": predicted / measured variance at 1, 1/2, 1/8, 1/64: " << p.predicted[0] << " / " << p.measured[0]
+                 << ", " << p.predicted[1] << " / " << p.measured[1] << ", " << p.predicted[3] << " / " << p.measured[3]
+                 << ", " << p.predicted[6] << " / " << p.measured[6] << "; work per sample " << p.measured_cost[0]
+                 << " .. " << p.measured_cost[6] << "; chosen " << p.chosen);
+}
+
+/// The choice is the measured best: variance x cost at the chosen count within 10 % of the best
+/// measured candidate's (the measured products' own SE is ~3 %).
+void check_choice(const Prediction& p) {
+    double best = INFINITY, at_chosen = 0.0;
+    for (int j = 0; j < NeeCountLearner::kCandidates; ++j) {
+        const auto k = std::size_t(j);
+        const double e = p.measured[k] * p.measured_cost[k];
+        best = std::min(best, e);
+        if (NeeCountLearner::candidate(j) == p.chosen) at_chosen = e;
+    }
+    CAPTURE(p.chosen);
+    CHECK(at_chosen <= 1.1 * best);
 }
 
 }  // namespace
@@ -297,18 +341,7 @@ TEST_CASE("NeeCountLearner: the variance predicted from a count-1 pilot is the v
     auto check = [&]<class Strategy = strategy::NullScatteringMis>(const auto& scene, const char* name, int spp,
                                                                     Strategy = {}) {
         const Prediction p = predict_and_measure<Strategy>(scene, ray, spp, 77);
-        for (int j = 0; j < NeeCountLearner::kCandidates; ++j) {
-            const auto k = std::size_t(j);
-            CAPTURE(std::string(name));
-            CAPTURE(NeeCountLearner::candidate(j));
-            CAPTURE(p.predicted[k]);
-            CAPTURE(p.predicted_se[k]);
-            CAPTURE(p.measured[k]);
-            CAPTURE(p.measured_se[k]);
-            CHECK(p.measured[k] > 0.0);
-            CHECK(std::abs(p.predicted[k] - p.measured[k]) <= kSigmas * std::hypot(p.predicted_se[k], p.measured_se[k]));
-            CHECK(p.predicted_cost[k] == doctest::Approx(p.measured_cost[k]).epsilon(0.03));
-        }
+        check_prediction(p, name);
         return p;
     };
     const Prediction p_sky = check(Scene(thin, GlobalMajorant<M>(thin), IsotropicPhase{}, sky), "thin cloud, sky", 2000);
@@ -326,21 +359,40 @@ TEST_CASE("NeeCountLearner: the variance predicted from a count-1 pilot is the v
                                   "thin cloud, small sphere, equiangular MIS", 2000, strategy::EquiangularMis{});
     const Prediction p_eq_big = check(Scene(dense, GlobalMajorant<M>(dense), HenyeyGreensteinPhase(0.9f), big),
                                       "dense cloud, large sphere, equiangular MIS", 1000, strategy::EquiangularMis{});
-    // The choice is the measured best: variance x cost at the chosen count within 10 % of the
-    // best measured candidate's (the measured products' own SE is ~3 %).
-    for (const Prediction* p : {&p_sky, &p_big, &p_small, &p_grid, &p_eq, &p_eq_big}) {
-        double best = INFINITY, at_chosen = 0.0;
-        for (int j = 0; j < NeeCountLearner::kCandidates; ++j) {
-            const auto k = std::size_t(j);
-            const double e = p->measured[k] * p->measured_cost[k];
-            best = std::min(best, e);
-            if (NeeCountLearner::candidate(j) == p->chosen) at_chosen = e;
-        }
-        CAPTURE(p->chosen);
-        CHECK(at_chosen <= 1.1 * best);
-    }
+    for (const Prediction* p : {&p_sky, &p_big, &p_small, &p_grid, &p_eq, &p_eq_big}) check_choice(*p);
     CHECK(p_small.chosen == 1.f);  // NEE pays for itself under a small bright light
     CHECK(p_big.chosen < 0.1f);    // tracking finds the large light; shadow rays through the dense cloud cost
+}
+
+TEST_CASE("NeeCountLearner: the emission segment count, predicted from a count-1 pilot, is the one measured") {
+    // As above for EstimatorOptions::emission_segment_count on emissive clouds without lights (the
+    // collision estimator, the segment technique and NEE toward the volume): the variance at every
+    // candidate within 5 combined SE, the work within 3 %, the choice within 10 % of the measured
+    // best. Two clouds: a thin absorbing emitter seen from outside, where the segment technique
+    // samples what collisions rarely find, and a dense scattering one glowing everywhere, where
+    // collisions find the emission at every step and the segment technique's flight costs.
+    using M = DenseGridMedium<Mono>;
+    using EM = Emissive<M>;
+    const Box box{Vec3(-1.f), Vec3(1.f)};
+    auto emitter = [&](float density, float sa, float ss, std::uint64_t seed) {
+        std::vector<float> e(64);
+        Pcg32 rng(seed, 5);
+        for (float& v : e) v = 2.f * rng.uniform();
+        return EM(make_medium<M>(box, density, grey<Mono>(sa), grey<Mono>(ss), 3), EmissionGrid(box, {4, 4, 4}, e),
+                  grey<Mono>(1.f), {8, 8, 8});
+    };
+    const EM thin = emitter(0.3f, 1.f, 0.f, 11);
+    const EM dense = emitter(4.f, 0.1f, 0.9f, 12);
+    const Ray ray{Vec3(-3.f, 0.1f, 0.f), Vec3(1.f, 0.f, 0.f)};
+    auto check = [&](const auto& scene, const char* name, int spp) {
+        const Prediction p = predict_and_measure(scene, ray, spp, 91, Axis::Segment);
+        check_prediction(p, name);
+        check_choice(p);
+        return p;
+    };
+    check(Scene(thin, GlobalMajorant<EM>(thin), IsotropicPhase{}, Lights<Mono>{}), "thin absorbing emitter", 2000);
+    check(Scene(dense, GlobalMajorant<EM>(dense), HenyeyGreensteinPhase(0.3f), Lights<Mono>{}),
+          "dense scattering emitter", 1000);
 }
 
 TEST_CASE("NeeCountLearner: bookkeeping") {
@@ -371,6 +423,52 @@ TEST_CASE("NeeCountLearner: bookkeeping") {
         CHECK(l.predicted_cost(0) == doctest::Approx(12.0 + 1.0).epsilon(1e-9));
         CHECK(l.predicted_cost(1) == doctest::Approx(6.0 + 3.0 + 1.0).epsilon(1e-9));
     }
+    SUBCASE("NEE and the emission segment technique are learned jointly") {
+        // Each sample: a NEE contribution u_l (alternating 1 and 3, NEE the only technique) and a
+        // segment contribution 2 (the segment technique the only one); the estimate u_l + 2.
+        NeeCountLearner l;
+        for (int i = 0; i < 100; ++i) {
+            const float u = i % 2 ? 3.f : 1.f;
+            for (int k = 0; k < 10; ++k) l.lookup();
+            l.record_light(u, 0.f, 1.f, 0.f, 1.f, LightTechnique::Nee);
+            l.record_shadow_walk(5.0, true);
+            l.record_emission(2.f, 0.f, 1.f, 0.f, 1.f, EmissionTechnique::Segment);
+            l.record_segment_walk(3.0);  // + kShadowRayCost 1: scales with the segment count
+            l.end_sample(double(u) + 2.0);
+            if (i % 10 == 9) l.end_pixel();  // ten pixels of ten samples
+        }
+        // Each pixel's sample variance 10 / 9; Bernoulli variances E[u^2] (1 - c) / c: NEE's 5 at
+        // count 1/2, the segment's 4 x 3 at 1/4.
+        CHECK(l.predicted_variance(0, 0) == doctest::Approx(10.0 / 9.0).epsilon(1e-9));
+        CHECK(l.predicted_variance(1, 2) == doctest::Approx(10.0 / 9.0 + 5.0 + 12.0).epsilon(1e-9));
+        // work 10 lookups + 2 fixed per sample, NEE's 6 and the segment's 4 of it:
+        // 2 + 6 / 2 + 4 / 4 + the camera ray's 1
+        CHECK(l.predicted_cost(0, 0) == doctest::Approx(12.0 + 1.0).epsilon(1e-9));
+        CHECK(l.predicted_cost(1, 2) == doctest::Approx(2.0 + 3.0 + 1.0 + 1.0).epsilon(1e-9));
+        CHECK(l.segment_work() == doctest::Approx(400.0));
+        const TechniqueCounts n = l.choose_counts();
+        CHECK(n.nee == 1.f);
+        CHECK(n.emission_segment == 1.f);
+    }
+    SUBCASE("without emission the segment count stays 1 whatever NEE's") {
+        // Tracking finds a large light as well as NEE does (p_hit = p_nee: each sample has both
+        // contributions, u / 2 each) and NEE's walk costs 20 of the sample's 21 lookups: the NEE
+        // count falls, the segment count, which changes nothing, stays 1.
+        NeeCountLearner l;
+        for (int i = 0; i < 100; ++i) {
+            const float u = i % 2 ? 3.f : 1.f;
+            for (int k = 0; k < 21; ++k) l.lookup();
+            l.record_light(u, 1.f, 1.f, 0.f, 1.f, LightTechnique::Hit);
+            l.record_light(u, 1.f, 1.f, 0.f, 1.f, LightTechnique::Nee);
+            l.record_shadow_walk(20.0, true);
+            l.end_sample(double(u));
+            if (i % 10 == 9) l.end_pixel();
+        }
+        const TechniqueCounts n = l.choose_counts();
+        CHECK(n.nee < 1.f);
+        CHECK(n.emission_segment == 1.f);
+        CHECK(l.choose() == n.nee);
+    }
     SUBCASE("a pilot at a count other than 1 is refused") {
         NeeCountLearner l;
         l.record_light(1.f, 1.f, 1.f, 0.f, 0.5f, LightTechnique::Hit);
@@ -379,6 +477,13 @@ TEST_CASE("NeeCountLearner: bookkeeping") {
         l.end_pixel();
         CHECK(l.invalid_pilot());
         CHECK(l.choose() == 1.f);
+        NeeCountLearner e;
+        e.record_emission(1.f, 1.f, 1.f, 0.f, 0.25f, EmissionTechnique::Collision);
+        e.end_sample(1.0);
+        e.end_sample(2.0);
+        e.end_pixel();
+        CHECK(e.invalid_pilot());
+        CHECK(e.choose_counts().emission_segment == 1.f);
     }
 }
 
@@ -394,4 +499,20 @@ TEST_CASE("NEE counts: a count outside (0, 1] is rejected by name; BDPT rejects 
     CHECK_THROWS_WITH_AS((BdptEstimator<bdpt::NullScattering, mis::Balance>(with_count(0.5f, BdptEstimator<>::default_options()))),
                          doctest::Contains("nsp::BdptEstimator"), InvalidArgument);
     CHECK_NOTHROW((PathEstimator<strategy::NullScatteringMis, mis::Balance>(with_count(1e-3f))));
+}
+
+TEST_CASE("emission segment counts: a count outside (0, 1] is rejected by name; BDPT rejects any but 1") {
+    for (const float bad : {0.f, -0.5f, 1.5f, std::nanf("")}) {
+        CAPTURE(bad);
+        EstimatorOptions o;
+        o.emission_segment_count = bad;
+        CHECK_THROWS_WITH_AS((PathEstimator<strategy::NullScatteringMis, mis::Balance>(o)),
+                             doctest::Contains("emission_segment_count"), InvalidArgument);
+        CHECK_THROWS_WITH_AS((SpectralPathEstimator<channels::SpectralMis, strategy::NullScatteringMis, mis::Balance>(o)),
+                             doctest::Contains("emission_segment_count"), InvalidArgument);
+    }
+    EstimatorOptions half = BdptEstimator<>::default_options();
+    half.emission_segment_count = 0.5f;
+    CHECK_THROWS_WITH_AS((BdptEstimator<bdpt::NullScattering, mis::Balance>(half)),
+                         doctest::Contains("emission_segment_count"), InvalidArgument);
 }

@@ -100,6 +100,13 @@ TEST_CASE_TEMPLATE_DEFINE("emissive furnace: L_e equal to the environment gives 
         // The option changes the combining strategies only (the others were run above).
         check_all<C>(scene, ray, off, 6000, 140, "global, no segment technique", [&](int c) { return double(le[c]); },
                      true);
+        // Expected counts (THEORY 5.9): the segment technique on 30% of the segments, NEE toward
+        // the environment at half the vertices; every weight takes count x pdf, L stays L_e.
+        EstimatorOptions few;
+        few.emission_segment_count = 0.3f;
+        few.nee_count = 0.5f;
+        check_all<C>(scene, ray, few, 6000, 240, "global, segment count 0.3, NEE count 0.5",
+                     [&](int c) { return double(le[c]); }, true);
     }
     for_each_kind<std::tuple<GridKind, SignedGridKind>, Emissive<M>>(
         [&](auto kind) { run(decltype(kind)::make(medium), decltype(kind)::name); });
@@ -125,6 +132,10 @@ TEST_CASE_TEMPLATE_DEFINE("emitting absorber with analytic optical depth = quadr
         EstimatorOptions off;
         off.emission_along_segments = false;
         check_all<C>(scene, ray, off, 20000, 160, maj_name + " no segment technique", [&](int c) { return ref[c]; }, true);
+        // The segment technique on a fifth of the segments: the collision estimator covers the rest.
+        EstimatorOptions few;
+        few.emission_segment_count = 0.2f;
+        check_all<C>(scene, ray, few, 20000, 260, maj_name + " segment count 0.2", [&](int c) { return ref[c]; }, true);
     };
     run(GlobalMajorant<Emissive<M>>(medium), "global");
     for_each_kind<std::tuple<SignedGlobalKind, GridKind, SignedGridKind>, Emissive<M>>(

@@ -129,6 +129,16 @@ TEST_CASE_TEMPLATE_DEFINE("spectral surface emission: white walls around two nes
         check_against(E{}, sc, 8000, 62, [](Pcg32& rng) {
             return Ray{Vec3(0.1f, 0.1f, -0.2f), uniform_sphere(rng.uniform(), rng.uniform())};
         }, le);
+        if constexpr (E::Strategy::combines) {
+            // Expected counts (THEORY 5.9): the segment technique on 30% of the pieces, NEE toward
+            // the lights and the volume's light sampling at half the vertices.
+            EstimatorOptions few;
+            few.emission_segment_count = 0.3f;
+            few.nee_count = 0.5f;
+            check_against(E{few}, sc, 8000, 63, [](Pcg32& rng) {
+                return Ray{Vec3(0.1f, 0.1f, -0.2f), uniform_sphere(rng.uniform(), rng.uniform())};
+            }, le);
+        }
     }
 }
 TEST_CASE_TEMPLATE_APPLY(spectral_emissive_furnace, Estimators);

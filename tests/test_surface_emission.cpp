@@ -52,6 +52,11 @@ void for_each_strategy(F check) {
     EstimatorOptions off;
     off.emission_along_segments = false;
     check(PathEstimator<strategy::NullScatteringMis, mis::Balance>{off}, "uni-nee-mis, no segment technique");
+    EstimatorOptions few;  // expected counts (THEORY 5.9): segments 0.3, NEE toward the lights 0.5
+    few.emission_segment_count = 0.3f;
+    few.nee_count = 0.5f;
+    check(PathEstimator<strategy::NullScatteringMis, mis::Balance>{few}, "uni-nee-mis, segment count 0.3, NEE count 0.5");
+    check(PathEstimator<strategy::EquiangularMis, mis::Balance>{few}, "equiangular-mis, segment count 0.3, NEE count 0.5");
     check(PathEstimator<strategy::EquiangularMis, mis::Balance>{}, "equiangular-mis");
 }
 

@@ -6,8 +6,8 @@
 // runs its estimate divides by n, and every MIS weight takes n p in place of its pdf p. That keeps
 // the estimator unbiased for any n in (0, 1] and lets a technique that does not pay for itself be
 // drawn rarely. The adaptive equiangular probability (EstimatorOptions::adaptive_equiangular),
-// BDPT's light_subpath_probability and PathEstimator's NEE count (EstimatorOptions::nee_count)
-// are such counts.
+// BDPT's light_subpath_probability, the NEE count (EstimatorOptions::nee_count) and the emission
+// segment technique's count (EstimatorOptions::emission_segment_count) are such counts.
 //
 // Choosing the NEE count (after Grittmann et al. 2022, "Efficiency-aware multiple importance
 // sampling for bidirectional rendering algorithms", which picks counts from estimated variances
@@ -22,12 +22,16 @@
 // noiseless, as in a furnace). NeeCountLearner keeps that for a ladder of candidate counts over a
 // pixel tile and picks the count that minimises variance x cost, the cost being density lookups
 // and DDA steps (deterministic, unlike time; a shadow walk's fixed work counted as one lookup) with
-// the shadow walks' share scaled by n (THEORY 5.9).
+// the shadow walks' share scaled by n (THEORY 5.9). Volume emission is the same with the
+// collision estimator in tracking's place and the segment technique in NEE's (NEE toward the
+// volume at a fixed count): the learner keeps both ladders and picks the pair of counts.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <utility>
 
 #include "core/counter.hpp"
 #include "core/error.hpp"
@@ -56,16 +60,28 @@ enum class LightTechnique : std::uint8_t {
     Other,  ///< a technique whose count the learner does not change (NEE from an equiangular vertex)
 };
 
-/// A lookup counter that also records what NeeCountLearner needs: every light contribution that
-/// both tracking and NEE can make and the work of every NEE shadow walk (whether the NEE count
-/// scales it or not). The estimators call these only on such counters; with any other counter
-/// they compile to nothing.
-template <class C>
-concept MisRecorder = LookupCounter<C> && requires(C& c, float f, LightTechnique t, double w, bool b) {
-    { c.record_light(f, f, f, f, f, t) } noexcept;
-    { c.record_shadow_walk(w, b) } noexcept;
-    { c.work() } -> std::convertible_to<double>;
+/// The three techniques that can produce volume emission at a point y of a segment (THEORY 5.7).
+enum class EmissionTechnique : std::uint8_t {
+    Collision,  ///< y a tentative collision of the delta-tracked segment (the collision estimator)
+    Segment,    ///< y drawn on the segment in proportion to the power grid along it, nulls ratio-tracked
+                ///< (drawn with EstimatorOptions::emission_segment_count)
+    Nee,        ///< y drawn in the volume by the power grid from the segment's real vertex x, nulls ratio-tracked
 };
+
+/// A lookup counter that also records what NeeCountLearner needs: every light contribution that
+/// both tracking and NEE can make and every emission contribution, the work of every NEE shadow
+/// walk (whether the NEE count scales it or not) and of every run of the emission segment
+/// technique. The estimators call these only on such counters; with any other counter they
+/// compile to nothing.
+template <class C>
+concept MisRecorder = LookupCounter<C> &&
+    requires(C& c, float f, LightTechnique t, EmissionTechnique e, double w, bool b) {
+        { c.record_light(f, f, f, f, f, t) } noexcept;
+        { c.record_emission(f, f, f, f, f, e) } noexcept;
+        { c.record_shadow_walk(w, b) } noexcept;
+        { c.record_segment_walk(w) } noexcept;
+        { c.work() } -> std::convertible_to<double>;
+    };
 
 namespace detail {
 /// Records a light contribution on a MisRecorder (else nothing). Every pdf is relative to one
@@ -80,6 +96,15 @@ void record_light(C& counter, float f_over_ref, float p_hit, float p_nee, float 
     if constexpr (MisRecorder<C>) counter.record_light(f_over_ref, p_hit, p_nee, p_other, count, t);
     else (void)counter, (void)f_over_ref, (void)p_hit, (void)p_nee, (void)p_other, (void)count, (void)t;
 }
+/// Records a volume emission contribution on a MisRecorder (else nothing), as record_light: the
+/// pdfs of the collision estimator, the segment technique (without its count) and NEE toward the
+/// volume relative to one reference density, `count` the segment count the path ran with.
+template <class C>
+void record_emission(C& counter, float f_over_ref, float p_collision, float p_segment, float p_nee, float count,
+                     EmissionTechnique t) noexcept {
+    if constexpr (MisRecorder<C>) counter.record_emission(f_over_ref, p_collision, p_segment, p_nee, count, t);
+    else (void)counter, (void)f_over_ref, (void)p_collision, (void)p_segment, (void)p_nee, (void)count, (void)t;
+}
 /// The work counted since `before` as one NEE shadow walk's, on a MisRecorder (else nothing):
 /// `counted` when the walk ran with the NEE count (from a tracked vertex or a surface), false when
 /// it runs whatever the count (from an equiangular vertex).
@@ -87,6 +112,13 @@ template <class C>
 void record_shadow_walk(C& counter, double before, bool counted) noexcept {
     if constexpr (MisRecorder<C>) counter.record_shadow_walk(counter.work() - before, counted);
     else (void)counter, (void)before, (void)counted;
+}
+/// The work counted since `before` as one run of the emission segment technique's, on a
+/// MisRecorder (else nothing).
+template <class C>
+void record_segment_walk(C& counter, double before) noexcept {
+    if constexpr (MisRecorder<C>) counter.record_segment_walk(counter.work() - before);
+    else (void)counter, (void)before;
 }
 /// counter.work() on a MisRecorder, else 0 (what record_shadow_walk takes as `before`).
 template <class C>
@@ -96,22 +128,33 @@ double recorder_work(const C& counter) noexcept {
 }
 }  // namespace detail
 
-/// Learns PathEstimator's NEE count (EstimatorOptions::nee_count) for a pixel tile from pilot
-/// samples rendered at count 1 with the learner as their lookup counter (see the header), for the
-/// balance heuristic. The host calls end_sample(estimate) after each sample and end_pixel() after
-/// each pixel's samples; choose() then gives the count. Deterministic: the same samples in the
-/// same order give the same count. Host-side and fixed-size (no heap); one per tile.
+/// The expected counts a NeeCountLearner chooses (EstimatorOptions::nee_count and
+/// EstimatorOptions::emission_segment_count).
+struct TechniqueCounts {
+    float nee = 1.f;
+    float emission_segment = 1.f;
+};
+
+/// Learns PathEstimator's NEE count (EstimatorOptions::nee_count) and, in emissive media, its
+/// emission segment count (EstimatorOptions::emission_segment_count) for a pixel tile from pilot
+/// samples rendered at counts 1 with the learner as their lookup counter (see the header), for the
+/// balance heuristic; the two jointly, over every pair of candidates (a path's light and emission
+/// contributions share its variance). The host calls end_sample(estimate) after each sample and
+/// end_pixel() after each pixel's samples; choose_counts() then gives the counts (choose() the NEE
+/// count alone). Where nothing emits the segment count stays 1 and the NEE count is what it would
+/// be without it. Deterministic: the same samples in the same order give the same counts.
+/// Host-side and fixed-size (no heap); one per tile.
 class NeeCountLearner {
 public:
     static constexpr bool enabled = true;
-    static constexpr int kCandidates = 7;  ///< counts 1, 1/2, ..., 1/64
+    static constexpr int kCandidates = 7;  ///< counts 1, 1/2, ..., 1/64 (for each technique)
 
     /// The j-th candidate count, 2^-j.
     static constexpr float candidate(int j) noexcept { return 1.f / float(1 << j); }
 
     /// A shadow walk's work besides its lookups and steps (the light sample, the phase or BSDF
     /// evaluation, the walk's set-up), in lookups: an assumption of the cost model, about what a
-    /// lookup costs.
+    /// lookup costs. The segment technique's run (its point's draw, its walk's set-up) counts the same.
     static constexpr double kShadowRayCost = 1.0;
 
     void lookup() noexcept { ++lookups_; }
@@ -126,44 +169,55 @@ public:
     /// the learner then reports invalid_pilot() and chooses 1.
     void record_light(float f_over_ref, float p_hit, float p_nee, float p_other, float count,
                       LightTechnique t) noexcept {
-        if (count != 1.f) invalid_ = true;
-        if (!(p_hit >= 0.f && p_nee >= 0.f && p_other >= 0.f) || !std::isfinite(f_over_ref) || f_over_ref == 0.f) return;
-        const double u = f_over_ref, h = p_hit, n = p_nee, o = p_other;
-        // With the balance heuristic the contribution is x = u / (h + c n + o) whichever technique
-        // drew it, NEE's where it runs (its weight c n / D over its count c): B x with B a
-        // Bernoulli draw of mean c, whose expectation c x and variance c (1 - c) x^2 go to A and B.
-        const double d1 = h + n + o;
-        if (!(d1 > 0.0) || !std::isfinite(d1)) return;
-        const double v1 = u / d1;
-        for (int j = 0; j < kCandidates; ++j) {
-            const double c = candidate(j), d = h + c * n + o;
-            const double x = d > 0.0 ? u / d : 0.0;
-            if (t == LightTechnique::Nee) {
-                path_delta_[std::size_t(j)] += c * x - v1;
-                path_bernoulli_[std::size_t(j)] += c * (1.0 - c) * x * x;
-            } else {
-                path_delta_[std::size_t(j)] += x - v1;
-            }
-        }
+        add_contribution(nee_, f_over_ref, p_hit, p_nee, p_other, count, t == LightTechnique::Nee);
+    }
+    /// Called by the estimator for every volume emission contribution of a combining strategy
+    /// (see detail::record_emission); a pilot at a segment count other than 1 is invalid as above.
+    void record_emission(float f_over_ref, float p_collision, float p_segment, float p_nee, float count,
+                         EmissionTechnique t) noexcept {
+        add_contribution(segment_, f_over_ref, p_collision, p_segment, p_nee, count, t == EmissionTechnique::Segment);
     }
     /// Called by the estimator after each NEE shadow walk with the work (work()) it took;
     /// `counted`: the walk runs with the NEE count, so its share of the cost scales with it (the
     /// walks from equiangular vertices run at any count: their work stays in the base).
     void record_shadow_walk(double w, bool counted) noexcept {
-        if (counted) nee_work_ += w + kShadowRayCost;
+        if (counted) nee_.work += w + kShadowRayCost;
+        fixed_work_ += kShadowRayCost;
+    }
+    /// Called by the estimator after each run of the emission segment technique with its work.
+    void record_segment_walk(double w) noexcept {
+        segment_.work += w + kShadowRayCost;
         fixed_work_ += kShadowRayCost;
     }
 
     /// The host, after each pilot sample: its estimate (the channel mean the render measures).
     void end_sample(double estimate) noexcept {
-        for (int j = 0; j < kCandidates; ++j) {
-            const double a = estimate + path_delta_[std::size_t(j)];
-            if (pixel_n_ == 0) shift_[std::size_t(j)] = a;  // shifted sums: no cancellation
-            const double d = a - shift_[std::size_t(j)];
-            pixel_sum_[std::size_t(j)] += d;
-            pixel_sum2_[std::size_t(j)] += d * d;
-            bernoulli_[std::size_t(j)] += path_bernoulli_[std::size_t(j)];
-            path_delta_[std::size_t(j)] = path_bernoulli_[std::size_t(j)] = 0.0;
+        for (int jn = 0; jn < kCandidates; ++jn)
+            for (int js = 0; js < kCandidates; ++js) {
+                const std::size_t k = pair(jn, js);
+                const double a = estimate + nee_.path_delta[std::size_t(jn)] + segment_.path_delta[std::size_t(js)];
+                if (pixel_n_ == 0) shift_[k] = a;  // shifted sums: no cancellation
+                const double d = a - shift_[k];
+                pixel_sum_[k] += d;
+                pixel_sum2_[k] += d * d;
+            }
+        SampleRecord& rec = group_[std::size_t(group_n_++)];
+        rec.estimate = estimate;
+        rec.nee_delta = nee_.path_delta;
+        rec.nee_bernoulli = nee_.path_bernoulli;
+        rec.segment_delta = segment_.path_delta;
+        rec.segment_bernoulli = segment_.path_bernoulli;
+        for (std::size_t j = 0; j < std::size_t(kCandidates); ++j) {
+            rec.nee_bernoulli[j] += nee_.path_diagonal[j];
+            rec.segment_bernoulli[j] += segment_.path_diagonal[j];
+        }
+        if (group_n_ == kGroupSize) flush_group();
+        for (Counted* t : {&nee_, &segment_}) {
+            for (std::size_t j = 0; j < std::size_t(kCandidates); ++j)
+                t->bernoulli[j] += t->path_bernoulli[j] + t->path_diagonal[j];
+            t->path_delta = {};
+            t->path_bernoulli = {};
+            t->path_diagonal = {};
         }
         ++pixel_n_;
         ++samples_;
@@ -172,13 +226,13 @@ public:
     void end_pixel() noexcept {
         if (pixel_n_ > 1) {
             const double n = double(pixel_n_);
-            for (int j = 0; j < kCandidates; ++j) {
-                const double s = pixel_sum_[std::size_t(j)], s2 = pixel_sum2_[std::size_t(j)];
-                const double var = (s2 - s * s / n) / (n - 1.0);
-                variance_sum_[std::size_t(j)] += (var > 0.0 ? var : 0.0) * n;
+            for (std::size_t k = 0; k < kPairs; ++k) {
+                const double var = (pixel_sum2_[k] - pixel_sum_[k] * pixel_sum_[k] / n) / (n - 1.0);
+                variance_sum_[k] += (var > 0.0 ? var : 0.0) * n;
             }
             variance_samples_ += pixel_n_;
         }
+        flush_group();
         pixel_n_ = 0;
         pixel_sum_ = {};
         pixel_sum2_ = {};
@@ -188,60 +242,225 @@ public:
     void merge(const NeeCountLearner& o) noexcept {
         lookups_ += o.lookups_;
         steps_ += o.steps_;
-        nee_work_ += o.nee_work_;
         fixed_work_ += o.fixed_work_;
         samples_ += o.samples_;
         variance_samples_ += o.variance_samples_;
+        z_n_ += o.z_n_;
+        z_dof_ += o.z_dof_;
         invalid_ = invalid_ || o.invalid_;
-        for (int j = 0; j < kCandidates; ++j) {
-            variance_sum_[std::size_t(j)] += o.variance_sum_[std::size_t(j)];
-            bernoulli_[std::size_t(j)] += o.bernoulli_[std::size_t(j)];
+        for (std::size_t k = 0; k < kPairs; ++k) {
+            variance_sum_[k] += o.variance_sum_[k];
+            z_[k] += o.z_[k];
+            z2_[k] += o.z2_[k];
+            z_at_1_[k] += o.z_at_1_[k];
+            z_nee_at_1_[k] += o.z_nee_at_1_[k];
+            z_segment_at_1_[k] += o.z_segment_at_1_[k];
+        }
+        for (auto [t, ot] : {std::pair{&nee_, &o.nee_}, std::pair{&segment_, &o.segment_}}) {
+            t->work += ot->work;
+            for (std::size_t j = 0; j < std::size_t(kCandidates); ++j) t->bernoulli[j] += ot->bernoulli[j];
         }
     }
 
-    /// The predicted variance of one sample at candidate j: the mean over pixels of the sample
-    /// variance of A(c_j), plus the mean of B(c_j); 0 before any pixel ended.
-    double predicted_variance(int j) const noexcept {
-        const double a = variance_samples_ > 0 ? variance_sum_[std::size_t(j)] / double(variance_samples_) : 0.0;
-        const double b = samples_ > 0 ? bernoulli_[std::size_t(j)] / double(samples_) : 0.0;
+    /// The predicted variance of one sample at NEE candidate j and segment candidate js: the mean
+    /// over pixels of the sample variance of A, plus the mean of both techniques' B; 0 before any
+    /// pixel ended.
+    double predicted_variance(int j, int js = 0) const noexcept {
+        const double a = variance_samples_ > 0 ? variance_sum_[pair(j, js)] / double(variance_samples_) : 0.0;
+        const double b = samples_ > 0 ? (nee_.bernoulli[std::size_t(j)] + segment_.bernoulli[std::size_t(js)]) /
+                                            double(samples_)
+                                      : 0.0;
         return a + b;
     }
-    /// Predicted work per sample at candidate j in lookups: lookups and DDA steps (work()), with
-    /// NEE's share (its shadow walks' work and kShadowRayCost each) scaled by the count, +1 per
-    /// sample for the camera ray (so that a tile whose paths never meet the medium has a cost).
-    double predicted_cost(int j) const noexcept {
+    /// Predicted work per sample at NEE candidate j and segment candidate js, in lookups: lookups
+    /// and DDA steps (work()), with each counted technique's share (its walks' work and
+    /// kShadowRayCost each) scaled by its count, +1 per sample for the camera ray (so that a tile
+    /// whose paths never meet the medium has a cost).
+    double predicted_cost(int j, int js = 0) const noexcept {
         if (samples_ == 0) return 1.0;
-        const double base = work() + fixed_work_ - nee_work_;
-        return (base + double(candidate(j)) * nee_work_) / double(samples_) + 1.0;
+        const double base = work() + fixed_work_ - nee_.work - segment_.work;
+        return (base + double(candidate(j)) * nee_.work + double(candidate(js)) * segment_.work) / double(samples_) +
+               1.0;
     }
 
-    /// The candidate count with the smallest predicted variance x cost; 1 when there is nothing to
-    /// learn from (no pixel with two samples, no variance at count 1) or the pilot did not run at
-    /// count 1.
-    float choose() const noexcept {
-        if (invalid_ || variance_samples_ == 0 || !(predicted_variance(0) > 0.0)) return 1.f;
-        int best = 0;
-        double best_e = predicted_variance(0) * predicted_cost(0);
-        for (int j = 1; j < kCandidates; ++j) {
-            const double e = predicted_variance(j) * predicted_cost(j);
-            if (e < best_e) best = j, best_e = e;
-        }
-        return candidate(best);
+    /// A count below 1 must pay for itself beyond the pilot's noise: a pair is taken only where its
+    /// predicted variance x cost is below that of the same pair with each reduced count put back
+    /// to 1 by at least kSignificance standard errors of the difference (paired: one pilot). The
+    /// predicted variance is a mean over the pilot's samples of z = n / (n - 1) (a - mean a)^2 + B
+    /// (a a sample's re-weighted estimate, the mean over its pixel, B its Bernoulli variance), so
+    /// the standard error follows from the spread of the samples' z differences: large exactly
+    /// where a few samples carry the prediction. A pilot's variance at a low count
+    /// rests on its largest re-weighted contributions, which are rare where the skipped technique
+    /// is the one that finds them: in the plume (examples) three pilots of one tile predicted the
+    /// variance at segment count 1/64 as 0.05, 0.0007 and 0.013 (measured: 0.007, against 0.002 at
+    /// count 1), and taking the lowest prediction's count tripled the image's variance. Count 1
+    /// (plain MIS) is the safe side.
+    static constexpr double kSignificance = 2.0;
+
+    /// The candidate pair with the smallest predicted variance x cost among those that pass the
+    /// significance test above (ties to the larger counts); counts 1 when there is nothing to
+    /// learn from (fewer than two samples in pixels with two or more, no variance at counts 1) or the pilot
+    /// did not run at counts 1.
+    TechniqueCounts choose_counts() const noexcept {
+        if (invalid_ || z_dof_ < 2 || !(predicted_variance(0, 0) > 0.0)) return {};
+        int best_n = 0, best_s = 0;
+        double best_e = predicted_variance(0, 0) * predicted_cost(0, 0);
+        for (int jn = 0; jn < kCandidates; ++jn)
+            for (int js = 0; js < kCandidates; ++js) {
+                if (jn == 0 && js == 0) continue;
+                const double e = predicted_variance(jn, js) * predicted_cost(jn, js);
+                if (!(e < best_e)) continue;
+                // Better than every pair with one or both of its reduced counts at 1, significantly.
+                const bool pays = significantly_better(jn, js, 0, 0, z_at_1_) &&
+                                  (jn == 0 || js == 0 ||
+                                   (significantly_better(jn, js, 0, js, z_nee_at_1_) &&
+                                    significantly_better(jn, js, jn, 0, z_segment_at_1_)));
+                if (pays) best_n = jn, best_s = js, best_e = e;
+            }
+        return {candidate(best_n), candidate(best_s)};
     }
+    /// The NEE count of choose_counts().
+    float choose() const noexcept { return choose_counts().nee; }
 
     bool invalid_pilot() const noexcept { return invalid_; }
     std::uint64_t samples() const noexcept { return samples_; }
-    double nee_work() const noexcept { return nee_work_; }  ///< NEE's work in lookups (see predicted_cost)
+    double nee_work() const noexcept { return nee_.work; }          ///< NEE's work in lookups (see predicted_cost)
+    double segment_work() const noexcept { return segment_.work; }  ///< the segment technique's
 
 private:
     using PerCandidate = std::array<double, kCandidates>;
-    std::uint64_t lookups_ = 0, steps_ = 0, samples_ = 0, variance_samples_ = 0;
-    double nee_work_ = 0.0, fixed_work_ = 0.0;
+    static constexpr std::size_t kPairs = std::size_t(kCandidates) * std::size_t(kCandidates);
+    using PerPair = std::array<double, kPairs>;
+    static constexpr std::size_t pair(int jn, int js) noexcept { return std::size_t(jn * kCandidates + js); }
+
+    /// One counted technique (NEE toward the lights, the emission segment technique): the current
+    /// sample's change of its estimate and Bernoulli variance at each candidate, the pixel's and
+    /// the tile's Bernoulli variance and the technique's work.
+    struct Counted {
+        PerCandidate path_delta{}, path_bernoulli{}, path_diagonal{}, bernoulli{};
+        double work = 0.0;
+    };
+
+    /// One pilot sample as the significance test needs it: its estimate and, per candidate of
+    /// each counted technique, the change of its re-weighted estimate and its Bernoulli variance.
+    struct SampleRecord {
+        double estimate = 0.0;
+        PerCandidate nee_delta{}, nee_bernoulli{}, segment_delta{}, segment_bernoulli{};
+    };
+    /// Samples of one pixel per group (a pixel with more forms several groups: the test's z only).
+    static constexpr int kGroupSize = 32;
+
+    /// Folds the current group's samples into the z sums (see kSignificance): z per sample at
+    /// every pair, its square and its products with z at the reference pairs.
+    void flush_group() noexcept {
+        const int n = group_n_;
+        group_n_ = 0;
+        if (n < 2) return;
+        PerPair mean{};
+        for (int i = 0; i < n; ++i)
+            for (int jn = 0; jn < kCandidates; ++jn)
+                for (int js = 0; js < kCandidates; ++js)
+                    mean[pair(jn, js)] += value(group_[std::size_t(i)], jn, js);
+        for (double& m : mean) m /= double(n);
+        const double k = double(n) / double(n - 1);
+        // Sums within the group, then folded in about the group's own means: the standard error
+        // is that of the tile's pixels as they are (their spread within), not of a random draw
+        // of pixels (their differences between them are no noise of the prediction).
+        PerPair z{}, sum{}, sum2{}, at_1{}, nee_at_1{}, segment_at_1{};
+        for (int i = 0; i < n; ++i) {
+            const SampleRecord& r = group_[std::size_t(i)];
+            for (int jn = 0; jn < kCandidates; ++jn)
+                for (int js = 0; js < kCandidates; ++js) {
+                    const double d = value(r, jn, js) - mean[pair(jn, js)];
+                    z[pair(jn, js)] = k * d * d + r.nee_bernoulli[std::size_t(jn)] + r.segment_bernoulli[std::size_t(js)];
+                }
+            for (int jn = 0; jn < kCandidates; ++jn)
+                for (int js = 0; js < kCandidates; ++js) {
+                    const std::size_t p = pair(jn, js);
+                    sum[p] += z[p];
+                    sum2[p] += z[p] * z[p];
+                    at_1[p] += z[p] * z[0];
+                    nee_at_1[p] += z[p] * z[pair(0, js)];
+                    segment_at_1[p] += z[p] * z[pair(jn, 0)];
+                }
+        }
+        const double inv = 1.0 / double(n);
+        for (int jn = 0; jn < kCandidates; ++jn)
+            for (int js = 0; js < kCandidates; ++js) {
+                const std::size_t p = pair(jn, js);
+                z_[p] += sum[p];
+                z2_[p] += sum2[p] - sum[p] * sum[p] * inv;
+                z_at_1_[p] += at_1[p] - sum[p] * sum[0] * inv;
+                z_nee_at_1_[p] += nee_at_1[p] - sum[p] * sum[pair(0, js)] * inv;
+                z_segment_at_1_[p] += segment_at_1[p] - sum[p] * sum[pair(jn, 0)] * inv;
+            }
+        z_n_ += std::uint64_t(n);
+        z_dof_ += std::uint64_t(n - 1);
+    }
+    static double value(const SampleRecord& r, int jn, int js) noexcept {
+        return r.estimate + r.nee_delta[std::size_t(jn)] + r.segment_delta[std::size_t(js)];
+    }
+
+    /// Whether pair (jn, js) has a smaller predicted variance x cost than pair (rn, rs) by more
+    /// than kSignificance standard errors: over the pilot's samples, the mean and spread of
+    /// d = z(jn, js) C(jn, js) - z(rn, rs) C(rn, rs) within the groups (`cross`: the sums of
+    /// z(jn, js) z(rn, rs) about the groups' means), C the tile's predicted cost.
+    bool significantly_better(int jn, int js, int rn, int rs, const PerPair& cross) const noexcept {
+        const std::size_t k = pair(jn, js), r = pair(rn, rs);
+        const double m = double(z_n_), dof = double(z_dof_), c = predicted_cost(jn, js), cr = predicted_cost(rn, rs);
+        const double mean = (z_[k] * c - z_[r] * cr) / m;
+        const double var_k = z2_[k] / dof, var_r = z2_[r] / dof, cov = cross[k] / dof;
+        const double var_d = c * c * var_k + cr * cr * var_r - 2.0 * c * cr * cov;
+        const double se = std::sqrt(std::max(var_d, 0.0) / m);
+        return mean + kSignificance * se < 0.0;
+    }
+
+    /// A contribution x = u / (h + c n + o) under the balance heuristic whichever of the three
+    /// techniques drew it (h: count 1; n: the counted one, at count c; o: a fixed count), the
+    /// counted technique's where it runs (its weight c n / D over its count c): B x with B a
+    /// Bernoulli draw of mean c, whose expectation c x and variance c (1 - c) x^2 go to A and B.
+    void add_contribution(Counted& t, float f_over_ref, float p_fixed, float p_counted, float p_other, float count,
+                          bool drawn_by_counted) noexcept {
+        if (count != 1.f) invalid_ = true;
+        if (!(p_fixed >= 0.f && p_counted >= 0.f && p_other >= 0.f) || !std::isfinite(f_over_ref) || f_over_ref == 0.f)
+            return;
+        const double u = f_over_ref, h = p_fixed, n = p_counted, o = p_other;
+        const double d1 = h + n + o;
+        if (!(d1 > 0.0) || !std::isfinite(d1)) return;
+        const double v1 = u / d1;
+        for (int j = 0; j < kCandidates; ++j) {
+            const double c = candidate(j), d = h + c * n + o;
+            const double x = d > 0.0 ? u / d : 0.0;
+            // The contribution's own second moment at count c, E[(its estimate)^2]: x^2 drawn by a
+            // technique of fixed count, c x^2 by the counted one (the sum of its A and B parts).
+            // Its expectation over the techniques is int f^2 / D(c), which u^2 / (D(1) D(c)) from
+            // any technique's draw estimates too, with far less noise where the drawing technique
+            // is the rare one; the difference goes into `diagonal` (expectation 0).
+            const double own = drawn_by_counted ? c * x * x : x * x;
+            t.path_diagonal[std::size_t(j)] += (d > 0.0 ? u * u / (d1 * d) : 0.0) - own;
+            if (drawn_by_counted) {
+                t.path_delta[std::size_t(j)] += c * x - v1;
+                t.path_bernoulli[std::size_t(j)] += c * (1.0 - c) * x * x;
+            } else {
+                t.path_delta[std::size_t(j)] += x - v1;
+            }
+        }
+    }
+
+    std::uint64_t lookups_ = 0, steps_ = 0, samples_ = 0, variance_samples_ = 0, z_n_ = 0, z_dof_ = 0;
+    double fixed_work_ = 0.0;
     int pixel_n_ = 0;
     bool invalid_ = false;
-    PerCandidate path_delta_{}, path_bernoulli_{};         // the current sample
-    PerCandidate shift_{}, pixel_sum_{}, pixel_sum2_{};    // the current pixel
-    PerCandidate variance_sum_{}, bernoulli_{};            // the tile
+    Counted nee_, segment_;
+    PerPair shift_{}, pixel_sum_{}, pixel_sum2_{};  // the current pixel
+    PerPair variance_sum_{};                        // the tile
+    // Over the pilot's samples (in groups of two or more), of z at each pair: its sum, and about
+    // each group's mean its sum of squares and its products with z at counts 1 (both), with z at
+    // the pair's segment count and NEE count 1, and at its NEE count and segment count 1; the
+    // samples and the degrees of freedom (samples less groups).
+    PerPair z_{}, z2_{}, z_at_1_{}, z_nee_at_1_{}, z_segment_at_1_{};
+    std::array<SampleRecord, std::size_t(kGroupSize)> group_{};  // the current pixel's samples
+    int group_n_ = 0;
 };
 
 static_assert(MisRecorder<NeeCountLearner>);

@@ -279,4 +279,24 @@ void record_channels(C& counter, const Spec& f, const Spec& uni, const Spec& nee
     }
 }
 
+/// Records a volume emission contribution of the spectral estimators on a MisRecorder (else
+/// nothing), as record_channels: channel_estimate's numerator `f` and its denominator split into
+/// the pdf sums of the collision estimator, the segment technique (with its count `count`, which
+/// this divides out) and NEE toward the volume; `t` the technique that drew it.
+template <ChannelPolicy CP, class C, class Spec>
+void record_emission_channels(C& counter, const Spec& f, const Spec& collision, const Spec& segment, const Spec& nee,
+                              const Spec& q, int c, float count, EmissionTechnique t) noexcept {
+    if constexpr (MisRecorder<C>) {
+        if constexpr (CP::mis_over_channels) {
+            detail::record_emission(counter, f.mean(), (q * collision).sum(), (q * segment).sum() / count,
+                                    (q * nee).sum(), count, t);
+        } else {
+            detail::record_emission(counter, f[c] / float(Spec::SizeAtCompileTime), q[c] * collision[c],
+                                    q[c] * segment[c] / count, q[c] * nee[c], count, t);
+        }
+    } else {
+        (void)counter, (void)f, (void)collision, (void)segment, (void)nee, (void)q, (void)c, (void)count, (void)t;
+    }
+}
+
 }  // namespace nsp

@@ -116,13 +116,6 @@ float equiangular_mis_weight(const H& h, VertexTechnique which, float track_nee,
     }
 }
 
-/// The three techniques that can produce volume emission at a point y of a segment (THEORY 5.7).
-enum class EmissionTechnique : std::uint8_t {
-    Collision,  ///< y a tentative collision of the delta-tracked segment (the collision estimator)
-    Segment,    ///< y drawn on the segment in proportion to the power grid along it, nulls ratio-tracked
-    Nee,        ///< y drawn in the volume by the power grid from the segment's real vertex x, nulls ratio-tracked
-};
-
 /// The pdfs of the three emission techniques for one path whose last segment, from a real vertex
 /// x (or the camera), reaches y at distance d, on a common scale, the largest 1. In volume measure
 /// times d^2, the nulls' shared mu_bar Tbar factors left out (they cancel):

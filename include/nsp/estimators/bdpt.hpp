@@ -354,7 +354,7 @@ private:
 
     static EstimatorOptions checked(EstimatorOptions o) {
         validate(o);
-        require_unit_nee_count(o, "nsp::BdptEstimator");
+        require_unit_counts(o, "nsp::BdptEstimator");
         if (o.max_depth > MaxDepth)
             detail::fail("BdptEstimator max_depth = ", o.max_depth, " is not allowed: it must be <= ", MaxDepth,
                          " (the estimator's MaxDepth template argument, the size of its vertex arrays)");

@@ -91,6 +91,14 @@ struct EstimatorOptions {
     /// the volume by MIS. It is the only sampling technique for the emission a camera ray sees
     /// directly. Off: collisions and NEE only. No effect on other media or strategies.
     bool emission_along_segments = true;
+    /// The expected count of the segment technique on each segment, in (0, 1] (THEORY 5.9,
+    /// counts.hpp; with emission_along_segments on): it runs on a segment with this probability,
+    /// its estimate divided by it, and every emission weight takes count x p_seg. 1: on every
+    /// segment. Below 1 it saves the technique's flight and lookup where the collision estimator
+    /// and NEE find the emission well; the power grid's walk along the segment stays (the other
+    /// techniques' weights need W). nsp::PathEstimator and nsp::SpectralPathEstimator, media and
+    /// surfaces; nsp::BdptEstimator rejects a value other than 1.
+    float emission_segment_count = 1.f;
     /// The expected count of NEE toward the lights at each real vertex, in (0, 1] (THEORY 5.9,
     /// counts.hpp): NEE runs there with this probability, its estimate divided by it, and the MIS
     /// weights of both techniques take nee_count x the light pdf. 1: NEE at every vertex. Below 1
@@ -212,15 +220,41 @@ std::optional<EmissionSample> sample_emission_from(const M& medium, const Lights
     return e;
 }
 
+/// The segment technique's density of a point in the MIS weights, count x p_V / W (W = `along`,
+/// its normaliser on the point's segment; opts.emission_segment_count the count): 0 where the
+/// technique does not run (W = 0).
+inline float segment_density(const EstimatorOptions& opts, float p_v, float along) noexcept {
+    return along > 0.f ? opts.emission_segment_count * (p_v / along) : 0.f;
+}
+
+/// Records an emission contribution drawn by technique `t` on a MisRecorder (else nothing):
+/// `unweighted` its channel mean without MIS weight or count (f over the drawing technique's
+/// density), `p` the three techniques' pdfs on their common scale (emission_pdfs, vertex.hpp), the
+/// segment's with opts.emission_segment_count in it.
+template <class C, class Pdfs>
+void record_emission_of(C& counter, float unweighted, const Pdfs& p, const EstimatorOptions& opts,
+                        EmissionTechnique t) noexcept {
+    if constexpr (MisRecorder<C>) {
+        const float count = opts.emission_segment_count;
+        const float p_seg = p.segment / count;
+        const float drawn = t == EmissionTechnique::Collision ? p.collision
+                            : t == EmissionTechnique::Segment ? p_seg
+                                                              : p.nee;
+        detail::record_emission(counter, unweighted * drawn, p.collision, p_seg, p.nee, count, t);
+    } else {
+        (void)counter, (void)unweighted, (void)p, (void)opts, (void)t;
+    }
+}
+
 /// The segment technique's density p_seg(y) = p_V(y) / W for an emission NEE sample from x: W along
 /// the ray from x toward y, to the sphere light it would hit or out of the medium (the segment
-/// tracking would take; sample_emission_from left y before that light). 0 where the technique
-/// does not run (`opts.emission_along_segments` off, or W = 0).
+/// tracking would take; sample_emission_from left y before that light), times the technique's
+/// count. 0 where the technique does not run (`opts.emission_along_segments` off, or W = 0).
 template <class Sc>
 float emission_segment_pdf(const EstimatorOptions& opts, const Sc& scene, const EmissionSample& e) noexcept {
     if (!opts.emission_along_segments) return 0.f;
     const float along = scene.medium.emission_along(e.shadow, 0.f, scene.lights.intersect(e.shadow).t);
-    return along > 0.f ? e.y.pdf / along : 0.f;
+    return segment_density(opts, e.y.pdf, along);
 }
 
 /// Throws InvalidArgument on max_depth < 0, rr_start_depth < 1 or rr_max_survival outside (0, 1].
@@ -233,14 +267,19 @@ inline void validate(const EstimatorOptions& opts) {
         detail::fail("EstimatorOptions rr_max_survival = ", opts.rr_max_survival,
                      " is not allowed: it must lie in (0, 1]");
     validate_count("EstimatorOptions nee_count", opts.nee_count);
+    validate_count("EstimatorOptions emission_segment_count", opts.emission_segment_count);
 }
 
-/// Throws InvalidArgument unless opts.nee_count is 1: for the estimators that do not take NEE
-/// counts (`estimator` names it), so that a count is never silently ignored.
-inline void require_unit_nee_count(const EstimatorOptions& opts, const char* estimator) {
+/// Throws InvalidArgument unless opts.nee_count and opts.emission_segment_count are 1: for the
+/// estimators that do not take expected counts (`estimator` names it), so that a count is never
+/// silently ignored.
+inline void require_unit_counts(const EstimatorOptions& opts, const char* estimator) {
     if (opts.nee_count != 1.f)
         detail::fail("EstimatorOptions nee_count = ", opts.nee_count, " is not allowed for ", estimator,
                      ": it takes NEE at every vertex (nee_count 1); expected counts are nsp::PathEstimator's");
+    if (opts.emission_segment_count != 1.f)
+        detail::fail("EstimatorOptions emission_segment_count = ", opts.emission_segment_count, " is not allowed for ",
+                     estimator, ": it takes no segment technique count (1); expected counts are nsp::PathEstimator's");
 }
 
 }  // namespace nsp

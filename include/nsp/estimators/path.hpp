@@ -118,14 +118,17 @@ private:
             DeltaTrack<typename Sc::Spectral> seg;
             if constexpr (kEmissive) {
                 // The segment technique: a point drawn on this segment in proportion to the power
-                // grid along it (W: its normaliser; 0 where it does not run).
+                // grid along it (W: its normaliser; 0 where it does not run), with the expected
+                // count EstimatorOptions::emission_segment_count (THEORY 5.9).
                 float along = 0.f;
                 if constexpr (St::combines) {
                     if (kernels_.options().emission_along_segments) {
                         along = scene.medium.emission_along(ray, 0.f, hit.t);
-                        if (along > 0.f) {
+                        if (along > 0.f && draw_technique(kernels_.options().emission_segment_count, rng)) {
+                            const double before = detail::recorder_work(counter);
                             const Status es = emission_segment(scene, ray, hit.t, along, !from_camera, prev_survival,
                                                                prev_phase_pdf, lambda, rng, counter, beta, L);
+                            detail::record_segment_walk(counter, before);
                             if (es != Status::Ok) status = es;
                         }
                     }
@@ -133,9 +136,9 @@ private:
                 if (from_camera || St::hits_lights) {
                     // The NEE alternative of emission exists from real vertices only (THEORY 5.7).
                     seg = track_delta_visiting<A>(scene.medium, scene.majorant, ray, hit.t, lambda, rng, counter,
-                                                  EmissionCollector<Sc>{scene, ray, lambda, beta, L, kernels_.heuristic(),
-                                                                        !from_camera, prev_survival, prev_phase_pdf,
-                                                                        along});
+                                                  EmissionCollector<Sc, C>{scene, ray, lambda, beta, L, kernels_.heuristic(),
+                                                                           kernels_.options(), counter, !from_camera,
+                                                                           prev_survival, prev_phase_pdf, along});
                 } else {
                     seg = track_delta<A>(scene.medium, scene.majorant, ray, hit.t, lambda, rng, counter);
                 }
@@ -314,8 +317,8 @@ private:
     /// The collision estimator of volume emission (THEORY 5.7): at every tentative collision y of
     /// a delta-tracked segment, beta mu_a(y) L_e(y) / mu_bar(y), weighted against NEE toward the
     /// emission where the segment left a real vertex and against the segment technique where it
-    /// ran (`along` > 0, its normaliser on this segment).
-    template <class Sc>
+    /// can run (`along` > 0, its normaliser on this segment; its count in `opts`).
+    template <class Sc, class C>
     struct EmissionCollector {
         static constexpr bool enabled = true;
         using S = typename Sc::Spectral;
@@ -325,6 +328,8 @@ private:
         const typename S::Spectrum& beta;
         typename S::Spectrum& L;
         const H& heuristic;
+        const EstimatorOptions& opts;
+        C& counter;  ///< a MisRecorder records the contribution (counts.hpp)
         bool from_vertex;  ///< the segment left a real vertex (else the camera: no NEE alternative)
         float survival, phase_pdf;
         float along;
@@ -338,11 +343,14 @@ private:
             float wt = 1.f;
             if constexpr (St::combines) {
                 const float p_v = scene.medium.emission_pdf(y);
-                const float p_seg = along > 0.f ? p_v / along : 0.f;
-                wt = emission_weight(heuristic, EmissionTechnique::Collision,
-                                     from_vertex ? emission_pdfs<St>(survival, phase_pdf, null_pdf_product, mu_bar,
-                                                                     p_seg, t * t, p_v)
-                                                 : emission_pdfs<St>(1.f, 1.f, null_pdf_product, mu_bar, p_seg, 0.f, 0.f));
+                const float p_seg = segment_density(opts, p_v, along);
+                const EmissionPdfs p = from_vertex ? emission_pdfs<St>(survival, phase_pdf, null_pdf_product, mu_bar,
+                                                                       p_seg, t * t, p_v)
+                                                   : emission_pdfs<St>(1.f, 1.f, null_pdf_product, mu_bar, p_seg, 0.f, 0.f);
+                wt = emission_weight(heuristic, EmissionTechnique::Collision, p);
+                if constexpr (MisRecorder<C>)
+                    record_emission_of(counter, (beta * w * c.sigma_a * le).mean() / mu_bar, p, opts,
+                                       EmissionTechnique::Collision);
             }
             L += beta * w * c.sigma_a * le * (wt / mu_bar);
         }
@@ -352,7 +360,8 @@ private:
     /// the density p_seg = emission_pdf / `along` along the ray, the nulls before it ratio-tracked,
     /// beta Tbar-ratio mu_a(y) L_e(y) / p_seg(y), weighted against the collision estimator of the
     /// same segment and, from a real vertex (`from_vertex`, with roulette survival and phase pdf
-    /// there), against NEE toward the volume.
+    /// there), against NEE toward the volume. It ran with the expected count emission_segment_count:
+    /// its estimate divides by it, its weight takes count x p_seg.
     template <class Sc, UniformRng R, LookupCounter C>
     Status emission_segment(const Sc& scene, const Ray& ray, float tmax, float along, bool from_vertex, float survival,
                             float phase_pdf, const typename Sc::Spectral::Wavelengths& lambda, R& rng, C& counter,
@@ -369,11 +378,16 @@ private:
         const typename Sc::Spectrum le = scene.medium.emission(y, lambda);
         // The weight takes p_seg where every technique evaluates it: at the point's own cell.
         const float p_v = scene.medium.emission_pdf(y);
+        const float count = kernels_.options().emission_segment_count;
+        const float p_seg = segment_density(kernels_.options(), p_v, along);
         const EmissionPdfs p = from_vertex ? emission_pdfs<St>(survival, phase_pdf, tr.null_pdf_product, v->mu,
-                                                               p_v / along, ds.t * ds.t, p_v)
-                                           : emission_pdfs<St>(1.f, 1.f, tr.null_pdf_product, v->mu, p_v / along, 0.f, 0.f);
+                                                               p_seg, ds.t * ds.t, p_v)
+                                           : emission_pdfs<St>(1.f, 1.f, tr.null_pdf_product, v->mu, p_seg, 0.f, 0.f);
         const float w = emission_weight(kernels_.heuristic(), EmissionTechnique::Segment, p);
-        L += beta * tr.transmittance * v->k.sigma_a * le * (w / ds.pdf);
+        if constexpr (MisRecorder<C>)
+            record_emission_of(counter, (beta * tr.transmittance * v->k.sigma_a * le).mean() / ds.pdf, p,
+                               kernels_.options(), EmissionTechnique::Segment);
+        L += beta * tr.transmittance * v->k.sigma_a * le * (w / (count * ds.pdf));
         return Status::Ok;
     }
 
@@ -394,10 +408,17 @@ private:
         const typename Sc::Spectrum le = scene.medium.emission(e->y.p, lambda);
         const Vec3& wi = e->shadow.d;
         float w = 1.f;
-        if constexpr (St::combines)
-            w = emission_weight(kernels_.heuristic(), EmissionTechnique::Nee,
-                                emission_pdfs<St>(survival, scene.phase.pdf(wo, wi), tr.null_pdf_product, v->mu,
-                                                  emission_segment_pdf(kernels_.options(), scene, *e), e->dist2, e->y.pdf));
+        if constexpr (St::combines) {
+            const EmissionPdfs p =
+                emission_pdfs<St>(survival, scene.phase.pdf(wo, wi), tr.null_pdf_product, v->mu,
+                                  emission_segment_pdf(kernels_.options(), scene, *e), e->dist2, e->y.pdf);
+            w = emission_weight(kernels_.heuristic(), EmissionTechnique::Nee, p);
+            if constexpr (MisRecorder<C>)
+                record_emission_of(counter,
+                                   (beta * tr.transmittance * v->k.sigma_a * le).mean() * scene.phase.eval(wo, wi) /
+                                       (e->dist2 * e->y.pdf),
+                                   p, kernels_.options(), EmissionTechnique::Nee);
+        }
         L += beta * tr.transmittance * v->k.sigma_a * le * (w * scene.phase.eval(wo, wi) / (e->dist2 * e->y.pdf));
         return Status::Ok;
     }

@@ -146,17 +146,23 @@ private:
                         along = scene.medium.emission_along(ray, 0.f, hit.t);
                         if (along > 0.f) {
                             if (from_camera) st.nee = st.uni;
-                            const Status es = emission_segment(scene, ray, hit.t, along, nee_alternative, dir_pdf,
-                                                               lambda, q, c, st, rng, counter, L);
-                            if (es == Status::NonFinite) return {Spectrum::Zero(), es};  // an overflowed flight: see below
-                            if (es != Status::Ok) status = es;
+                            // With the expected count EstimatorOptions::emission_segment_count (THEORY 5.9).
+                            if (draw_technique(opts_.emission_segment_count, rng)) {
+                                const double before = detail::recorder_work(counter);
+                                const Status es = emission_segment(scene, ray, hit.t, along, nee_alternative, dir_pdf,
+                                                                   lambda, q, c, st, rng, counter, L);
+                                detail::record_segment_walk(counter, before);
+                                if (es == Status::NonFinite) return {Spectrum::Zero(), es};  // an overflowed flight: see below
+                                if (es != Status::Ok) status = es;
+                            }
                         }
                     }
                 }
                 if (from_camera || St::hits_lights)
                     seg = track_channels_delta_visiting<CP, A>(
                         scene.medium, scene.majorant, ray, hit.t, lambda, c, st, nee_alternative || along > 0.f, rng,
-                        counter, EmissionCollector<Sc>{scene, ray, lambda, q, c, L, nee_alternative, along, dir_pdf});
+                        counter, EmissionCollector<Sc, C>{scene, ray, lambda, q, c, L, opts_, counter,
+                                                                    nee_alternative, along, dir_pdf});
                 else
                     seg = track_channels_delta<CP, A>(scene.medium, scene.majorant, ray, hit.t, lambda, c, st,
                                                       nee_alternative, rng, counter);
@@ -287,8 +293,9 @@ private:
     /// tentative collision y, f_c = f_c(prefix) Tbar_c mu_a,c L_e,c and the collision pdf
     /// mu_bar_c Tbar_c of every channel; with `nee_alternative` also NEE's pdf of y toward the
     /// volume (ratio-tracked nulls from the last real vertex, p_V(y) t^2 in the same measure), and
-    /// where the segment technique ran (`along` > 0) its pdf: the same nulls, dir_pdf p_seg(y).
-    template <class Sc>
+    /// where the segment technique can run (`along` > 0) its pdf: the same nulls, dir_pdf p_seg(y)
+    /// times its count.
+    template <class Sc, class C>
     struct EmissionCollector {
         static constexpr bool enabled = true;
         using S = typename Sc::Spectral;
@@ -299,6 +306,8 @@ private:
         const Spec& q;
         int c;
         Spec& L;
+        const EstimatorOptions& opts;
+        C& counter;  ///< a MisRecorder records the contribution (counts.hpp)
         bool nee_alternative;
         float along, dir_pdf;
 
@@ -311,8 +320,13 @@ private:
             Spec pdf = st.uni * tbar * mu;
             if (nee_alternative || along > 0.f) {
                 const float p_v = scene.medium.emission_pdf(y);
-                const float other = (nee_alternative ? p_v * t * t : 0.f) + (along > 0.f ? dir_pdf * (p_v / along) : 0.f);
-                pdf += st.nee * tbar * other;
+                const float to_volume = nee_alternative ? p_v * t * t : 0.f;
+                const float on_segment = dir_pdf * segment_density(opts, p_v, along);
+                pdf += st.nee * tbar * (to_volume + on_segment);
+                if constexpr (MisRecorder<C> && St::combines)
+                    record_emission_channels<CP>(counter, Spec(st.f * tbar * k.sigma_a * le), Spec(st.uni * tbar * mu),
+                                                 Spec(st.nee * tbar * on_segment), Spec(st.nee * tbar * to_volume), q, c,
+                                                 opts.emission_segment_count, EmissionTechnique::Collision);
             }
             L += channel_estimate<CP, Spec>(Spec(st.f * tbar * k.sigma_a * le), pdf, q, c);
         }
@@ -340,9 +354,15 @@ private:
         Spectrum pdf = sh.nee * (e->y.pdf * e->dist2);
         if constexpr (St::combines) {
             const float dir = rr * scene.phase.pdf(wo, wi);
-            pdf += sh.uni * detail::broadcast_majorant<Spectrum>(v->mu) * dir;
+            const Spectrum collision = sh.uni * detail::broadcast_majorant<Spectrum>(v->mu) * dir;
             // The segment technique on the ray from x toward y, with the same ratio-tracked nulls.
-            pdf += sh.nee * (dir * emission_segment_pdf(opts_, scene, *e));
+            const Spectrum segment = sh.nee * (dir * emission_segment_pdf(opts_, scene, *e));
+            if constexpr (MisRecorder<C>)
+                record_emission_channels<CP>(counter, f, Spectrum(st.uni * collision), Spectrum(st.uni * segment),
+                                             Spectrum(st.uni * pdf), q, c, opts_.emission_segment_count,
+                                             EmissionTechnique::Nee);
+            pdf += collision;
+            pdf += segment;
         }
         L += channel_estimate<CP, Spectrum>(f, Spectrum(st.uni * pdf), q, c);
         return Status::Ok;
@@ -374,9 +394,16 @@ private:
         // Every channel's pdf of the three techniques, p_seg where each technique evaluates it (the
         // point's own cell).
         const float p_v = scene.medium.emission_pdf(y);
-        Spectrum pdf = st.uni * sh.uni * detail::broadcast_majorant<Spectrum>(v->mu);
-        pdf += st.nee * sh.nee * ((nee_alternative ? p_v * ds.t * ds.t : 0.f) + dir_pdf * (p_v / along));
-        // channel_estimate divides by this technique's pdf in the sum; the density actually
+        const Spectrum collision = st.uni * sh.uni * detail::broadcast_majorant<Spectrum>(v->mu);
+        if constexpr (MisRecorder<C>)
+            record_emission_channels<CP>(counter, f, collision,
+                                         Spectrum(st.nee * sh.nee * (dir_pdf * segment_density(opts_, p_v, along))),
+                                         Spectrum(st.nee * sh.nee * (nee_alternative ? p_v * ds.t * ds.t : 0.f)), q, c,
+                                         opts_.emission_segment_count, EmissionTechnique::Segment);
+        Spectrum pdf = collision;
+        pdf += st.nee * sh.nee * ((nee_alternative ? p_v * ds.t * ds.t : 0.f) + dir_pdf * segment_density(opts_, p_v, along));
+        // channel_estimate divides by the techniques' sum, where this one's pdf is count x p_seg:
+        // that is the estimate of a technique run with its count (THEORY 5.9). The density actually
         // sampled is ds.pdf, which differs from p_v / along only within rounding of a cell face.
         L += channel_estimate<CP, Spectrum>(f, pdf, q, c);
         return Status::Ok;

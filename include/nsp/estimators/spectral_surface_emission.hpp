@@ -27,7 +27,7 @@ namespace nsp::detail {
 
 /// The collision estimator of one piece in an emissive medium, over channels: at every tentative
 /// collision y, f Tbar mu_a L_e against every channel's three pdfs (see the header).
-template <ChannelPolicy CP, class Sc>
+template <ChannelPolicy CP, class Sc, class C, bool kRecord>
 struct ChannelPieceEmission {
     static constexpr bool enabled = true;
     using S = typename Sc::Spectral;
@@ -38,6 +38,8 @@ struct ChannelPieceEmission {
     const Spec& q;
     int c;
     Spec& L;
+    const EstimatorOptions& opts;
+    C& counter;            ///< with kRecord (a combining strategy), a MisRecorder records the contribution
     bool nee_alternative;  ///< NEE toward the volume from the last real vertex could have drawn y
     float along, select, walked;
 
@@ -52,7 +54,13 @@ struct ChannelPieceEmission {
             const float p_v = medium.emission_pdf(y);
             const float d = walked + t;
             if (nee_alternative) pdf += st.nee * tbar * (select * p_v * d * d);
-            if (along > 0.f) pdf += st.eq.vertex * tbar * (p_v / along);
+            if (along > 0.f) pdf += st.eq.vertex * tbar * segment_density(opts, p_v, along);
+            if constexpr (MisRecorder<C> && kRecord)
+                record_emission_channels<CP>(
+                    counter, Spec(st.f * tbar * k.sigma_a * le), Spec(st.uni * tbar * mu),
+                    Spec(st.eq.vertex * tbar * segment_density(opts, p_v, along)),
+                    Spec(st.nee * tbar * (nee_alternative ? select * p_v * d * d : 0.f)), q, c,
+                    opts.emission_segment_count, EmissionTechnique::Collision);
         }
         L += channel_estimate<CP, Spec>(Spec(st.f * tbar * k.sigma_a * le), pdf, q, c);
     }
@@ -74,7 +82,10 @@ ChannelTrack track_emissive_piece_channels(const EstimatorOptions& opts, const S
     float along = 0.f;
     if constexpr (St::combines) {
         if (opts.emission_along_segments) along = m.medium.emission_along(ray, 0.f, t_max);
-        if (along > 0.f) {
+        // With the expected count EstimatorOptions::emission_segment_count (THEORY 5.9): the
+        // techniques' sum takes count x p_seg, which makes channel_estimate the count's estimate.
+        if (along > 0.f && draw_technique(opts.emission_segment_count, rng)) {
+            const double before = recorder_work(counter);
             const DistanceSample ds = m.medium.sample_emission_along(ray, 0.f, t_max, along, rng.uniform());
             if (ds.pdf > 0.f) {
                 const auto sh = track_channels_ratio<CP, A>(m.medium, m.majorant, ray, ds.t, lambda, c, st.f, true, rng,
@@ -90,19 +101,27 @@ ChannelTrack track_emissive_piece_channels(const EstimatorOptions& opts, const S
                         const float p_v = m.medium.emission_pdf(y);
                         const float d = walked + ds.t;
                         Spectrum pdf = st.uni * sh.uni * broadcast_majorant<Spectrum>(v->mu);
-                        pdf += st.uni * sh.nee * (p_v / along);
+                        pdf += st.uni * sh.nee * segment_density(opts, p_v, along);
                         if (nee_alternative) pdf += st.nee * sh.nee * (select * p_v * d * d);
-                        L += channel_estimate<CP, Spectrum>(
-                            Spectrum(st.f * sh.f * v->k.sigma_a * m.medium.emission(y, lambda)), pdf, q, c);
+                        const Spectrum f = st.f * sh.f * v->k.sigma_a * m.medium.emission(y, lambda);
+                        if constexpr (MisRecorder<C>)
+                            record_emission_channels<CP>(
+                                counter, f, Spectrum(st.uni * sh.uni * broadcast_majorant<Spectrum>(v->mu)),
+                                Spectrum(st.uni * sh.nee * segment_density(opts, p_v, along)),
+                                Spectrum(st.nee * sh.nee * (nee_alternative ? select * p_v * d * d : 0.f)), q, c,
+                                opts.emission_segment_count, EmissionTechnique::Segment);
+                        L += channel_estimate<CP, Spectrum>(f, pdf, q, c);
                     }
                 }
             }
+            record_segment_walk(counter, before);
         }
     }
     if (counts)
         return track_channels_delta_visiting<CP, A>(
             m.medium, m.majorant, ray, t_max, lambda, c, st, nee_alternative, rng, counter,
-            ChannelPieceEmission<CP, Sc>{m.medium, ray, lambda, q, c, L, nee_alternative, along, select, walked});
+            ChannelPieceEmission<CP, Sc, C, St::combines>{m.medium, ray, lambda, q, c, L, opts, counter, nee_alternative,
+                                                          along, select, walked});
     return track_channels_delta<CP, A>(m.medium, m.majorant, ray, t_max, lambda, c, st, nee_alternative, rng, counter);
 }
 
@@ -205,8 +224,13 @@ Status channel_emission_event(const EstimatorOptions& opts, const Sc& sc, const 
     Spectrum pdf = sh.nee * (select * y.pdf * dist2);
     if constexpr (St::combines) {
         const float dir = rr * fv.pdf;
+        if constexpr (MisRecorder<C>)
+            record_emission_channels<CP>(counter, f, Spectrum(st.uni * (sh.uni * broadcast_majorant<Spectrum>(k->mu) * dir)),
+                                         Spectrum(st.uni * (sh.seg * (dir * segment_density(opts, y.pdf, sh.along)))),
+                                         Spectrum(st.uni * pdf), q, c, opts.emission_segment_count,
+                                         EmissionTechnique::Nee);
         pdf += sh.uni * broadcast_majorant<Spectrum>(k->mu) * dir;
-        if (sh.along > 0.f) pdf += sh.seg * (dir * (y.pdf / sh.along));
+        if (sh.along > 0.f) pdf += sh.seg * (dir * segment_density(opts, y.pdf, sh.along));
     }
     L += channel_estimate<CP, Spectrum>(f, Spectrum(st.uni * pdf), q, c);
     return Status::Ok;

@@ -54,7 +54,7 @@ EmissionPdfs piece_emission_pdfs(const PieceStart& s, float null_pdf_product, fl
 /// The collision estimator of one piece in emissive medium `medium` (index `index` of the scene):
 /// beta w mu_a L_e / mu_bar at every tentative collision, weighted against the segment technique
 /// (`along` > 0: its normaliser on this piece) and NEE.
-template <PathStrategy St, class H, class Sc>
+template <PathStrategy St, class H, class Sc, class C>
 struct PieceEmissionCollector {
     static constexpr bool enabled = true;
     using S = typename Sc::Spectral;
@@ -64,6 +64,8 @@ struct PieceEmissionCollector {
     const typename S::Spectrum& beta;
     typename S::Spectrum& L;
     const H& heuristic;
+    const EstimatorOptions& opts;
+    C& counter;  ///< a MisRecorder records the contribution (counts.hpp)
     PieceStart start;
     float along, select;
 
@@ -76,9 +78,13 @@ struct PieceEmissionCollector {
         float wt = 1.f;
         if constexpr (St::combines) {
             const float p_v = medium.emission_pdf(y);
-            wt = emission_weight(heuristic, EmissionTechnique::Collision,
-                                 piece_emission_pdfs<St>(start, null_pdf_product, mu_bar, along > 0.f ? p_v / along : 0.f,
-                                                         start.distance + t, select * p_v));
+            const EmissionPdfs p = piece_emission_pdfs<St>(start, null_pdf_product, mu_bar,
+                                                           segment_density(opts, p_v, along), start.distance + t,
+                                                           select * p_v);
+            wt = emission_weight(heuristic, EmissionTechnique::Collision, p);
+            if constexpr (MisRecorder<C>)
+                record_emission_of(counter, (beta * w * c.sigma_a * le).mean() / mu_bar, p, opts,
+                                   EmissionTechnique::Collision);
         }
         L += beta * w * c.sigma_a * le * (wt / mu_bar);
     }
@@ -100,7 +106,10 @@ DeltaTrack<typename Sc::Spectral> track_emissive_piece(const K& k, const Sc& sc,
     float along = 0.f;
     if constexpr (St::combines) {
         if (k.options().emission_along_segments) along = m.medium.emission_along(ray, 0.f, t_max);
-        if (along > 0.f) {
+        // With the expected count EstimatorOptions::emission_segment_count (THEORY 5.9).
+        const float count = k.options().emission_segment_count;
+        if (along > 0.f && draw_technique(count, rng)) {
+            const double before = recorder_work(counter);
             const DistanceSample ds = m.medium.sample_emission_along(ray, 0.f, t_max, along, rng.uniform());
             if (ds.pdf > 0.f) {
                 const auto tr = k.shadow(m.medium, m.majorant, ray, ds.t, lambda, rng, counter);
@@ -113,20 +122,26 @@ DeltaTrack<typename Sc::Spectral> track_emissive_piece(const K& k, const Sc& sc,
                     } else if ((v->k.sigma_a > 0.f).any()) {
                         const Vec3 y = ray.at(ds.t);
                         const float p_v = m.medium.emission_pdf(y);
-                        const float w = emission_weight(
-                            k.heuristic(), EmissionTechnique::Segment,
-                            piece_emission_pdfs<St>(start, tr.null_pdf_product, v->mu, p_v / along,
-                                                    start.distance + ds.t, select * p_v));
-                        L += beta * tr.transmittance * v->k.sigma_a * m.medium.emission(y, lambda) * (w / ds.pdf);
+                        const EmissionPdfs p =
+                            piece_emission_pdfs<St>(start, tr.null_pdf_product, v->mu,
+                                                    segment_density(k.options(), p_v, along), start.distance + ds.t,
+                                                    select * p_v);
+                        const float w = emission_weight(k.heuristic(), EmissionTechnique::Segment, p);
+                        const typename Sc::Spectrum f = beta * tr.transmittance * v->k.sigma_a * m.medium.emission(y, lambda);
+                        if constexpr (MisRecorder<C>)
+                            record_emission_of(counter, f.mean() / ds.pdf, p, k.options(), EmissionTechnique::Segment);
+                        L += f * (w / (count * ds.pdf));
                     }
                 }
             }
+            record_segment_walk(counter, before);
         }
     }
     if (k.counts_hit(start.from))
         return k.track_visiting(m.medium, m.majorant, ray, t_max, lambda, rng, counter,
-                                PieceEmissionCollector<St, typename K::Heuristic, Sc>{
-                                    m.medium, ray, lambda, beta, L, k.heuristic(), start, along, select});
+                                PieceEmissionCollector<St, typename K::Heuristic, Sc, C>{
+                                    m.medium, ray, lambda, beta, L, k.heuristic(), k.options(), counter, start, along,
+                                    select});
     return k.track(m.medium, m.majorant, ray, t_max, lambda, rng, counter);
 }
 
@@ -240,11 +255,17 @@ Status emission_event(const K& k, const Sc& sc, const SceneVertex& v, const Vec3
     if (!c) return Status::Rejected;
     if (!(c->k.sigma_a > 0.f).any()) return Status::Ok;
     float w = 1.f;
-    if constexpr (St::combines)
-        w = emission_weight(k.heuristic(), EmissionTechnique::Nee,
-                            piece_emission_pdfs<St>(PieceStart{VertexPdf::scattered(q, f.pdf), sh.nulls_before, 0.f},
-                                                    sh.nulls_own, c->mu,
-                                                    sh.along > 0.f ? y.pdf / sh.along : 0.f, dist, select * y.pdf));
+    if constexpr (St::combines) {
+        const EmissionPdfs p =
+            piece_emission_pdfs<St>(PieceStart{VertexPdf::scattered(q, f.pdf), sh.nulls_before, 0.f}, sh.nulls_own,
+                                    c->mu, segment_density(k.options(), y.pdf, sh.along), dist, select * y.pdf);
+        w = emission_weight(k.heuristic(), EmissionTechnique::Nee, p);
+        if constexpr (MisRecorder<C>)
+            record_emission_of(counter,
+                               (beta * sh.transmittance * c->k.sigma_a * m.medium.emission(y.p, lambda) * f.value).mean() /
+                                   (dist2 * select * y.pdf),
+                               p, k.options(), EmissionTechnique::Nee);
+    }
     L += beta * sh.transmittance * c->k.sigma_a * m.medium.emission(y.p, lambda) * f.value *
          (w / (dist2 * select * y.pdf));
     return Status::Ok;
