@@ -7,7 +7,7 @@
 // power-grid sample, a shadow flight and two lookups per real vertex; the combining strategies also
 // draw a point on every segment that crosses the power grid (the segment technique: a DDA over the
 // power grid, a ratio-tracked flight, a lookup), measured against the same MIS without it
-// (`:no-segments`). Which of them wins per unit
+// (`:no-segments`) and at the segment count 1/4 (`:segment-count-1/4`). Which of them wins per unit
 // of variance is the plume table's business (examples, README); the rows here separate the cost.
 #include <string>
 
@@ -44,12 +44,14 @@ const auto& emissive_scene() {
     return scene;
 }
 
-template <nsp::PathStrategy St, nsp::mis::Heuristic H, nsp::SpectralMode S, bool kSegments = true>
+template <nsp::PathStrategy St, nsp::mis::Heuristic H, nsp::SpectralMode S, bool kSegments = true,
+          float kSegmentCount = 1.f>
 void BM_Emission(benchmark::State& state) {
     const auto& scene = emissive_scene<S>();
     const std::vector<nsp::Ray>& rays = camera_rays();
     nsp::EstimatorOptions opts;
     opts.emission_along_segments = kSegments;
+    opts.emission_segment_count = kSegmentCount;
     const nsp::PathEstimator<St, H> estimator(opts);
     nsp::Pcg32 rng(7, 77);
     nsp::LookupCount counter;
@@ -80,6 +82,9 @@ const bool registered = [] {
                                  BM_Emission<NoSegments, nsp::mis::Balance, nsp::Mono, false>)->MinTime(kMinTime);
     benchmark::RegisterBenchmark("BM_Emission/uni-nee-mis:balance:no-segments/rgb",
                                  BM_Emission<NoSegments, nsp::mis::Balance, nsp::Rgb, false>)->MinTime(kMinTime);
+    // The segment technique on a quarter of the segments (EstimatorOptions::emission_segment_count).
+    benchmark::RegisterBenchmark("BM_Emission/uni-nee-mis:balance:segment-count-1/4/mono",
+                                 BM_Emission<NoSegments, nsp::mis::Balance, nsp::Mono, true, 0.25f>)->MinTime(kMinTime);
     return true;
 }();
 

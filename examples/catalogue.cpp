@@ -97,7 +97,8 @@ std::vector<SceneEntry> make_catalogue() {
                  "behind its dense core (nsp::Emissive; no other light)",
                  {{"P1", {K::Plume}}},
                  {nsp::Rgb::name}, 64, 64, 256,
-                 {"unidirectional_grey_absorb-weight", "ratio-nee_grey_absorb-weight", "uni-nee-mis_grey_absorb-weight"},
+                 {"unidirectional_grey_absorb-weight", "ratio-nee_grey_absorb-weight", "uni-nee-mis_grey_absorb-weight",
+                  "uni-nee-mis_grey_balance_absorb-weight_learned"},
                  {"global", "grid"},
                  // directional MIS weights under the grid majorant: they sum to 1 and tame NEE's 1/d^2
                  // near the flame as the null-scattering ones do; none of the default rows

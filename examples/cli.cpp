@@ -255,6 +255,10 @@ Options parse_command_line(int argc, char** argv) {
          [&] { o.estimator.adaptive_equiangular = false; });
     flag("--no-emission-segments", "leave out the emission segment technique (plume)",
          [&] { o.estimator.emission_along_segments = false; });
+    value("--emission-segment-count", "C", "run the emission segment technique on a fraction C in (0, 1] of segments",
+          [&](std::string_view v) {
+              o.estimator.emission_segment_count = parse_number<float>("--emission-segment-count", v, 1e-6f, 1.f);
+          });
     // Lights
     value("--env", "L", "add a constant environment light of radiance L >= 0",
           [&](std::string_view v) { o.lights.env = parse_number<float>("--env", v, 0.f, 1e30f); });

@@ -74,8 +74,9 @@ struct RenderStats {
     /// Only with RenderRequest::pixel_stats: per pixel and channel (interleaved RGB, row-major),
     /// the mean of the spp samples and their sample variance (per sample, not of the mean).
     std::vector<double> pixel_mean, pixel_variance;
-    /// With RenderRequest::learn_nee_counts: the NEE count chosen for each tile (row-major tiles).
-    std::vector<float> nee_counts;
+    /// With RenderRequest::learn_nee_counts: the NEE count chosen for each tile (row-major tiles),
+    /// and on an emissive medium the emission segment count (empty otherwise).
+    std::vector<float> nee_counts, segment_counts;
 
     /// The mean over the 3 channels of channel_variance.
     double variance_per_channel() const {

@@ -163,7 +163,8 @@ struct PixelState {
 /// linear RGB into `rgb`. With rq.learn_nee_counts (C::learns_nee_count), a first pass renders
 /// each tile's pilot samples at NEE count 1 with an nsp::NeeCountLearner as their counter, tiles
 /// handed out to threads (a tile's statistics in one fixed order: the chosen counts do not depend
-/// on the thread count); the second pass renders the rest at each tile's count.
+/// on the thread count); the second pass renders the rest at each tile's counts (NEE's and, on
+/// an emissive medium, the emission segment technique's).
 template <class C>
 RenderStats render(const typename C::Scene& scene, const RenderRequest& rq, std::vector<float>& rgb) {
     using S = typename C::Spectral;
@@ -245,7 +246,9 @@ RenderStats render(const typename C::Scene& scene, const RenderRequest& rq, std:
             const int pilot = RenderRequest::pilot_spp(rq.spp);
             std::vector<PixelState> px(std::size_t(w) * std::size_t(h));
             for (std::size_t p = 0; p < px.size(); ++p) px[p].rng = nsp::Pcg32(rq.seed, p);
+            constexpr bool kEmissive = C::MediumKind::emissive;
             st.nee_counts.assign(std::size_t(tiles_x) * std::size_t(tiles_y), 1.f);
+            if (kEmissive) st.segment_counts.assign(st.nee_counts.size(), 1.f);
             std::atomic<int> next_tile{0};
             auto pilot_work = [&](ThreadTotals& out) {
                 ThreadTotals t;
@@ -259,7 +262,9 @@ RenderStats render(const typename C::Scene& scene, const RenderRequest& rq, std:
                             for (int k = 0; k < pilot; ++k) learner.end_sample(sample(estimator, learner, state, x, y, t));
                             learner.end_pixel();
                         }
-                    st.nee_counts[std::size_t(tile)] = learner.choose();
+                    const nsp::TechniqueCounts n = learner.choose_counts();
+                    st.nee_counts[std::size_t(tile)] = n.nee;
+                    if (kEmissive) st.segment_counts[std::size_t(tile)] = n.emission_segment;
                     t.counter.n += learner.count();
                     t.counter.steps += learner.steps();
                 }
@@ -267,21 +272,27 @@ RenderStats render(const typename C::Scene& scene, const RenderRequest& rq, std:
                 out = t;
             };
             run_pool(pilot_work, pilot_totals);
-            // Pass 2: the rest of each pixel's samples at its tile's count.
+            // Pass 2: the rest of each pixel's samples at its tile's counts: one estimator per
+            // candidate pair (NEE x segment; the segment's at 1 only where nothing emits).
+            constexpr int kC = nsp::NeeCountLearner::kCandidates, kS = kEmissive ? kC : 1;
             std::vector<Estimator> at_count;
-            for (int j = 0; j < nsp::NeeCountLearner::kCandidates; ++j) {
-                nsp::EstimatorOptions o = rq.estimator;
-                o.nee_count = nsp::NeeCountLearner::candidate(j);
-                at_count.emplace_back(o);
-            }
+            for (int j = 0; j < kC; ++j)
+                for (int js = 0; js < kS; ++js) {
+                    nsp::EstimatorOptions o = rq.estimator;
+                    o.nee_count = nsp::NeeCountLearner::candidate(j);
+                    o.emission_segment_count = nsp::NeeCountLearner::candidate(js);
+                    at_count.emplace_back(o);
+                }
+            auto index = [](float count) { return int(std::lround(-std::log2(count))); };
             auto work = [&](ThreadTotals& out) {
                 ThreadTotals t;
                 const double cpu0 = thread_cpu_seconds();
                 for (int y; (y = next_row.fetch_add(1)) < h;) {
                     for (int x = 0; x < w; ++x) {
                         const std::size_t pixel = std::size_t(y) * std::size_t(w) + std::size_t(x);
-                        const float count = st.nee_counts[std::size_t((y / ts) * tiles_x + x / ts)];
-                        const Estimator& est = at_count[std::size_t(std::lround(-std::log2(count)))];
+                        const std::size_t tile = std::size_t((y / ts) * tiles_x + x / ts);
+                        const int js = kEmissive ? index(st.segment_counts[tile]) : 0;
+                        const Estimator& est = at_count[std::size_t(index(st.nee_counts[tile]) * kS + js)];
                         PixelState& state = px[pixel];
                         while (state.k < rq.spp) sample(est, t.counter, state, x, y, t);
                         finish_pixel(state, pixel, t);

@@ -126,10 +126,17 @@ void print_learned_counts(const std::vector<Row>& rows) {
                             : 0;
         std::printf("learned NEE counts (%s, %d-spp pilot at count 1 per %dx%d tile, nsp::NeeCountLearner): tiles at",
                     r.c.name.c_str(), RenderRequest::pilot_spp(spp), defaults.tile_size, defaults.tile_size);
-        for (int j = 0; j < nsp::NeeCountLearner::kCandidates; ++j) {
-            const float c = nsp::NeeCountLearner::candidate(j);
-            const auto n = std::count(r.runs[0].nee_counts.begin(), r.runs[0].nee_counts.end(), c);
-            if (n > 0) std::printf(" 1/%d: %lld", 1 << j, (long long)n);
+        auto histogram = [](const std::vector<float>& counts) {
+            for (int j = 0; j < nsp::NeeCountLearner::kCandidates; ++j) {
+                const float c = nsp::NeeCountLearner::candidate(j);
+                const auto n = std::count(counts.begin(), counts.end(), c);
+                if (n > 0) std::printf(" 1/%d: %lld", 1 << j, (long long)n);
+            }
+        };
+        histogram(r.runs[0].nee_counts);
+        if (!r.runs[0].segment_counts.empty()) {
+            std::printf("; emission segment counts: tiles at");
+            histogram(r.runs[0].segment_counts);
         }
         std::printf("\n");
     }
