@@ -263,8 +263,8 @@ public:
     }
 
     /// The predicted variance of one sample at NEE candidate j and segment candidate js: the mean
-    /// over pixels of the sample variance of A, plus the mean of both techniques' B; 0 before any
-    /// pixel ended.
+    /// over pixels of the sample variance of A, plus the mean of both techniques' B and of their
+    /// contributions' diagonal correction (see add_contribution); 0 before any pixel ended.
     double predicted_variance(int j, int js = 0) const noexcept {
         const double a = variance_samples_ > 0 ? variance_sum_[pair(j, js)] / double(variance_samples_) : 0.0;
         const double b = samples_ > 0 ? (nee_.bernoulli[std::size_t(j)] + segment_.bernoulli[std::size_t(js)]) /
@@ -287,7 +287,8 @@ public:
     /// predicted variance x cost is below that of the same pair with each reduced count put back
     /// to 1 by at least kSignificance standard errors of the difference (paired: one pilot). The
     /// predicted variance is a mean over the pilot's samples of z = n / (n - 1) (a - mean a)^2 + B
-    /// (a a sample's re-weighted estimate, the mean over its pixel, B its Bernoulli variance), so
+    /// (a a sample's re-weighted estimate, the mean over its pixel, B its Bernoulli variance and
+    /// diagonal correction), so
     /// the standard error follows from the spread of the samples' z differences: large exactly
     /// where a few samples carry the prediction. A pilot's variance at a low count
     /// rests on its largest re-weighted contributions, which are rare where the skipped technique
@@ -334,15 +335,16 @@ private:
     static constexpr std::size_t pair(int jn, int js) noexcept { return std::size_t(jn * kCandidates + js); }
 
     /// One counted technique (NEE toward the lights, the emission segment technique): the current
-    /// sample's change of its estimate and Bernoulli variance at each candidate, the pixel's and
-    /// the tile's Bernoulli variance and the technique's work.
+    /// sample's change of its estimate, Bernoulli variance and diagonal correction at each
+    /// candidate, the tile's sum of the last two and the technique's work.
     struct Counted {
         PerCandidate path_delta{}, path_bernoulli{}, path_diagonal{}, bernoulli{};
         double work = 0.0;
     };
 
     /// One pilot sample as the significance test needs it: its estimate and, per candidate of
-    /// each counted technique, the change of its re-weighted estimate and its Bernoulli variance.
+    /// each counted technique, the change of its re-weighted estimate and its Bernoulli variance
+    /// plus diagonal correction (the `_bernoulli` members).
     struct SampleRecord {
         double estimate = 0.0;
         PerCandidate nee_delta{}, nee_bernoulli{}, segment_delta{}, segment_bernoulli{};
