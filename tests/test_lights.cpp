@@ -171,6 +171,7 @@ TEST_CASE("lights: a directional light is a delta light from one direction, neve
 
 }  // namespace
 
+
 namespace {
 
 TEST_CASE("lights: emission sampling (light subpaths) matches emission_pdf and emits the light's power") {
@@ -220,6 +221,72 @@ TEST_CASE("lights: emission sampling (light subpaths) matches emission_pdf and e
     }
     CHECK(picked[3] == 0);
     for (int i = 0; i < 3; ++i) CHECK(std::abs(picked[i] - 1000) < 5 * std::sqrt(3000 * (1.0 / 3) * (2.0 / 3)));
+}
+
+TEST_CASE("lights: with a BoundingSphere, lights at infinity start light subpaths from a disk outside it") {
+    // The environment's direction uniform (1 / 4 pi, selection 1/2 included in pdf_pos), the ray's
+    // origin uniform on a disk of radius R facing the scene: E[L / (pdf_pos pdf_dir)] over all
+    // samples (0 for the quad's) is the environment's power in closed form, L 4 pi x pi R^2
+    // (5 SE, fixed seed). emission_pdf agrees with every sample at points on its ray inside the
+    // sphere, and is 0 off the disk's cylinder and beyond the disk.
+    using M = Mono;
+    const BoundingSphere sphere{Vec3(1.f, -2.f, 0.5f), 3.f};
+    const QuadLight<M> quad{Vec3(-1.f, 2.f, 0.f), Vec3(2.f, 0.f, 0.f), Vec3(0.f, 0.f, 0.5f), M::Spectrum::Constant(3.f)};
+    const LightSampler<M, QuadLight<M>, EnvironmentLight<M>> sampler(LightSelection::Uniform, sphere, {quad},
+                                                                     {EnvironmentLight<M>{M::Spectrum::Constant(0.7f)}});
+    CHECK(sampler.emits_from_infinity());
+    CHECK(sampler.emission_selection_pdf(1) == doctest::Approx(0.5f));
+    const double R = 3.0, power = 0.7 * 4.0 * kPi * kPi * R * R;
+    Pcg32 rng(17, 3);
+    Stat s;
+    int env = 0;
+    const int n = 40000;
+    for (int i = 0; i < n; ++i) {
+        const EmittedLight<M> e = sampler.sample_emission(rng.uniform(), rng.uniform(), rng.uniform(), rng.uniform(),
+                                                          rng.uniform());
+        REQUIRE(e.emission.pdf_pos > 0.f);
+        if (e.light != 1) {
+            CHECK_FALSE(e.emission.at_infinity);
+            s.add(0.0);
+            continue;
+        }
+        ++env;
+        const LightEmission<M>& x = e.emission;
+        CHECK(x.at_infinity);
+        CHECK(x.pdf_pos == doctest::Approx(0.5f * kInv4Pi));
+        CHECK(x.pdf_dir == doctest::Approx(1.0 / (kPi * R * R)));
+        // The origin lies on the disk: R from the centre along -w, within R across.
+        const Vec3 q = x.p - sphere.center;
+        const float along = glm::dot(q, -x.w);
+        CHECK(along == doctest::Approx(R).epsilon(1e-4));
+        CHECK(glm::dot(q, q) - along * along <= float(R * R) * 1.0001f);
+        for (const float t : {1.f, 3.f, 5.f}) {  // points on the ray inside the sphere
+            const EmissionDensity d = sampler.emission_pdf(1, x.p + t * x.w, x.w);
+            CHECK(d.pdf_pos == doctest::Approx(x.pdf_pos));
+            CHECK(d.pdf_dir == doctest::Approx(x.pdf_dir));
+        }
+        s.add(double(x.radiance[0]) * x.cos / (double(x.pdf_pos) * x.pdf_dir));
+    }
+    CAPTURE(s.mean);
+    CHECK(std::abs(s.mean - power) <= kSigmas * s.se());
+    CHECK(std::abs(env - n / 2) < 5 * std::sqrt(n * 0.25));
+    // Off the cylinder, and beyond the disk (behind where every ray starts): no ray passes there.
+    const Vec3 w(0.f, 0.f, 1.f);
+    CHECK(sampler.emission_pdf(1, sphere.center + Vec3(3.1f, 0.f, 0.f), w).pdf_dir == 0.f);
+    CHECK(sampler.emission_pdf(1, sphere.center + Vec3(0.f, 0.f, -3.1f), w).pdf_dir == 0.f);
+    CHECK(sampler.emission_pdf(1, sphere.center + Vec3(2.9f, 0.f, 2.9f), w).pdf_dir > 0.f);
+    // Without a sphere the environment starts none, as before.
+    const LightSampler<M, QuadLight<M>, EnvironmentLight<M>> plain(LightSelection::Uniform, 3.f, {quad},
+                                                                   {EnvironmentLight<M>{M::Spectrum::Constant(0.7f)}});
+    CHECK_FALSE(plain.emits_from_infinity());
+    CHECK(plain.emission_selection_pdf(1) == 0.f);
+    CHECK(plain.emission_pdf(1, Vec3(0.f), w).pdf_pos == 0.f);
+    // Bad spheres are rejected with their value.
+    CHECK_THROWS_WITH_AS((LightSampler<M, QuadLight<M>>(LightSelection::Uniform, BoundingSphere{Vec3(0.f), -1.f}, {quad})),
+                         doctest::Contains("scene_radius = -1"), InvalidArgument);
+    CHECK_THROWS_WITH_AS(
+        (LightSampler<M, QuadLight<M>>(LightSelection::Uniform, BoundingSphere{Vec3(kInf, 0.f, 0.f), 1.f}, {quad})),
+        doctest::Contains("BoundingSphere center"), InvalidArgument);
 }
 
 }  // namespace

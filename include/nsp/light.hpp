@@ -38,12 +38,17 @@ struct LightSample {
 /// point by `pdf_pos` (area measure; 1 for a point light's delta position), the direction leaving
 /// it by `pdf_dir` (solid angle), the radiance (a point light: its intensity) sent along `w`, and
 /// `cos` = |n . w| at the point (1 for a point light). pdf_pos 0: no sample.
+/// From a light at infinity (`at_infinity`, LightSampler with a BoundingSphere) the path's first
+/// vertex is the direction -w toward the light: pdf_pos is its solid-angle density, p the ray's
+/// origin outside the scene and pdf_dir its density on a disk facing along w (area measure
+/// perpendicular to w), n = w, cos = 1.
 template <SpectralMode S>
 struct LightEmission {
     Vec3 p{0.f}, n{0.f, 0.f, 1.f}, w{0.f, 0.f, 1.f};  ///< the point, its unit normal (a point light: w), the direction
     typename S::Spectrum radiance = S::Spectrum::Zero();
     float pdf_pos = 0.f, pdf_dir = 0.f, cos = 0.f;
     bool delta_position = false;  ///< a point light: no path can hit it
+    bool at_infinity = false;     ///< a light at infinity (see above)
 };
 
 /// The densities with which a light's `sample_emission` produces point p (on the light) and a
@@ -53,8 +58,9 @@ struct EmissionDensity {
 };
 
 /// A light from which light subpaths start (BdptEstimator): `sample_emission(u1, u2, u3, u4,
-/// lambda)` and `emission_pdf(p, w)` as above. Lights at infinity and DirectionalLight have none;
-/// bidirectional estimators reach them by hitting and by NEE alone.
+/// lambda)` and `emission_pdf(p, w)` as above. Lights at infinity have none of their own:
+/// LightSampler starts their light subpaths when it has a BoundingSphere (else bidirectional
+/// estimators reach them by hitting and NEE alone). DirectionalLight starts none.
 template <class L, class S>
 concept EmittingLight = SpectralMode<S> && requires(const L& l, const Vec3& v, float u, const typename S::Wavelengths& lambda) {
     { l.sample_emission(u, u, u, u, lambda) } -> std::same_as<LightEmission<S>>;

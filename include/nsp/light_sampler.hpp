@@ -6,6 +6,11 @@
 // The lights live in one vector per model type (no virtual calls): `LightSampler<S, QuadLight<S>,
 // SphereLight<S>>`. A light is named by its index in the order the constructor got them, vector
 // by vector. Everything is built and checked in the constructor; sample / pdf allocate nothing.
+//
+// Light subpaths (BdptEstimator) start at the lights with a point to emit from (EmittingLight
+// models) and, when the sampler is given a BoundingSphere around the scene, at the lights at
+// infinity too: a direction toward the light by its own sample(), then the ray's origin uniform
+// on a disk of the sphere's radius that faces the scene from outside it (THEORY 5.5).
 #pragma once
 
 #include <algorithm>
@@ -30,6 +35,13 @@ struct EmittedLight {
     int light = -1;             ///< the light's index, or -1
 };
 
+/// A sphere that holds everything of a scene (its surfaces and its media's bounds): what light
+/// subpaths from the lights at infinity start outside of (LightSampler, BdptEstimator).
+struct BoundingSphere {
+    Vec3 center{0.f};
+    float radius = 0.f;
+};
+
 /// How LightSampler chooses a light.
 enum class LightSelection : std::uint8_t {
     Uniform,  ///< every light with probability 1 / count
@@ -50,10 +62,32 @@ public:
     /// Throws InvalidArgument on a light with a non-finite position, a radius or area that is not
     /// finite and > 0, a bad radiance, or (Power) when no light has positive power. No lights is
     /// allowed: sample() then returns pdf 0.
+    /// Lights at infinity start no light subpaths (emits_from_infinity() false).
     explicit LightSampler(LightSelection selection, float scene_radius, std::vector<Ls>... lights)
-        : lights_(std::move(lights)...) {
-        if (!(scene_radius > 0.f) || !std::isfinite(scene_radius))
-            detail::fail("LightSampler scene_radius = ", scene_radius, " is not allowed: it must be finite and > 0");
+        : LightSampler(Checked{}, selection, checked_radius(scene_radius), BoundingSphere{}, std::move(lights)...) {}
+
+    /// As above with `sphere.radius` as the scene radius, and light subpaths from the lights at
+    /// infinity (sample_emission): their rays start on a disk of radius `sphere.radius` outside
+    /// `sphere`, which must hold all of the scene (SurfaceScene checks its media's bounds; the host
+    /// keeps its surfaces inside). Throws InvalidArgument on a non-finite centre or a radius that
+    /// is not finite and > 0.
+    explicit LightSampler(LightSelection selection, BoundingSphere sphere, std::vector<Ls>... lights)
+        : LightSampler(Checked{}, selection, checked_radius(sphere.radius), checked(sphere), std::move(lights)...) {}
+
+private:
+    struct Checked {};
+    static float checked_radius(float r) {
+        if (!(r > 0.f) || !std::isfinite(r) || !std::isfinite(r * r))
+            detail::fail("LightSampler scene_radius = ", r,
+                         " is not allowed: it must be finite and > 0, its square finite (a BoundingSphere's radius too)");
+        return r;
+    }
+    static BoundingSphere checked(const BoundingSphere& b) {
+        for (int a = 0; a < 3; ++a) detail::require_finite(b.center[a], "LightSampler BoundingSphere center");
+        return b;
+    }
+    LightSampler(Checked, LightSelection selection, float scene_radius, BoundingSphere sphere, std::vector<Ls>... lights)
+        : lights_(std::move(lights)...), sphere_(sphere) {
         double total = 0.0;
         for_each_light([&](const auto& l, int kind, int index) {
             validate(l);
@@ -106,6 +140,8 @@ public:
         if (!emitters_.empty()) emitters_.back().cdf = 1.f;
     }
 
+public:
+
     /// Whether every light model can start light subpaths, or is reached from infinity (hit or
     /// NEE only): what a bidirectional estimator needs of its lights.
     static constexpr bool bidirectional_ready() noexcept {
@@ -115,14 +151,23 @@ public:
     /// Whether any light can start a light subpath (an EmittingLight with a positive probability).
     bool has_emitters() const noexcept { return !emitters_.empty(); }
 
-    /// The probability with which sample_emission() starts at light `light` (0 for lights at
-    /// infinity, directional lights and indices outside the table).
+    /// Whether the lights at infinity start light subpaths (the sampler was given a BoundingSphere).
+    bool emits_from_infinity() const noexcept { return sphere_.radius > 0.f; }
+    /// The sphere given to the constructor (radius 0: none).
+    const BoundingSphere& bounding_sphere() const noexcept { return sphere_; }
+
+    /// The probability with which sample_emission() starts at light `light` (0 for directional
+    /// lights, for lights at infinity without a BoundingSphere, and for indices outside the table).
     float emission_selection_pdf(int light) const noexcept {
         return light >= 0 && light < count() ? emit_pmf_[std::size_t(light)] : 0.f;
     }
 
-    /// Chooses a light that emits from a point (an EmittingLight) with u0, and a point on it and a
-    /// direction leaving it with (u1, u2) and (u3, u4). pdf_pos 0 when there is none.
+    /// Chooses a light that emits (an EmittingLight, or with a BoundingSphere a light at infinity)
+    /// with u0, and a point on it and a direction leaving it with (u1, u2) and (u3, u4). pdf_pos
+    /// 0 when there is none. From a light at infinity (LightEmission::at_infinity): the direction
+    /// toward it by (u1, u2) and its sample() (pdf_pos, solid angle), the ray's origin p uniform
+    /// by (u3, u4) on the disk of the sphere's radius centred at center + radius x (-w), facing
+    /// along w (pdf_dir = 1 / (pi radius^2), area on the disk), cos = 1.
     EmittedLight<S> sample_emission(float u0, float u1, float u2, float u3, float u4,
                                     const typename S::Wavelengths& lambda = {}) const noexcept {
         if (emitters_.empty()) return {};
@@ -131,19 +176,26 @@ public:
         const int light = std::min(it, emitters_.end() - 1)->light;
         EmittedLight<S> out{{}, light};
         visit(entries_[std::size_t(light)], [&](const auto& l) {
-            if constexpr (EmittingLight<std::decay_t<decltype(l)>, S>) out.emission = l.sample_emission(u1, u2, u3, u4, lambda);
+            using L = std::decay_t<decltype(l)>;
+            if constexpr (EmittingLight<L, S>) out.emission = l.sample_emission(u1, u2, u3, u4, lambda);
+            else if constexpr (is_infinite<L>()) out.emission = emission_from_infinity(l, u1, u2, u3, u4, lambda);
         });
         out.emission.pdf_pos *= emit_pmf_[std::size_t(light)];
         return out;
     }
 
     /// The densities with which sample_emission() starts at point p of light `light` (selection
-    /// included in pdf_pos) and leaves along w; all 0 for a light it never starts from.
+    /// included in pdf_pos) and leaves along w; all 0 for a light it never starts from. For a
+    /// light at infinity p is any point the ray reaches: pdf_pos the density of the direction -w
+    /// toward the light, pdf_dir that of a ray through p (0 where no ray from the disk passes
+    /// through p: outside the sphere's cylinder along w, or beyond the disk).
     EmissionDensity emission_pdf(int light, const Vec3& p, const Vec3& w) const noexcept {
         EmissionDensity d;
         if (!(emission_selection_pdf(light) > 0.f)) return d;
         visit(entries_[std::size_t(light)], [&](const auto& l) {
-            if constexpr (EmittingLight<std::decay_t<decltype(l)>, S>) d = l.emission_pdf(p, w);
+            using L = std::decay_t<decltype(l)>;
+            if constexpr (EmittingLight<L, S>) d = l.emission_pdf(p, w);
+            else if constexpr (is_infinite<L>()) d = emission_pdf_from_infinity(l, p, w);
         });
         d.pdf_pos *= emit_pmf_[std::size_t(light)];
         return d;
@@ -222,8 +274,43 @@ private:
 
     bool emits(const Entry& e) const noexcept {
         bool r = false;
-        visit(e, [&](const auto& l) { r = EmittingLight<std::decay_t<decltype(l)>, S>; });
+        visit(e, [&](const auto& l) {
+            using L = std::decay_t<decltype(l)>;
+            r = EmittingLight<L, S> || (is_infinite<L>() && emits_from_infinity());
+        });
         return r;
+    }
+
+    /// A light subpath's start from light l at infinity (see sample_emission), selection left out.
+    template <class L>
+    LightEmission<S> emission_from_infinity(const L& l, float u1, float u2, float u3, float u4,
+                                            const typename S::Wavelengths& lambda) const noexcept {
+        LightEmission<S> e;
+        const LightSample<S> s = l.sample(sphere_.center, u1, u2, lambda, 1.f);
+        if (!(s.pdf > 0.f) || !(std::isinf(s.distance))) return e;
+        const Vec3 toward = s.wi;
+        Vec3 a, b;
+        orthonormal_basis(toward, a, b);
+        const float r = sphere_.radius * std::sqrt(u3), phi = 2.f * kPi * u4;
+        e.p = sphere_.center + sphere_.radius * toward + r * (std::cos(phi) * a + std::sin(phi) * b);
+        e.w = e.n = -toward;
+        e.radiance = s.radiance;
+        e.pdf_pos = s.pdf;
+        e.pdf_dir = 1.f / (kPi * sphere_.radius * sphere_.radius);
+        e.cos = 1.f;
+        e.at_infinity = true;
+        return e;
+    }
+
+    template <class L>
+    EmissionDensity emission_pdf_from_infinity(const L& l, const Vec3& p, const Vec3& w) const noexcept {
+        EmissionDensity d;
+        const Vec3 toward = -w, q = p - sphere_.center;
+        const float along = glm::dot(q, toward), r2 = sphere_.radius * sphere_.radius;
+        d.pdf_pos = l.pdf(sphere_.center, toward, 1.f);
+        d.pdf_dir = along < sphere_.radius && glm::dot(q, q) - along * along < r2 ? 1.f / (kPi * r2) : 0.f;
+        d.cos = 1.f;
+        return d;
     }
 
     template <class F>
@@ -281,6 +368,7 @@ private:
     };
     std::vector<Emitter> emitters_;  ///< the EmittingLight entries, with their cdf for sample_emission
     std::vector<float> emit_pmf_;    ///< by light index: sample_emission's probability of it
+    BoundingSphere sphere_;          ///< radius 0: the lights at infinity start no light subpaths
 };
 
 }  // namespace nsp

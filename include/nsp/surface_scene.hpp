@@ -123,8 +123,10 @@ struct SurfaceScene {
     Ls lights;
     int camera_medium = -1;
 
-    /// Throws InvalidArgument if `camera_medium` is not -1 or an index into `media`, or if a
-    /// medium's single-valued majorant (GlobalMajorant) has a value its bound policy forbids.
+    /// Throws InvalidArgument if `camera_medium` is not -1 or an index into `media`, if a
+    /// medium's single-valued majorant (GlobalMajorant) has a value its bound policy forbids, or
+    /// if the lights have a BoundingSphere (light subpaths from infinity) that a medium's bounds
+    /// do not lie inside (the geometry must lie inside it too; the host's is not checked).
     SurfaceScene(G g, std::vector<SceneMedium<M, Maj, P>> m, Mats mats, Ls l, int camera = -1)
         : geometry(std::move(g)), media(std::move(m)), materials(std::move(mats)), lights(std::move(l)),
           camera_medium(camera) {
@@ -136,6 +138,8 @@ struct SurfaceScene {
                 detail::require_majorant_value<bound_policy_t<Maj>>(s.majorant.value(), s.medium.max_extinction(),
                                                                     "SurfaceScene: a medium's majorant value",
                                                                     " of that medium");
+        if constexpr (requires(const Ls& x) { x.bounding_sphere(); })
+            if (lights.emits_from_infinity()) check_inside(lights.bounding_sphere());
         build_emission_selection();
     }
 
@@ -164,6 +168,24 @@ struct SurfaceScene {
     }
 
 private:
+    /// Light subpaths from infinity start outside the sphere: every medium must lie inside it.
+    void check_inside(const BoundingSphere& b) const {
+        for (std::size_t i = 0; i < media.size(); ++i) {
+            const Box box = media[i].medium.bounds();
+            for (int c = 0; c < 8; ++c) {
+                const Vec3 corner((c & 1) ? box.hi.x : box.lo.x, (c & 2) ? box.hi.y : box.lo.y,
+                                  (c & 4) ? box.hi.z : box.lo.z);
+                const float d = glm::length(corner - b.center);
+                if (!(d <= b.radius))
+                    detail::fail("SurfaceScene: medium ", i, "'s bounds [", box.lo.x, ", ", box.lo.y, ", ", box.lo.z,
+                                 "] .. [", box.hi.x, ", ", box.hi.y, ", ", box.hi.z,
+                                 "] are not allowed: they must lie inside the lights' BoundingSphere (centre ", b.center.x,
+                                 ", ", b.center.y, ", ", b.center.z, ", radius ", b.radius, "; a corner lies ", d,
+                                 " from its centre), where light subpaths from infinity start");
+            }
+        }
+    }
+
     void build_emission_selection() {
         if constexpr (EmissiveMedium<M>) {
             std::vector<double> w(media.size(), 1.0);

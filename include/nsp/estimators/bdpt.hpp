@@ -26,8 +26,10 @@
 // (the baseline: direction pdfs and geometry only, the tracking factors left out, as pbrt's BDPT
 // weighs medium vertices), the heuristic (mis::Balance or mis::Power), the absorption policy of
 // the tracked segments, and MaxDepth, the longest subpath the fixed-size vertex arrays hold (no
-// heap allocation in the kernel). Lights at infinity and DirectionalLight start no light subpaths:
-// paths to them are weighted among s = 0 and s = 1 alone. Russian roulette divides the subpaths'
+// heap allocation in the kernel). Lights at infinity start light subpaths when the scene's
+// LightSampler has a BoundingSphere (their rays from a disk outside it; x_0 is then a direction,
+// its densities solid angles, and x_1's the disk's per perpendicular area, converted); without one,
+// and for DirectionalLight, paths to them are weighted among s = 0 and s = 1 alone. Russian roulette divides the subpaths'
 // throughputs as in PathEstimator, but the weights leave it out (the same for every strategy, so
 // they still sum to 1; the survival probability of a subpath read backwards is not defined).
 #pragma once
@@ -77,8 +79,9 @@ concept MisPolicy = requires {
 /// - from_camera[i], i in 0..k-1: the density of x_i drawn from x_{i+1} on the camera side
 ///   (from_camera[k-1] = 1: the camera's own, the same in every strategy with t >= 2);
 /// - emit: the density of x_0 under light subpaths (the light sampler's emission, selection
-///   included; 0 for lights at infinity); nee: its density under NEE from x_1 (solid angle at
-///   infinity, area measure otherwise, a point light's selection probability);
+///   included; solid angle at infinity, 0 there when the sampler has no BoundingSphere); nee: its
+///   density under NEE from x_1 (solid angle at infinity, area measure otherwise, a point light's
+///   selection probability);
 /// - connectible[i]: x_i is not a delta vertex (a mirror), so a connection may end there;
 /// - light_tracing: strategy s = k (t = 1, x_{k-1} connected to the camera) is among them; then
 ///   from_camera[k-1] is the camera's own density of x_{k-1} (its pdf_dir converted), else any
@@ -192,6 +195,7 @@ struct Vertex {
     VertexKind kind = VertexKind::Camera;
     bool delta = false;           ///< a delta lobe was sampled here: no connection may end at p
     bool delta_position = false;  ///< a point light: no path hits it
+    bool at_infinity = false;     ///< a light at infinity: x_0 is a direction (solid angle), p its ray's origin
 
     /// The medium a ray leaving p along w travels in.
     int medium_toward(const Vec3& w) const noexcept {
@@ -203,7 +207,8 @@ struct Vertex {
 /// The vertices of one strategy's path, for an observer (BdptEstimator::radiance_observed): the
 /// light subpath's first s vertices (s >= 2), the camera subpath's first t (z_0 the camera; for
 /// s = 0 the emitter hit is not among them), and x_0's position (the light point; for a light at
-/// infinity the last camera vertex's).
+/// infinity, `x0_at_infinity`, the light subpath's ray origin outside the scene or else the last
+/// camera vertex's).
 template <SpectralMode S>
 struct PathVertices {
     const Vertex<S>* light = nullptr;
@@ -211,12 +216,15 @@ struct PathVertices {
     const Vertex<S>* camera = nullptr;
     int t = 0;
     Vec3 x0{0.f};
+    bool x0_at_infinity = false;
 };
 
 /// Converts a solid-angle density at `from` toward vertex `to` into `to`'s measure: |n . w| / d^2
-/// on a surface or light, 1 / d^2 in a medium; 0 for a point light and the camera.
+/// on a surface or light, 1 / d^2 in a medium; 0 for a point light and the camera. A light at
+/// infinity is a direction: its measure is the solid angle, pdf_dir unchanged.
 template <SpectralMode S>
 float to_vertex_measure(float pdf_dir, const Vec3& from, const Vertex<S>& to) noexcept {
+    if (to.kind == VertexKind::Light && to.at_infinity) return pdf_dir;
     const Vec3 d = to.p - from;
     const float d2 = glm::dot(d, d);
     if (!(d2 > 0.f)) return 0.f;
@@ -225,6 +233,18 @@ float to_vertex_measure(float pdf_dir, const Vec3& from, const Vertex<S>& to) no
         case VertexKind::Surface: return pdf_dir * std::abs(glm::dot(to.ng, d)) / (d2 * std::sqrt(d2));
         case VertexKind::Light:
             return to.delta_position ? 0.f : pdf_dir * std::abs(glm::dot(to.ng, d)) / (d2 * std::sqrt(d2));
+        default: return 0.f;
+    }
+}
+
+/// Converts the density of a ray from a light at infinity, per area perpendicular to its direction
+/// w, into the measure of the vertex `to` it reaches: x |ng . w| on a surface, x 1 in a medium
+/// (the ray's length is the tracking's own measure); 0 for a light and the camera.
+template <SpectralMode S>
+float from_infinity_measure(float pdf_perpendicular, const Vec3& w, const Vertex<S>& to) noexcept {
+    switch (to.kind) {
+        case VertexKind::Medium: return pdf_perpendicular;
+        case VertexKind::Surface: return pdf_perpendicular * std::abs(glm::dot(to.ng, w));
         default: return 0.f;
     }
 }
@@ -482,8 +502,9 @@ int BdptEstimator<Mis, H, A, MaxDepth>::walk(const Sc& sc, VertexT<Sc>* path, in
         v.nulls_in = nulls;
         // From the camera: its own density of the ray converted (light tracing), or 1, which every
         // strategy with t >= 2 shares.
-        v.pdf_fwd = prev.kind == VertexKind::Camera && !(pdf_dir > 0.f) ? 1.f
-                                                                        : to_vertex_measure(pdf_dir, prev.p, v) * nulls * v.event;
+        if (prev.kind == VertexKind::Camera && !(pdf_dir > 0.f)) v.pdf_fwd = 1.f;
+        else if (prev.at_infinity) v.pdf_fwd = from_infinity_measure(pdf_dir, ray.d, v) * nulls * v.event;
+        else v.pdf_fwd = to_vertex_measure(pdf_dir, prev.p, v) * nulls * v.event;
         path[count] = v;
         V& cur = path[count++];
         if (count >= max_vertices) return count;
@@ -540,9 +561,10 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::trace(
     const float q_volume_share = has_volume ? (sc.lights.has_emitters() ? 0.5f : 1.f) : 0.f;
     const float q_volume = light_probability_ * q_volume_share;
     const float q_lights = light_probability_ * (1.f - q_volume_share);
-    auto add = [&](int s, int t, const Spectrum& f, const Pdfs& p, const Vec3& x0) {
+    auto add = [&](int s, int t, const Spectrum& f, const Pdfs& p, const Vec3& x0, bool x0_at_infinity = false) {
         const float w = strategy_weight(kernels_.heuristic(), p, s);
-        observe(s, t, f, w, p, PathVertices<typename Sc::Spectral>{light, s, camera, s == 0 ? t - 1 : t, x0});
+        observe(s, t, f, w, p,
+                PathVertices<typename Sc::Spectral>{light, s, camera, s == 0 ? t - 1 : t, x0, x0_at_infinity});
         L += f * w;
     };
     auto eval_at = [&](const V& v, const Vec3& wo, const Vec3& wi) {
@@ -581,7 +603,7 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::trace(
                 pdfs.k = 1;
                 pdfs.from_camera[0] = 1.f;
                 pdfs.nee = pdfs.emit = 0.f;
-                add(0, 2, f, pdfs, std::isfinite(dist) ? hit.p : z.p);
+                add(0, 2, f, pdfs, std::isfinite(dist) ? hit.p : z.p, !std::isfinite(dist));
                 return;
             }
             gather(0, t - 1, t - 1);  // camera[0..t-2]; the emitter is x_0
@@ -596,11 +618,12 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::trace(
                 pdfs.emit = q_lights * e.pdf_pos;
                 pdfs.nee = sc.lights.pdf(light_index, z.p, w) * cos0 / d2;
                 pdfs.from_light[1] = to_vertex_measure(e.pdf_dir, hit.p, z) * nulls * z.event;
-            } else {
+            } else {  // x_0 is the direction w; light subpaths (if any) reach z along -w
+                const EmissionDensity e = sc.lights.emission_pdf(light_index, z.p, -w);
                 pdfs.from_camera[0] = (z.delta ? 1.f : pdf_dir_z) * nulls;
-                pdfs.emit = 0.f;
+                pdfs.emit = q_lights * e.pdf_pos;
                 pdfs.nee = sc.lights.pdf(light_index, z.p, w);
-                pdfs.from_light[1] = 0.f;
+                pdfs.from_light[1] = from_infinity_measure(e.pdf_dir, -w, z) * nulls * z.event;
             }
             // z's own density from the light side: from x_1 toward x_2, arriving along -w.
             if (t >= 4) {
@@ -608,7 +631,7 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::trace(
                 const float pd = z.delta ? 1.f : eval_at(z, -w, -z.wo).pdf;
                 pdfs.from_light[2] = to_vertex_measure(pd, z.p, z2) * z.nulls_in * z2.event;
             }
-            add(0, t, f, pdfs, std::isfinite(dist) ? hit.p : z.p);
+            add(0, t, f, pdfs, std::isfinite(dist) ? hit.p : z.p, !std::isfinite(dist));
         };
         if (!hit.found()) {
             for (const int i : sc.lights.infinite())
@@ -726,6 +749,7 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::trace(
                 y0.ng = y0.ns = e.emission.n;
                 y0.light = e.light;
                 y0.delta_position = e.emission.delta_position;
+                y0.at_infinity = e.emission.at_infinity;
                 y0.pdf_fwd = q_lights * e.emission.pdf_pos;
                 y0.beta = e.emission.radiance / y0.pdf_fwd;
                 const int start = light_start_medium(sc, e.emission.p, e.emission.w);
@@ -734,7 +758,9 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::trace(
                     nl = walk(sc, light, 1, light_vertices, Ray{e.emission.p, e.emission.w}, start, e.emission.pdf_dir,
                               Spectrum(y0.beta * (e.emission.cos / e.emission.pdf_dir)), lambda, rng, counter,
                               [](auto&&...) {}, status);
-                if (nl >= 2) {
+                if (nl >= 2 && y0.at_infinity) {
+                    nee_y0 = sc.lights.pdf(y0.light, light[1].p, -e.emission.w);  // solid angle, as x_0's measure
+                } else if (nl >= 2) {
                     const Vec3 d = y0.p - light[1].p;
                     const float d2 = glm::dot(d, d);
                     nee_y0 = y0.delta_position ? sc.lights.selection_pdf(y0.light)
@@ -794,10 +820,11 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::trace(
                                                              : to_vertex_measure(sc.lights.emission_pdf(ls.light, y0.p, -w).pdf_dir,
                                                                                  y0.p, z) * nulls * z.event;
                         } else if (at_infinity) {
+                            const EmissionDensity e = sc.lights.emission_pdf(ls.light, z.p, -w);
                             pdfs.from_camera[0] = fz.pdf * nulls;
                             pdfs.nee = ls.sample.pdf;
-                            pdfs.emit = 0.f;
-                            pdfs.from_light[1] = 0.f;
+                            pdfs.emit = q_lights * e.pdf_pos;
+                            pdfs.from_light[1] = from_infinity_measure(e.pdf_dir, -w, z) * nulls * z.event;
                         } else {
                             const EmissionDensity e = sc.lights.emission_pdf(ls.light, y0.p, -w);
                             pdfs.from_camera[0] = fz.pdf * e.cos / d2 * nulls;
@@ -810,7 +837,7 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::trace(
                             pdfs.from_light[2] = to_vertex_measure(eval_at(z, w * -1.f, -z.wo).pdf, z.p, z2) *
                                                  z.nulls_in * z2.event;
                         }
-                        add(1, t, f, pdfs, y0.p);
+                        add(1, t, f, pdfs, y0.p, at_infinity && !ls.sample.delta);
                     }
                 }
             }
@@ -883,7 +910,7 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::trace(
                 const V& y2 = light[s - 2];
                 pdfs.from_camera[s - 2] = to_vertex_measure(eval_at(y, -w, -y.wo).pdf, y.p, y2) * y.nulls_in * y2.event;
             }
-            add(s, t, f, pdfs, light[0].p);
+            add(s, t, f, pdfs, light[0].p, light[0].at_infinity);
         }
     }
     // t = 1: light vertex s-1 seen by the camera, splatted where it appears on the image.
@@ -914,7 +941,8 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::trace(
             const V& y2 = light[s - 2];
             pdfs.from_camera[s - 2] = to_vertex_measure(eval_at(y, -w, -y.wo).pdf, y.p, y2) * y.nulls_in * y2.event;
             const float wt = strategy_weight(kernels_.heuristic(), pdfs, s);
-            observe(s, 1, f, wt, pdfs, PathVertices<typename Sc::Spectral>{light, s, camera, 1, light[0].p});
+            observe(s, 1, f, wt, pdfs,
+                    PathVertices<typename Sc::Spectral>{light, s, camera, 1, light[0].p, light[0].at_infinity});
             const Spectrum value = f * wt;
             if (all_finite(value)) splat(u, v, value);
             else status = Status::NonFinite;
