@@ -107,8 +107,8 @@ int main(int argc, char** argv) {
     std::vector<std::string> tables{"grey", "rgb", "plume", "lantern"};  // "cloud" on request
     app.add_option("--tables", tables,
                    "which tables to render (default: grey,rgb,plume,lantern; cloud: the main job's cloud, set-ups A "
-                   "and B, with BDPT)")
-        ->check(CLI::IsMember({"grey", "rgb", "plume", "lantern", "cloud"}))
+                   "and B, with BDPT; sky: the grey room's BDPT with and without light subpaths from the sky)")
+        ->check(CLI::IsMember({"grey", "rgb", "plume", "lantern", "cloud", "sky"}))
         ->delimiter(',');
     CLI11_PARSE(app, argc, argv);
     auto want = [&](const char* t) { return std::find(tables.begin(), tables.end(), t) != tables.end(); };
@@ -222,6 +222,23 @@ int main(int argc, char** argv) {
                     "tracing: %.3g); / best path tracer: %.3g\n",
                     cost(lantern_rows, 4) / cost(lantern_rows, 3), cost(lantern_rows, 7) / cost(lantern_rows, 6),
                     cost(lantern_rows, 4) / std::min({cost(lantern_rows, 0), cost(lantern_rows, 1), cost(lantern_rows, 2)}));
+    }
+
+    // Table "sky" (--tables sky only): the grey room, BDPT with the sky reached by hits and NEE
+    // alone against BDPT whose light subpaths also start from the sky (a BoundingSphere).
+    if (want("sky")) {
+        const std::size_t first_sky = rows.size();
+        const auto sky_room = nsp_examples::make_room_scene(true);
+        seed = 29 + seed_offset;
+        run_res = res;
+        run_spp = spp;
+        run(grey, PathEstimator<strategy::NullScatteringMis, mis::Balance>{}, "uni-nee-mis_balance");
+        run_splatting(grey, BdptEstimator<bdpt::NullScattering, mis::Balance>{}, "bdpt_null-mis_balance");
+        run_splatting(sky_room, BdptEstimator<bdpt::NullScattering, mis::Balance>{}, "bdpt_null-mis_balance_sky-subpaths");
+        std::vector<Row> sky_rows(rows.begin() + std::ptrdiff_t(first_sky), rows.end());
+        failed += print_table("Room, light subpaths from the sky (mono", sky_rows, 0, run_res, run_spp, threads);
+        std::printf("sky: bdpt with sky subpaths / without in cpu-s*var: %.3g; / uni-nee-mis_balance: %.3g\n",
+                    cost(sky_rows, 2) / cost(sky_rows, 1), cost(sky_rows, 2) / cost(sky_rows, 0));
     }
 
     // Tables 5 and 6 (--tables cloud only): the main job's cloud scene, set-ups A and B, as a

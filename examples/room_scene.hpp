@@ -44,8 +44,11 @@ inline void add_room_shell(nsp_host::Shapes& shapes) {
 /// The room around `medium` (in [-1, 1]^3, behind null interfaces: medium 0) with `majorant`:
 /// the floor (material 0, albedo 0.7), the back and left walls (material 1, albedo 0.5), the lamp
 /// (light 0) and the sky (light 1), light selection by power. Grey surfaces and lights.
+/// `sky_subpaths`: the light sampler gets a BoundingSphere around the room (centre (0, 0.95, 0),
+/// radius 4.8; the shell's corners lie 4.69 from it), so BDPT's light subpaths start from the sky
+/// too; its power is then measured over that radius instead of 4, which changes the selection.
 template <nsp::Medium M, class Maj>
-RoomScene<M, Maj> make_room_scene(M medium, Maj majorant) {
+RoomScene<M, Maj> make_room_scene(M medium, Maj majorant, bool sky_subpaths = false) {
     using S = typename M::Spectral;
     nsp_host::Shapes shapes;
     add_room_shell(shapes);
@@ -54,16 +57,19 @@ RoomScene<M, Maj> make_room_scene(M medium, Maj majorant) {
     return RoomScene<M, Maj>(std::move(shapes), {{std::move(medium), std::move(majorant), nsp::HenyeyGreensteinPhase(kPhaseG)}},
                              RoomMaterials<S>({nsp::LambertianBsdf<S>(nsp::constant_coefficient<S>(0.7f)),
                                                nsp::LambertianBsdf<S>(nsp::constant_coefficient<S>(0.5f))}),
-                             RoomLights<S>(nsp::LightSelection::Power, 4.f, {lamp},
-                                           {nsp::EnvironmentLight<S>{nsp::constant_coefficient<S>(kRoomSky)}}),
+                             sky_subpaths
+                                 ? RoomLights<S>(nsp::LightSelection::Power, nsp::BoundingSphere{nsp::Vec3(0.f, 0.95f, 0.f), 4.8f},
+                                                 {lamp}, {nsp::EnvironmentLight<S>{nsp::constant_coefficient<S>(kRoomSky)}})
+                                 : RoomLights<S>(nsp::LightSelection::Power, 4.f, {lamp},
+                                                 {nsp::EnvironmentLight<S>{nsp::constant_coefficient<S>(kRoomSky)}}),
                              -1);
 }
 
 /// The grey room of the main job's first table: the default cloud, Mono, one global majorant.
-inline RoomScene<> make_room_scene() {
+inline RoomScene<> make_room_scene(bool sky_subpaths = false) {
     auto cloud = make_default_medium<nsp::Mono>();
     nsp::GlobalMajorant<nsp::DenseGridMedium<nsp::Mono>> majorant(cloud);
-    return make_room_scene(std::move(cloud), majorant);
+    return make_room_scene(std::move(cloud), majorant, sky_subpaths);
 }
 
 /// The lantern: the room's floor and walls around the cloud, no sky, lit only by a lamp inside a
