@@ -220,18 +220,23 @@ Ray cube_camera(Pcg32& rng) {
     return Ray{Vec3(0.f, 0.3f, -4.5f), glm::normalize(Vec3(0.7f * (2.f * u - 1.f), 0.7f * (1.f - 2.f * v), 1.f))};
 }
 
-TEST_CASE("bdpt: agrees with PathEstimator on a scattering cube over a floor, a quad light and a sky") {
-    // No closed form: against null-scattering uni + NEE MIS, within 5 combined standard errors
-    // (independent estimates). The sky's paths are weighted among s = 0 and s = 1 alone.
-    const Sc sc = cube_over_floor(true);
-    const Stat ref = estimate(PathEstimator<strategy::NullScatteringMis, mis::Balance>{}, sc, 40000, 21, cube_camera);
+/// Every BDPT variant's estimate through cube_camera (10000 samples, seed + 1) against null-
+/// scattering uni + NEE MIS's (40000, seed), within 5 combined standard errors (independent).
+void check_agrees_with_path_estimator(const Sc& sc, std::uint64_t seed) {
+    const Stat ref = estimate(PathEstimator<strategy::NullScatteringMis, mis::Balance>{}, sc, 40000, seed, cube_camera);
     for_each_bdpt([&](const auto& est, const char* name) {
         CAPTURE(std::string(name));
-        const Stat s = estimate(est, sc, 10000, 22, cube_camera);
+        const Stat s = estimate(est, sc, 10000, seed + 1, cube_camera);
         CAPTURE(s.mean);
         CAPTURE(ref.mean);
         CHECK(std::abs(s.mean - ref.mean) <= kSigmas * std::sqrt(s.se() * s.se() + ref.se() * ref.se()));
     });
+}
+
+TEST_CASE("bdpt: agrees with PathEstimator on a scattering cube over a floor, a quad light and a sky") {
+    // No closed form: against null-scattering uni + NEE MIS, within 5 combined standard errors
+    // (independent estimates). The sky's paths are weighted among s = 0 and s = 1 alone.
+    check_agrees_with_path_estimator(cube_over_floor(true), 21);
 }
 
 /// What one run of the estimator on the cube over the floor measured per strategy, over the paths
@@ -403,14 +408,7 @@ TEST_CASE("bdpt: with light subpaths from the sky, agrees with PathEstimator und
     const Sc sc(base.geometry, base.media, base.materials,
                 Ls(LightSelection::Power, BoundingSphere{Vec3(0.f), 4.5f}, {lamp}, {EnvironmentLight<S>{Spectrum::Constant(0.05f)}}),
                 -1);
-    const Stat ref = estimate(PathEstimator<strategy::NullScatteringMis, mis::Balance>{}, sc, 40000, 23, cube_camera);
-    for_each_bdpt([&](const auto& est, const char* name) {
-        CAPTURE(std::string(name));
-        const Stat s = estimate(est, sc, 10000, 24, cube_camera);
-        CAPTURE(s.mean);
-        CAPTURE(ref.mean);
-        CHECK(std::abs(s.mean - ref.mean) <= kSigmas * std::sqrt(s.se() * s.se() + ref.se() * ref.se()));
-    });
+    check_agrees_with_path_estimator(sc, 23);
 }
 
 TEST_CASE("bdpt: a medium outside the lights' BoundingSphere is rejected with its bounds") {

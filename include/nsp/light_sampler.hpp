@@ -141,7 +141,6 @@ private:
     }
 
 public:
-
     /// Whether every light model can start light subpaths, or is reached from infinity (hit or
     /// NEE only): what a bidirectional estimator needs of its lights.
     static constexpr bool bidirectional_ready() noexcept {
@@ -287,7 +286,7 @@ private:
                                             const typename S::Wavelengths& lambda) const noexcept {
         LightEmission<S> e;
         const LightSample<S> s = l.sample(sphere_.center, u1, u2, lambda, 1.f);
-        if (!(s.pdf > 0.f) || !(std::isinf(s.distance))) return e;
+        if (!(s.pdf > 0.f) || !std::isinf(s.distance)) return e;
         const Vec3 toward = s.wi;
         Vec3 a, b;
         orthonormal_basis(toward, a, b);

@@ -224,7 +224,7 @@ struct PathVertices {
 /// infinity is a direction: its measure is the solid angle, pdf_dir unchanged.
 template <SpectralMode S>
 float to_vertex_measure(float pdf_dir, const Vec3& from, const Vertex<S>& to) noexcept {
-    if (to.kind == VertexKind::Light && to.at_infinity) return pdf_dir;
+    if (to.at_infinity) return pdf_dir;
     const Vec3 d = to.p - from;
     const float d2 = glm::dot(d, d);
     if (!(d2 > 0.f)) return 0.f;
@@ -758,14 +758,13 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::trace(
                     nl = walk(sc, light, 1, light_vertices, Ray{e.emission.p, e.emission.w}, start, e.emission.pdf_dir,
                               Spectrum(y0.beta * (e.emission.cos / e.emission.pdf_dir)), lambda, rng, counter,
                               [](auto&&...) {}, status);
-                if (nl >= 2 && y0.at_infinity) {
-                    nee_y0 = sc.lights.pdf(y0.light, light[1].p, -e.emission.w);  // solid angle, as x_0's measure
-                } else if (nl >= 2) {
+                if (nl >= 2) {
                     const Vec3 d = y0.p - light[1].p;
                     const float d2 = glm::dot(d, d);
-                    nee_y0 = y0.delta_position ? sc.lights.selection_pdf(y0.light)
-                                               : sc.lights.pdf(y0.light, light[1].p, d / std::sqrt(d2)) *
-                                                     std::abs(glm::dot(y0.ng, d)) / (d2 * std::sqrt(d2));
+                    nee_y0 = y0.at_infinity      ? sc.lights.pdf(y0.light, light[1].p, -e.emission.w)  // solid angle
+                             : y0.delta_position ? sc.lights.selection_pdf(y0.light)
+                                                 : sc.lights.pdf(y0.light, light[1].p, d / std::sqrt(d2)) *
+                                                       std::abs(glm::dot(y0.ng, d)) / (d2 * std::sqrt(d2));
                 }
             }
         }
