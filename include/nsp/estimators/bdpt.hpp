@@ -36,8 +36,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <new>
 #include <type_traits>
 
 #include "../core/counter.hpp"
@@ -547,8 +549,14 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::trace(
     const int depth = kernels_.options().max_depth;
     Spectrum L = Spectrum::Zero();
     Status status = Status::Ok;
-    V camera[MaxDepth + 2];  // z_0 .. z_{depth+1}
-    V light[MaxDepth + 1];   // y_0 .. y_{depth-1}, and y_depth for light tracing
+    // The subpaths' vertices, each written whole before it is read: a Vertex is an implicit-
+    // lifetime aggregate, so the storage is left as it is instead of 67 vertices being set to
+    // their defaults per sample (a fifth of a sample's time where the subpaths are short).
+    static_assert(std::is_aggregate_v<V> && std::is_trivially_destructible_v<V>, "implicit-lifetime vertices");
+    alignas(V) std::byte camera_storage[sizeof(V) * (MaxDepth + 2)];
+    alignas(V) std::byte light_storage[sizeof(V) * (MaxDepth + 1)];
+    V* const camera = std::launder(reinterpret_cast<V*>(camera_storage));  // z_0 .. z_{depth+1}
+    V* const light = std::launder(reinterpret_cast<V*>(light_storage));    // y_0 .. y_{depth-1}, y_depth (light tracing)
     Pdfs pdfs;
     pdfs.light_tracing = kLightTracing;
     // A light subpath is traced with probability light_probability_; it starts in the emitting
@@ -682,6 +690,7 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::trace(
     };
 
     // The camera subpath.
+    camera[0] = V{};
     camera[0].kind = VertexKind::Camera;
     camera[0].p = camera_ray.o;
     camera[0].beta = Spectrum::Ones();
@@ -724,7 +733,7 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::trace(
                     } else if ((c->k.sigma_a > 0.f).any() && c->mu > 0.f) {
                         const Spectrum source = c->k.sigma_a * m.medium.emission(yv.p, lambda);
                         if ((source > 0.f).any()) {
-                            V& y0 = light[0];
+                            V& y0 = light[0] = V{};
                             y0.kind = VertexKind::Medium;
                             y0.p = yv.p;
                             y0.medium = i;
@@ -743,7 +752,7 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::trace(
                         u4 = rng.uniform();
             const EmittedLight<typename Sc::Spectral> e = sc.lights.sample_emission(u0, u1, u2, u3, u4, lambda);
             if (e.emission.pdf_pos > 0.f && e.emission.pdf_dir > 0.f && (e.emission.radiance != 0.f).any()) {
-                V& y0 = light[0];
+                V& y0 = light[0] = V{};
                 y0.kind = VertexKind::Light;
                 y0.p = e.emission.p;
                 y0.ng = y0.ns = e.emission.n;
