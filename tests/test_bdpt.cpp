@@ -201,25 +201,6 @@ TEST_CASE("bdpt: a mirror behind an absorbing slab reflects the light behind the
     });
 }
 
-/// The scattering cube (albedo 0.8, HG 0.6, behind null interfaces) over a Lambertian floor,
-/// under a quad lamp and (when `sky`) a dim sky; the camera in front of it.
-Sc cube_over_floor(bool sky) {
-    Shapes shapes;
-    shapes.boxes.push_back({Vec3(-1.f), Vec3(1.f), {-1, -1, 0, -1}});
-    shapes.quads.push_back({Vec3(-3.f, -1.05f, 3.f), Vec3(6.f, 0.f, 0.f), Vec3(0.f, 0.f, -6.f), {0, -1, -1, -1}});
-    const QuadLight<S> lamp{Vec3(-0.6f, 2.6f, -0.6f), Vec3(1.2f, 0.f, 0.f), Vec3(0.f, 0.f, 1.2f), Spectrum::Constant(12.f)};
-    shapes.quads.push_back({lamp.corner, lamp.edge_u, lamp.edge_v, {-1, 0, -1, -1}});
-    std::vector<EnvironmentLight<S>> env;
-    if (sky) env.push_back(EnvironmentLight<S>{Spectrum::Constant(0.05f)});
-    return Sc(shapes, {medium(Box{Vec3(-1.f), Vec3(1.f)}, 0.3f, 1.2f, 0.6f)}, materials(0.6f),
-              Ls(LightSelection::Power, 4.f, {lamp}, env), -1);
-}
-
-Ray cube_camera(Pcg32& rng) {
-    const float u = rng.uniform(), v = rng.uniform();
-    return Ray{Vec3(0.f, 0.3f, -4.5f), glm::normalize(Vec3(0.7f * (2.f * u - 1.f), 0.7f * (1.f - 2.f * v), 1.f))};
-}
-
 /// Every BDPT variant's estimate through cube_camera (10000 samples, seed + 1) against null-
 /// scattering uni + NEE MIS's (40000, seed), within 5 combined standard errors (independent).
 void check_agrees_with_path_estimator(const Sc& sc, std::uint64_t seed) {
@@ -247,12 +228,6 @@ struct StrategyRecord {
     std::map<std::pair<int, int>, Stat> alone;
     std::map<std::pair<int, int>, std::map<int, Stat>> share;
 };
-
-/// The cube's camera as a PinholeCamera: cube_camera(u, v) is its ray(u, 1 - v).
-PinholeCamera cube_pinhole() {
-    return PinholeCamera(Vec3(0.f, 0.3f, -4.5f), Vec3(0.f, 0.3f, 0.f), Vec3(0.f, 1.f, 0.f),
-                         2.f * std::atan(0.7f) * 180.f / kPi, 1.f);
-}
 
 /// Samples of the cube's image at uniform (u, v) over the whole image, light tracing included.
 template <class E, class Scene>
@@ -615,18 +590,22 @@ TEST_CASE("bdpt: agrees with PathEstimator on an emitting cube over a floor unde
     });
 }
 
-TEST_CASE("bdpt: light subpaths on a fraction of the samples (an expected count < 1) stay unbiased") {
+TEST_CASE("bdpt: light subpaths and NEE on a fraction of the samples (expected counts < 1) stay unbiased") {
     // THEORY 5.9: with light_subpath_probability c the connections and light tracing run on a
-    // fraction c of the samples and weigh with c times their densities. The emitting furnace
-    // (L = 2, with and without light tracing) at c = 0.3, and the cube's pdf symmetry and each
-    // strategy alone at c = 0.4 (the densities now include c), 5 SE.
+    // fraction c of the samples and weigh with c times their densities; with nee_count n, NEE
+    // toward the lights (s = 1) runs at a camera vertex with probability n, divides by it, and
+    // every path's NEE density carries n. The emitting furnace (L = 2, with and without light
+    // tracing) at c = 0.3, n = 0.3 (NEE toward the volume keeps count 1), and the cube's pdf
+    // symmetry and each strategy alone at c = 0.4, n = 0.5 (the densities now include both), 5 SE.
     Shapes shapes;
     std::vector<QuadLight<S>> walls;
     box_walls(1.f, {}, shapes, walls);
     const ESc sc(shapes, {emitting(Box{Vec3(-1.f), Vec3(1.f)}, 0.6f, 1.f, 2.f)}, materials(),
                  Ls(LightSelection::Uniform, 2.f, walls, {}), 0);
     const PinholeCamera camera(Vec3(0.1f, -0.2f, 0.3f), Vec3(0.5f, 0.f, -1.f), Vec3(0.f, 1.f, 0.f), 70.f, 1.3f);
-    const BdptEstimator<bdpt::NullScattering, mis::Balance> est(BdptEstimator<>::default_options(), {}, 0.3f);
+    EstimatorOptions furnace_opts = BdptEstimator<>::default_options();
+    furnace_opts.nee_count = 0.3f;
+    const BdptEstimator<bdpt::NullScattering, mis::Balance> est(furnace_opts, {}, 0.3f);
     CHECK(est.light_subpath_probability() == 0.3f);
     const Stat a = estimate(est, sc, 6000, 43, [](Pcg32& rng) {
         return Ray{Vec3(0.1f, -0.2f, 0.3f), uniform_sphere(rng.uniform(), rng.uniform())};
@@ -637,7 +616,8 @@ TEST_CASE("bdpt: light subpaths on a fraction of the samples (an expected count 
     CAPTURE(b.mean);
     CHECK(std::abs(b.mean - 2.0) <= kSigmas * b.se());
 
-    const EstimatorOptions opts = strategy_test_options();
+    EstimatorOptions opts = strategy_test_options();
+    opts.nee_count = 0.5f;
     StrategyRecord rec =
         record_strategies(BdptEstimator<bdpt::NullScattering, mis::Balance>(opts, {}, 0.4f), cube_over_floor(false), 200000, 3);
     check_strategies_alone_and_symmetric(rec);

@@ -24,7 +24,10 @@
 // and DDA steps (deterministic, unlike time; a shadow walk's fixed work counted as one lookup) with
 // the shadow walks' share scaled by n (THEORY 5.9). Volume emission is the same with the
 // collision estimator in tracking's place and the segment technique in NEE's (NEE toward the
-// volume at a fixed count): the learner keeps both ladders and picks the pair of counts.
+// volume at a fixed count): the learner keeps both ladders and picks the pair of counts. Under
+// BdptEstimator the pair is NEE's count and the light subpath probability: every strategy's
+// contribution is u / (p_fixed + n p_nee + c p_light) at counts (n, c), the NEE draws independent
+// per camera vertex, the light subpath one draw for all of its connections and splats.
 #pragma once
 
 #include <algorithm>
@@ -128,22 +131,69 @@ double recorder_work(const C& counter) noexcept {
 }
 }  // namespace detail
 
-/// The expected counts a NeeCountLearner chooses (EstimatorOptions::nee_count and
-/// EstimatorOptions::emission_segment_count).
+/// Which group of BDPT's strategies drew a contribution a BdptRecorder sees (the groups whose
+/// counts the learner changes together).
+enum class BdptTechnique : std::uint8_t {
+    Fixed,  ///< s = 0 (the camera subpath reaches the emitter), NEE toward an emitting volume: count 1
+    Nee,    ///< s = 1 toward a light, drawn with EstimatorOptions::nee_count at each camera vertex
+    Light,  ///< s >= 2 and t = 1: a light subpath's, drawn with the light subpath probability (one draw a sample)
+};
+
+/// A MisRecorder that also records BdptEstimator's contributions (every strategy's, balance
+/// heuristic) and the work of its light subpaths; BdptEstimator calls these only on such counters.
+template <class C>
+concept BdptRecorder = MisRecorder<C> && requires(C& c, float f, BdptTechnique t, double w, bool b) {
+    { c.record_bdpt(f, f, f, f, f, f, t, b) } noexcept;
+    { c.record_light_walk(w) } noexcept;
+};
+
+namespace detail {
+/// Records a BDPT contribution on a BdptRecorder (else nothing), as record_light: `f_over_ref`
+/// the unweighted contribution times its strategy's pdf relative to one reference density of the
+/// path, the summed pdfs of the path's strategies by group (`p_fixed` the count-1 strategies',
+/// `p_nee` light NEE's without its count, `p_light` the light subpath's strategies' without its
+/// probability), the counts the path ran with, the group that drew it and whether it was splatted
+/// onto the image elsewhere (t = 1) instead of returned for the sample's own pixel.
+template <class C>
+void record_bdpt(C& counter, float f_over_ref, float p_fixed, float p_nee, float p_light, float nee_count,
+                 float light_count, BdptTechnique t, bool splat) noexcept {
+    if constexpr (BdptRecorder<C>) counter.record_bdpt(f_over_ref, p_fixed, p_nee, p_light, nee_count, light_count, t, splat);
+    else (void)counter, (void)f_over_ref, (void)p_fixed, (void)p_nee, (void)p_light, (void)nee_count, (void)light_count, (void)t, (void)splat;
+}
+/// The work counted since `before` as a light subpath's (its walk, or one of its connections'
+/// shadow walks), on a BdptRecorder (else nothing).
+template <class C>
+void record_light_walk(C& counter, double before) noexcept {
+    if constexpr (BdptRecorder<C>) counter.record_light_walk(counter.work() - before);
+    else (void)counter, (void)before;
+}
+}  // namespace detail
+
+/// The expected counts a NeeCountLearner chooses (EstimatorOptions::nee_count,
+/// EstimatorOptions::emission_segment_count, BdptEstimator's light_subpath_probability).
 struct TechniqueCounts {
     float nee = 1.f;
     float emission_segment = 1.f;
+    float light_subpath = 1.f;
 };
 
-/// Learns PathEstimator's NEE count (EstimatorOptions::nee_count) and, in emissive media, its
-/// emission segment count (EstimatorOptions::emission_segment_count) for a pixel tile from pilot
-/// samples rendered at counts 1 with the learner as their lookup counter (see the header), for the
-/// balance heuristic; the two jointly, over every pair of candidates (a path's light and emission
-/// contributions share its variance). The host calls end_sample(estimate) after each sample and
-/// end_pixel() after each pixel's samples; choose_counts() then gives the counts (choose() the NEE
-/// count alone). Where nothing emits the segment count stays 1 and the NEE count is what it would
-/// be without it. Deterministic: the same samples in the same order give the same counts.
-/// Host-side and fixed-size (no heap); one per tile.
+/// Learns a tile's expected counts from pilot samples rendered at counts 1 with the learner as
+/// their lookup counter (see the header), for the balance heuristic: under PathEstimator and
+/// SpectralPathEstimator the NEE count (EstimatorOptions::nee_count) and, in emissive media, the
+/// emission segment count (EstimatorOptions::emission_segment_count); under BdptEstimator the NEE
+/// count and the light subpath probability. Two counts jointly, over every pair of candidates (a
+/// path's contributions share its variance): the second is the segment technique's or the light
+/// subpaths', whichever the pilot recorded. The host calls end_sample(estimate) after each sample
+/// and end_pixel() after each pixel's samples; choose_counts() then gives the counts (choose() the
+/// NEE count alone). Where the second technique never ran its count stays 1 and the NEE count is
+/// what it would be without it. Deterministic: the same samples in the same order give the same
+/// counts. Host-side and fixed-size (no heap, about 32 KiB); one per tile.
+///
+/// BDPT's light subpath is one draw per sample for all of its strategies, so its Bernoulli
+/// variance is that of the sum of its contributions to the sample's own pixel; its splats (t = 1)
+/// land on other pixels, whose variance they add to by their second moment (their means there,
+/// spread over the image, are left out). Its counts are predicted without the diagonal correction
+/// (a path one tile's light subpath splats may be drawn by another tile's camera subpaths).
 class NeeCountLearner {
 public:
     static constexpr bool enabled = true;
@@ -154,7 +204,8 @@ public:
 
     /// A shadow walk's work besides its lookups and steps (the light sample, the phase or BSDF
     /// evaluation, the walk's set-up), in lookups: an assumption of the cost model, about what a
-    /// lookup costs. The segment technique's run (its point's draw, its walk's set-up) counts the same.
+    /// lookup costs. The segment technique's run (its point's draw, its walk's set-up), a light
+    /// subpath's walk and each of its connections count the same.
     static constexpr double kShadowRayCost = 1.0;
 
     void lookup() noexcept { ++lookups_; }
@@ -169,56 +220,93 @@ public:
     /// the learner then reports invalid_pilot() and chooses 1.
     void record_light(float f_over_ref, float p_hit, float p_nee, float p_other, float count,
                       LightTechnique t) noexcept {
-        add_contribution(nee_, f_over_ref, p_hit, p_nee, p_other, count, t == LightTechnique::Nee);
+        add_contribution(Axis::Nee, f_over_ref, p_hit, p_nee, p_other, count, t == LightTechnique::Nee);
     }
     /// Called by the estimator for every volume emission contribution of a combining strategy
     /// (see detail::record_emission); a pilot at a segment count other than 1 is invalid as above.
     void record_emission(float f_over_ref, float p_collision, float p_segment, float p_nee, float count,
                          EmissionTechnique t) noexcept {
-        add_contribution(segment_, f_over_ref, p_collision, p_segment, p_nee, count, t == EmissionTechnique::Segment);
+        set_second(Second::Segment);
+        add_contribution(Axis::Second, f_over_ref, p_collision, p_segment, p_nee, count, t == EmissionTechnique::Segment);
+    }
+    /// Called by BdptEstimator for every strategy's contribution (see detail::record_bdpt): at
+    /// NEE count c_n and light subpath count c_l it is x = u / (p_fixed + c_n p_nee + c_l p_light),
+    /// times the Bernoulli draw of the group that drew it (none for the fixed group).
+    void record_bdpt(float f_over_ref, float p_fixed, float p_nee, float p_light, float nee_count, float light_count,
+                     BdptTechnique t, bool splat) noexcept {
+        set_second(Second::LightSubpath);
+        if (nee_count != 1.f || light_count != 1.f) invalid_ = true;
+        if (!(p_fixed >= 0.f && p_nee >= 0.f && p_light >= 0.f) || !std::isfinite(f_over_ref) || f_over_ref == 0.f)
+            return;
+        const double u = f_over_ref, h = p_fixed, n = p_nee, l = p_light;
+        const double d1 = h + n + l;
+        if (!(d1 > 0.0) || !std::isfinite(d1)) return;
+        const double v1 = u / d1;
+        for (int jn = 0; jn < kCandidates; ++jn)
+            for (int jl = 0; jl < kCandidates; ++jl) {
+                const std::size_t k = pair(jn, jl);
+                const double cn = candidate(jn), cl = candidate(jl), d = h + cn * n + cl * l;
+                const double x = d > 0.0 ? u / d : 0.0;
+                switch (t) {
+                    case BdptTechnique::Fixed: path_delta_[k] += x - v1; break;
+                    case BdptTechnique::Nee:
+                        path_delta_[k] += cn * x - v1;
+                        path_bernoulli_[k] += cn * (1.0 - cn) * x * x;
+                        break;
+                    case BdptTechnique::Light:
+                        if (splat) {
+                            path_bernoulli_[k] += cl * x * x;  // E[(B x)^2] on another pixel
+                        } else {
+                            path_delta_[k] += cl * x - v1;
+                            light_sum_[k] += x;  // one draw for all: its variance at end_sample
+                        }
+                        break;
+                }
+            }
     }
     /// Called by the estimator after each NEE shadow walk with the work (work()) it took;
     /// `counted`: the walk runs with the NEE count, so its share of the cost scales with it (the
     /// walks from equiangular vertices run at any count: their work stays in the base).
     void record_shadow_walk(double w, bool counted) noexcept {
-        if (counted) nee_.work += w + kShadowRayCost;
+        if (counted) nee_work_ += w + kShadowRayCost;
         fixed_work_ += kShadowRayCost;
     }
     /// Called by the estimator after each run of the emission segment technique with its work.
     void record_segment_walk(double w) noexcept {
-        segment_.work += w + kShadowRayCost;
-        fixed_work_ += kShadowRayCost;
+        set_second(Second::Segment);
+        add_second_work(w);
+    }
+    /// Called by BdptEstimator after a light subpath's walk and after each of its connections'
+    /// shadow walks with the work it took: all of it scales with the light subpath count.
+    void record_light_walk(double w) noexcept {
+        set_second(Second::LightSubpath);
+        add_second_work(w);
     }
 
-    /// The host, after each pilot sample: its estimate (the channel mean the render measures).
+    /// The host, after each pilot sample: its estimate for its own pixel (the channel mean the
+    /// render measures; BDPT's splats are not part of it).
     void end_sample(double estimate) noexcept {
         for (int jn = 0; jn < kCandidates; ++jn)
             for (int js = 0; js < kCandidates; ++js) {
                 const std::size_t k = pair(jn, js);
-                const double a = estimate + nee_.path_delta[std::size_t(jn)] + segment_.path_delta[std::size_t(js)];
+                const double c = candidate(js);
+                path_bernoulli_[k] += c * (1.0 - c) * light_sum_[k] * light_sum_[k];
+                const double a = estimate + path_delta_[k];
                 if (pixel_n_ == 0) shift_[k] = a;  // shifted sums: no cancellation
                 const double d = a - shift_[k];
                 pixel_sum_[k] += d;
                 pixel_sum2_[k] += d * d;
+                bernoulli_[k] += path_bernoulli_[k] + path_diagonal_[k];
             }
         SampleRecord& rec = group_[std::size_t(group_n_++)];
         rec.estimate = estimate;
-        rec.nee_delta = nee_.path_delta;
-        rec.nee_bernoulli = nee_.path_bernoulli;
-        rec.segment_delta = segment_.path_delta;
-        rec.segment_bernoulli = segment_.path_bernoulli;
-        for (std::size_t j = 0; j < std::size_t(kCandidates); ++j) {
-            rec.nee_bernoulli[j] += nee_.path_diagonal[j];
-            rec.segment_bernoulli[j] += segment_.path_diagonal[j];
-        }
+        rec.delta = path_delta_;
+        for (std::size_t k = 0; k < kPairs; ++k) rec.bernoulli[k] = path_bernoulli_[k] + path_diagonal_[k];
         if (group_n_ == kGroupSize) flush_group();
-        for (Counted* t : {&nee_, &segment_}) {
-            for (std::size_t j = 0; j < std::size_t(kCandidates); ++j)
-                t->bernoulli[j] += t->path_bernoulli[j] + t->path_diagonal[j];
-            t->path_delta = {};
-            t->path_bernoulli = {};
-            t->path_diagonal = {};
-        }
+        path_delta_ = {};
+        path_bernoulli_ = {};
+        path_diagonal_ = {};
+        light_sum_ = {};
         ++pixel_n_;
         ++samples_;
     }
@@ -243,43 +331,43 @@ public:
         lookups_ += o.lookups_;
         steps_ += o.steps_;
         fixed_work_ += o.fixed_work_;
+        nee_work_ += o.nee_work_;
+        second_work_ += o.second_work_;
         samples_ += o.samples_;
         variance_samples_ += o.variance_samples_;
         z_n_ += o.z_n_;
         z_dof_ += o.z_dof_;
         invalid_ = invalid_ || o.invalid_;
+        if (o.second_ != Second::None) set_second(o.second_);
         for (std::size_t k = 0; k < kPairs; ++k) {
             variance_sum_[k] += o.variance_sum_[k];
+            bernoulli_[k] += o.bernoulli_[k];
             z_[k] += o.z_[k];
             z2_[k] += o.z2_[k];
             z_at_1_[k] += o.z_at_1_[k];
             z_nee_at_1_[k] += o.z_nee_at_1_[k];
             z_segment_at_1_[k] += o.z_segment_at_1_[k];
         }
-        for (auto [t, ot] : {std::pair{&nee_, &o.nee_}, std::pair{&segment_, &o.segment_}}) {
-            t->work += ot->work;
-            for (std::size_t j = 0; j < std::size_t(kCandidates); ++j) t->bernoulli[j] += ot->bernoulli[j];
-        }
     }
 
-    /// The predicted variance of one sample at NEE candidate j and segment candidate js: the mean
-    /// over pixels of the sample variance of A, plus the mean of both techniques' B and of their
-    /// contributions' diagonal correction (see add_contribution); 0 before any pixel ended.
+    /// The predicted variance of one sample at NEE candidate j and candidate js of the second
+    /// technique (the segment technique's or the light subpaths'): the mean over pixels of the
+    /// sample variance of A, plus the mean of the Bernoulli variances, the splats' second moments
+    /// and the contributions' diagonal correction (see add_contribution); 0 before any pixel ended.
     double predicted_variance(int j, int js = 0) const noexcept {
-        const double a = variance_samples_ > 0 ? variance_sum_[pair(j, js)] / double(variance_samples_) : 0.0;
-        const double b = samples_ > 0 ? (nee_.bernoulli[std::size_t(j)] + segment_.bernoulli[std::size_t(js)]) /
-                                            double(samples_)
-                                      : 0.0;
+        const std::size_t k = pair(j, js);
+        const double a = variance_samples_ > 0 ? variance_sum_[k] / double(variance_samples_) : 0.0;
+        const double b = samples_ > 0 ? bernoulli_[k] / double(samples_) : 0.0;
         return a + b;
     }
-    /// Predicted work per sample at NEE candidate j and segment candidate js, in lookups: lookups
+    /// Predicted work per sample at NEE candidate j and second candidate js, in lookups: lookups
     /// and DDA steps (work()), with each counted technique's share (its walks' work and
     /// kShadowRayCost each) scaled by its count, +1 per sample for the camera ray (so that a tile
     /// whose paths never meet the medium has a cost).
     double predicted_cost(int j, int js = 0) const noexcept {
         if (samples_ == 0) return 1.0;
-        const double base = work() + fixed_work_ - nee_.work - segment_.work;
-        return (base + double(candidate(j)) * nee_.work + double(candidate(js)) * segment_.work) / double(samples_) +
+        const double base = work() + fixed_work_ - nee_work_ - second_work_;
+        return (base + double(candidate(j)) * nee_work_ + double(candidate(js)) * second_work_) / double(samples_) +
                1.0;
     }
 
@@ -318,36 +406,45 @@ public:
                                     significantly_better(jn, js, jn, 0, z_segment_at_1_)));
                 if (pays) best_n = jn, best_s = js, best_e = e;
             }
-        return {candidate(best_n), candidate(best_s)};
+        TechniqueCounts out;
+        out.nee = candidate(best_n);
+        (second_ == Second::LightSubpath ? out.light_subpath : out.emission_segment) = candidate(best_s);
+        return out;
     }
     /// The NEE count of choose_counts().
     float choose() const noexcept { return choose_counts().nee; }
 
     bool invalid_pilot() const noexcept { return invalid_; }
     std::uint64_t samples() const noexcept { return samples_; }
-    double nee_work() const noexcept { return nee_.work; }          ///< NEE's work in lookups (see predicted_cost)
-    double segment_work() const noexcept { return segment_.work; }  ///< the segment technique's
+    double nee_work() const noexcept { return nee_work_; }  ///< NEE's work in lookups (see predicted_cost)
+    /// The segment technique's work (0 under BDPT).
+    double segment_work() const noexcept { return second_ == Second::Segment ? second_work_ : 0.0; }
+    /// The light subpaths' work (0 under the path estimators).
+    double light_subpath_work() const noexcept { return second_ == Second::LightSubpath ? second_work_ : 0.0; }
 
 private:
-    using PerCandidate = std::array<double, kCandidates>;
     static constexpr std::size_t kPairs = std::size_t(kCandidates) * std::size_t(kCandidates);
     using PerPair = std::array<double, kPairs>;
     static constexpr std::size_t pair(int jn, int js) noexcept { return std::size_t(jn * kCandidates + js); }
 
-    /// One counted technique (NEE toward the lights, the emission segment technique): the current
-    /// sample's change of its estimate, Bernoulli variance and diagonal correction at each
-    /// candidate, the tile's sum of the last two and the technique's work.
-    struct Counted {
-        PerCandidate path_delta{}, path_bernoulli{}, path_diagonal{}, bernoulli{};
-        double work = 0.0;
-    };
+    /// Which count the second axis of the pairs is: none recorded yet, the emission segment
+    /// technique's (path estimators) or the light subpath probability (BDPT). A pilot that records
+    /// both is invalid.
+    enum class Second : std::uint8_t { None, Segment, LightSubpath };
+    void set_second(Second s) noexcept {
+        if (second_ != Second::None && second_ != s) invalid_ = true;
+        second_ = s;
+    }
+    void add_second_work(double w) noexcept {
+        second_work_ += w + kShadowRayCost;
+        fixed_work_ += kShadowRayCost;
+    }
 
-    /// One pilot sample as the significance test needs it: its estimate and, per candidate of
-    /// each counted technique, the change of its re-weighted estimate and its Bernoulli variance
-    /// plus diagonal correction (the `_bernoulli` members).
+    /// One pilot sample as the significance test needs it: its estimate and, per candidate pair,
+    /// the change of its re-weighted estimate and its Bernoulli variance plus diagonal correction.
     struct SampleRecord {
         double estimate = 0.0;
-        PerCandidate nee_delta{}, nee_bernoulli{}, segment_delta{}, segment_bernoulli{};
+        PerPair delta{}, bernoulli{};
     };
     /// Samples of one pixel per group (a pixel with more forms several groups: the test's z only).
     static constexpr int kGroupSize = 32;
@@ -360,22 +457,19 @@ private:
         if (n < 2) return;
         PerPair mean{};
         for (int i = 0; i < n; ++i)
-            for (int jn = 0; jn < kCandidates; ++jn)
-                for (int js = 0; js < kCandidates; ++js)
-                    mean[pair(jn, js)] += value(group_[std::size_t(i)], jn, js);
+            for (std::size_t k = 0; k < kPairs; ++k) mean[k] += value(group_[std::size_t(i)], k);
         for (double& m : mean) m /= double(n);
-        const double k = double(n) / double(n - 1);
+        const double c = double(n) / double(n - 1);
         // Sums within the group, then folded in about the group's own means: the standard error
         // is that of the tile's pixels as they are (their spread within), not of a random draw
         // of pixels (their differences between them are no noise of the prediction).
         PerPair z{}, sum{}, sum2{}, at_1{}, nee_at_1{}, segment_at_1{};
         for (int i = 0; i < n; ++i) {
             const SampleRecord& r = group_[std::size_t(i)];
-            for (int jn = 0; jn < kCandidates; ++jn)
-                for (int js = 0; js < kCandidates; ++js) {
-                    const double d = value(r, jn, js) - mean[pair(jn, js)];
-                    z[pair(jn, js)] = k * d * d + r.nee_bernoulli[std::size_t(jn)] + r.segment_bernoulli[std::size_t(js)];
-                }
+            for (std::size_t k = 0; k < kPairs; ++k) {
+                const double d = value(r, k) - mean[k];
+                z[k] = c * d * d + r.bernoulli[k];
+            }
             for (int jn = 0; jn < kCandidates; ++jn)
                 for (int js = 0; js < kCandidates; ++js) {
                     const std::size_t p = pair(jn, js);
@@ -399,9 +493,7 @@ private:
         z_n_ += std::uint64_t(n);
         z_dof_ += std::uint64_t(n - 1);
     }
-    static double value(const SampleRecord& r, int jn, int js) noexcept {
-        return r.estimate + r.nee_delta[std::size_t(jn)] + r.segment_delta[std::size_t(js)];
-    }
+    static double value(const SampleRecord& r, std::size_t k) noexcept { return r.estimate + r.delta[k]; }
 
     /// Whether pair (jn, js) has a smaller predicted variance x cost than pair (rn, rs) by more
     /// than kSignificance standard errors: over the pilot's samples, the mean and spread of
@@ -417,11 +509,16 @@ private:
         return mean + kSignificance * se < 0.0;
     }
 
+    /// Which count a path estimator's contribution depends on: NEE's (the first of a pair) or the
+    /// segment technique's (the second).
+    enum class Axis : std::uint8_t { Nee, Second };
+
     /// A contribution x = u / (h + c n + o) under the balance heuristic whichever of the three
     /// techniques drew it (h: count 1; n: the counted one, at count c; o: a fixed count), the
     /// counted technique's where it runs (its weight c n / D over its count c): B x with B a
     /// Bernoulli draw of mean c, whose expectation c x and variance c (1 - c) x^2 go to A and B.
-    void add_contribution(Counted& t, float f_over_ref, float p_fixed, float p_counted, float p_other, float count,
+    /// It depends on one axis's count: every pair with that candidate gets the same terms.
+    void add_contribution(Axis axis, float f_over_ref, float p_fixed, float p_counted, float p_other, float count,
                           bool drawn_by_counted) noexcept {
         if (count != 1.f) invalid_ = true;
         if (!(p_fixed >= 0.f && p_counted >= 0.f && p_other >= 0.f) || !std::isfinite(f_over_ref) || f_over_ref == 0.f)
@@ -439,26 +536,32 @@ private:
             // any technique's draw estimates too, with far less noise where the drawing technique
             // is the rare one; the difference goes into `diagonal` (expectation 0).
             const double own = drawn_by_counted ? c * x * x : x * x;
-            t.path_diagonal[std::size_t(j)] += (d > 0.0 ? u * u / (d1 * d) : 0.0) - own;
-            if (drawn_by_counted) {
-                t.path_delta[std::size_t(j)] += c * x - v1;
-                t.path_bernoulli[std::size_t(j)] += c * (1.0 - c) * x * x;
-            } else {
-                t.path_delta[std::size_t(j)] += x - v1;
+            const double diagonal = (d > 0.0 ? u * u / (d1 * d) : 0.0) - own;
+            const double delta = drawn_by_counted ? c * x - v1 : x - v1;
+            const double bernoulli = drawn_by_counted ? c * (1.0 - c) * x * x : 0.0;
+            for (int i = 0; i < kCandidates; ++i) {
+                const std::size_t k = axis == Axis::Nee ? pair(j, i) : pair(i, j);
+                path_diagonal_[k] += diagonal;
+                path_delta_[k] += delta;
+                path_bernoulli_[k] += bernoulli;
             }
         }
     }
 
     std::uint64_t lookups_ = 0, steps_ = 0, samples_ = 0, variance_samples_ = 0, z_n_ = 0, z_dof_ = 0;
-    double fixed_work_ = 0.0;
+    double fixed_work_ = 0.0, nee_work_ = 0.0, second_work_ = 0.0;
     int pixel_n_ = 0;
     bool invalid_ = false;
-    Counted nee_, segment_;
+    Second second_ = Second::None;
+    // The current sample, per pair: the change of its estimate from count 1, its Bernoulli
+    // variance (and splats' second moments), its diagonal correction, its light subpath's
+    // contributions to its own pixel.
+    PerPair path_delta_{}, path_bernoulli_{}, path_diagonal_{}, light_sum_{};
     PerPair shift_{}, pixel_sum_{}, pixel_sum2_{};  // the current pixel
-    PerPair variance_sum_{};                        // the tile
+    PerPair variance_sum_{}, bernoulli_{};          // the tile
     // Over the pilot's samples (in groups of two or more), of z at each pair: its sum, and about
     // each group's mean its sum of squares and its products with z at counts 1 (both), with z at
-    // the pair's segment count and NEE count 1, and at its NEE count and segment count 1; the
+    // the pair's second count and NEE count 1, and at its NEE count and second count 1; the
     // samples and the degrees of freedom (samples less groups).
     PerPair z_{}, z2_{}, z_at_1_{}, z_nee_at_1_{}, z_segment_at_1_{};
     std::array<SampleRecord, std::size_t(kGroupSize)> group_{};  // the current pixel's samples
@@ -466,5 +569,6 @@ private:
 };
 
 static_assert(MisRecorder<NeeCountLearner>);
+static_assert(BdptRecorder<NeeCountLearner>);
 
 }  // namespace nsp

@@ -69,6 +69,34 @@ inline Sc nested_media() {
               materials(), Ls(LightSelection::Uniform, 3.f, {lamp}, {}), -1);
 }
 
+/// The scattering cube (albedo 0.8, HG 0.6, behind null interfaces) over a Lambertian floor,
+/// under a quad lamp (`lamp_size` on a side, its power that of 1.2 at radiance 12) and (when
+/// `sky`) a dim sky; the camera in front of it.
+inline Sc cube_over_floor(bool sky, float lamp_size = 1.2f) {
+    Shapes shapes;
+    shapes.boxes.push_back({Vec3(-1.f), Vec3(1.f), {-1, -1, 0, -1}});
+    shapes.quads.push_back({Vec3(-3.f, -1.05f, 3.f), Vec3(6.f, 0.f, 0.f), Vec3(0.f, 0.f, -6.f), {0, -1, -1, -1}});
+    const float l = lamp_size;
+    const QuadLight<S> lamp{Vec3(-0.5f * l, 2.6f, -0.5f * l), Vec3(l, 0.f, 0.f), Vec3(0.f, 0.f, l),
+                            Spectrum::Constant(12.f * (1.2f / l) * (1.2f / l))};
+    shapes.quads.push_back({lamp.corner, lamp.edge_u, lamp.edge_v, {-1, 0, -1, -1}});
+    std::vector<EnvironmentLight<S>> env;
+    if (sky) env.push_back(EnvironmentLight<S>{Spectrum::Constant(0.05f)});
+    return Sc(shapes, {medium(Box{Vec3(-1.f), Vec3(1.f)}, 0.3f, 1.2f, 0.6f)}, materials(0.6f),
+              Ls(LightSelection::Power, 4.f, {lamp}, env), -1);
+}
+
+inline Ray cube_camera(Pcg32& rng) {
+    const float u = rng.uniform(), v = rng.uniform();
+    return Ray{Vec3(0.f, 0.3f, -4.5f), glm::normalize(Vec3(0.7f * (2.f * u - 1.f), 0.7f * (1.f - 2.f * v), 1.f))};
+}
+
+/// The cube's camera as a PinholeCamera: cube_camera(u, v) is its ray(u, 1 - v).
+inline PinholeCamera cube_pinhole() {
+    return PinholeCamera(Vec3(0.f, 0.3f, -4.5f), Vec3(0.f, 0.3f, 0.f), Vec3(0.f, 1.f, 0.f),
+                         2.f * std::atan(0.7f) * 180.f / kPi, 1.f);
+}
+
 /// The statistics of n estimates of `est` over a SurfaceScene along rays from make_ray(rng) (Mono:
 /// channel 0), every one of status Ok; one Pcg32 (seed, stream).
 template <class E, class Scene, class Make>

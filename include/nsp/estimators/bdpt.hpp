@@ -32,6 +32,10 @@
 // and for DirectionalLight, paths to them are weighted among s = 0 and s = 1 alone. Russian roulette divides the subpaths'
 // throughputs as in PathEstimator, but the weights leave it out (the same for every strategy, so
 // they still sum to 1; the survival probability of a subpath read backwards is not defined).
+// Expected counts (THEORY 5.9): NEE toward the lights runs at a camera vertex with probability
+// EstimatorOptions::nee_count and a light subpath on a sample with light_subpath_probability,
+// each folded into its strategies' densities in every weight; with a NeeCountLearner as the
+// counter every strategy's contribution is recorded, so both can be learned from a pilot.
 #pragma once
 
 #include <algorithm>
@@ -376,7 +380,9 @@ private:
 
     static EstimatorOptions checked(EstimatorOptions o) {
         validate(o);
-        require_unit_counts(o, "nsp::BdptEstimator");
+        if (o.emission_segment_count != 1.f)
+            detail::fail("EstimatorOptions emission_segment_count = ", o.emission_segment_count,
+                         " is not allowed for nsp::BdptEstimator: it has no segment technique (count 1)");
         if (o.max_depth > MaxDepth)
             detail::fail("BdptEstimator max_depth = ", o.max_depth, " is not allowed: it must be <= ", MaxDepth,
                          " (the estimator's MaxDepth template argument, the size of its vertex arrays)");
@@ -569,8 +575,33 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::trace(
     const float q_volume_share = has_volume ? (sc.lights.has_emitters() ? 0.5f : 1.f) : 0.f;
     const float q_volume = light_probability_ * q_volume_share;
     const float q_lights = light_probability_ * (1.f - q_volume_share);
-    auto add = [&](int s, int t, const Spectrum& f, const Pdfs& p, const Vec3& x0, bool x0_at_infinity = false) {
+    const float nee_count = kernels_.options().nee_count;
+    // A BdptRecorder (NeeCountLearner) sees every strategy's contribution with the path's pdfs
+    // summed by count group: s = 0 (and NEE toward the volume, `volume_x0`) at count 1, NEE toward
+    // a light at nee_count, s >= 2 and t = 1 at the light subpath probability (THEORY 5.9).
+    auto record = [&](int s, const Spectrum& f, const Pdfs& p, bool volume_x0, bool splatted) {
+        if constexpr (BdptRecorder<C>) {
+            double q[kMaxPath + 1];
+            if (!strategy_pdfs(p, q)) return;
+            const int n = strategy_count(p);
+            double p_fixed = q[0], p_nee = 0.0, p_light = 0.0;
+            if (n > 1) (volume_x0 ? p_fixed : p_nee) += q[1];
+            for (int r = 2; r < n; ++r) p_light += q[r];
+            const BdptTechnique group = s == 0 ? BdptTechnique::Fixed
+                                        : s == 1 ? (volume_x0 ? BdptTechnique::Fixed : BdptTechnique::Nee)
+                                                 : BdptTechnique::Light;
+            detail::record_bdpt(counter, float(double(f.mean()) * q[s]), float(p_fixed),
+                                float(p_nee / double(nee_count)), float(p_light / double(light_probability_)),
+                                nee_count, light_probability_, group,
+                                splatted);
+        } else {
+            (void)s, (void)f, (void)p, (void)volume_x0, (void)splatted;
+        }
+    };
+    auto add = [&](int s, int t, const Spectrum& f, const Pdfs& p, const Vec3& x0, bool x0_at_infinity = false,
+                   bool volume_x0 = false) {
         const float w = strategy_weight(kernels_.heuristic(), p, s);
+        record(s, f, p, volume_x0, false);
         observe(s, t, f, w, p,
                 PathVertices<typename Sc::Spectral>{light, s, camera, s == 0 ? t - 1 : t, x0, x0_at_infinity});
         L += f * w;
@@ -624,13 +655,13 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::trace(
                 const float cos0 = std::abs(glm::dot(hit.ng, w));
                 pdfs.from_camera[0] = z.delta ? 1.f * cos0 / d2 * nulls : pdf_dir_z * cos0 / d2 * nulls;
                 pdfs.emit = q_lights * e.pdf_pos;
-                pdfs.nee = sc.lights.pdf(light_index, z.p, w) * cos0 / d2;
+                pdfs.nee = nee_count * sc.lights.pdf(light_index, z.p, w) * cos0 / d2;
                 pdfs.from_light[1] = to_vertex_measure(e.pdf_dir, hit.p, z) * nulls * z.event;
             } else {  // x_0 is the direction w; light subpaths (if any) reach z along -w
                 const EmissionDensity e = sc.lights.emission_pdf(light_index, z.p, -w);
                 pdfs.from_camera[0] = (z.delta ? 1.f : pdf_dir_z) * nulls;
                 pdfs.emit = q_lights * e.pdf_pos;
-                pdfs.nee = sc.lights.pdf(light_index, z.p, w);
+                pdfs.nee = nee_count * sc.lights.pdf(light_index, z.p, w);
                 pdfs.from_light[1] = from_infinity_measure(e.pdf_dir, -w, z) * nulls * z.event;
             }
             // z's own density from the light side: from x_1 toward x_2, arriving along -w.
@@ -666,7 +697,7 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::trace(
                 pdfs.k = 1;
                 pdfs.from_camera[0] = 1.f;
                 pdfs.nee = pdfs.emit = 0.f;
-                add(0, 2, f, pdfs, y);
+                add(0, 2, f, pdfs, y, false, true);
                 return;
             }
             const V& z = path[count - 1];  // x_1
@@ -683,7 +714,7 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::trace(
                 const float pd = z.delta ? 1.f : eval_at(z, -(d / std::sqrt(d2)), -z.wo).pdf;
                 pdfs.from_light[2] = to_vertex_measure(pd, z.p, z2) * z.nulls_in * z2.event;
             }
-            add(0, t, f, pdfs, y);
+            add(0, t, f, pdfs, y, false, true);
         } else {
             (void)path, (void)count, (void)medium, (void)y, (void)c, (void)mu_bar, (void)beta, (void)nulls, (void)pdf_dir;
         }
@@ -707,9 +738,11 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::trace(
 
     // The light subpath: from a light, or from the emitting volume.
     int nl = 0;
-    float nee_y0 = 0.f;  // NEE's density of y_0 from y_1
+    float nee_y0 = 0.f;         // NEE's density of y_0 from y_1 (with its count at a light)
+    bool volume_start = true;  // y_0 lies in the emitting volume (else on a light)
     const int light_vertices = kLightTracing ? depth + 1 : depth;
-    const bool traced = light_probability_ >= 1.f || rng.uniform() < light_probability_;
+    const bool traced = draw_technique(light_probability_, rng);
+    const double light_work_before = detail::recorder_work(counter);
     if (traced && depth >= (kLightTracing ? 1 : 2)) {
         const float uq = q_volume_share > 0.f && q_volume_share < 1.f ? rng.uniform() : 0.f;
         if (q_volume_share > 0.f && uq < q_volume_share) {
@@ -750,6 +783,7 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::trace(
         } else {
             const float u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform(), u3 = rng.uniform(),
                         u4 = rng.uniform();
+            volume_start = false;
             const EmittedLight<typename Sc::Spectral> e = sc.lights.sample_emission(u0, u1, u2, u3, u4, lambda);
             if (e.emission.pdf_pos > 0.f && e.emission.pdf_dir > 0.f && (e.emission.radiance != 0.f).any()) {
                 V& y0 = light[0] = V{};
@@ -770,23 +804,28 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::trace(
                 if (nl >= 2) {
                     const Vec3 d = y0.p - light[1].p;
                     const float d2 = glm::dot(d, d);
-                    nee_y0 = y0.at_infinity      ? sc.lights.pdf(y0.light, light[1].p, -e.emission.w)  // solid angle
-                             : y0.delta_position ? sc.lights.selection_pdf(y0.light)
-                                                 : sc.lights.pdf(y0.light, light[1].p, d / std::sqrt(d2)) *
-                                                       std::abs(glm::dot(y0.ng, d)) / (d2 * std::sqrt(d2));
+                    nee_y0 = nee_count *
+                             (y0.at_infinity      ? sc.lights.pdf(y0.light, light[1].p, -e.emission.w)  // solid angle
+                              : y0.delta_position ? sc.lights.selection_pdf(y0.light)
+                                                  : sc.lights.pdf(y0.light, light[1].p, d / std::sqrt(d2)) *
+                                                        std::abs(glm::dot(y0.ng, d)) / (d2 * std::sqrt(d2)));
                 }
             }
         }
     }
+    if (traced) detail::record_light_walk(counter, light_work_before);
 
-    // Transmittance of the segment a -> b through the scene, with its nulls' P_n product.
+    // Transmittance of a connection a -> b through the scene, with its nulls' P_n product (its
+    // work the light subpath's).
     auto transmit = [&](const V& a, const V& b, float& nulls) -> Spectrum {
         const Vec3 d = b.p - a.p;
         const float dist = glm::length(d);
         if (!(dist > 0.f)) return Spectrum::Zero();
         const Vec3 w = d / dist;
+        const double before = detail::recorder_work(counter);
         const auto sh = detail::shadow_through(kernels_, sc, Ray{a.p, w}, detail::shadow_distance(dist),
                                                a.medium_toward(w), lambda, rng, counter);
+        detail::record_light_walk(counter, before);
         if (sh.status != Status::Ok) {
             status = sh.status;
             return Spectrum::Zero();
@@ -798,8 +837,10 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::trace(
     for (int t = 2; t <= std::min(nc, depth + 1); ++t) {
         const V& z = camera[t - 1];
         if (z.delta) continue;
-        // s = 1: next-event estimation from z.
-        {
+        // s = 1: next-event estimation from z toward the lights, drawn with the NEE count
+        // (THEORY 5.9: its estimate divides by it, every path's NEE density carries it).
+        if (draw_technique(nee_count, rng)) {
+            const double before = detail::recorder_work(counter);
             const float u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
             const SampledLight<typename Sc::Spectral> ls = sc.lights.sample(z.p, u0, u1, u2, lambda);
             if (ls.sample.pdf > 0.f) {
@@ -814,15 +855,17 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::trace(
                     const auto sh = detail::shadow_through(kernels_, sc, Ray{z.p, w},
                                                            detail::shadow_distance(ls.sample.distance),
                                                            z.medium_toward(w), lambda, rng, counter);
+                    detail::record_shadow_walk(counter, before, true);
                     if (sh.status != Status::Ok) status = sh.status;
                     if (sh.status == Status::Ok && (sh.transmittance != 0.f).any()) {
                         const float nulls = Mis::null_pdfs ? sh.null_pdf_product : 1.f;
-                        const Spectrum f = z.beta * fz.value * sh.transmittance * ls.sample.radiance / ls.sample.pdf;
+                        const Spectrum f = z.beta * fz.value * sh.transmittance * ls.sample.radiance /
+                                           (nee_count * ls.sample.pdf);
                         gather(0, t, t);  // camera[0..t-1]; the light point is x_0
                         const float d2 = ls.sample.distance * ls.sample.distance;
                         if (ls.sample.delta) {  // a point or directional light: NEE alone reaches it
                             pdfs.from_camera[0] = 0.f;
-                            pdfs.nee = ls.sample.pdf;
+                            pdfs.nee = nee_count * ls.sample.pdf;
                             pdfs.emit = at_infinity ? 0.f : q_lights * sc.lights.emission_pdf(ls.light, y0.p, -w).pdf_pos;
                             pdfs.from_light[1] = at_infinity ? 0.f
                                                              : to_vertex_measure(sc.lights.emission_pdf(ls.light, y0.p, -w).pdf_dir,
@@ -830,13 +873,13 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::trace(
                         } else if (at_infinity) {
                             const EmissionDensity e = sc.lights.emission_pdf(ls.light, z.p, -w);
                             pdfs.from_camera[0] = fz.pdf * nulls;
-                            pdfs.nee = ls.sample.pdf;
+                            pdfs.nee = nee_count * ls.sample.pdf;
                             pdfs.emit = q_lights * e.pdf_pos;
                             pdfs.from_light[1] = from_infinity_measure(e.pdf_dir, -w, z) * nulls * z.event;
                         } else {
                             const EmissionDensity e = sc.lights.emission_pdf(ls.light, y0.p, -w);
                             pdfs.from_camera[0] = fz.pdf * e.cos / d2 * nulls;
-                            pdfs.nee = ls.sample.pdf * e.cos / d2;
+                            pdfs.nee = nee_count * ls.sample.pdf * e.cos / d2;
                             pdfs.emit = q_lights * e.pdf_pos;
                             pdfs.from_light[1] = to_vertex_measure(e.pdf_dir, y0.p, z) * nulls * z.event;
                         }
@@ -881,7 +924,7 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::trace(
                                     pdfs.from_light[2] = to_vertex_measure(eval_at(z, -e->wi, -z.wo).pdf, z.p, z2) *
                                                          z.nulls_in * z2.event;
                                 }
-                                add(1, t, f, pdfs, e->y.p);
+                                add(1, t, f, pdfs, e->y.p, false, true);
                             }
                         }
                     }
@@ -918,7 +961,7 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::trace(
                 const V& y2 = light[s - 2];
                 pdfs.from_camera[s - 2] = to_vertex_measure(eval_at(y, -w, -y.wo).pdf, y.p, y2) * y.nulls_in * y2.event;
             }
-            add(s, t, f, pdfs, light[0].p, light[0].at_infinity);
+            add(s, t, f, pdfs, light[0].p, light[0].at_infinity, volume_start);
         }
     }
     // t = 1: light vertex s-1 seen by the camera, splatted where it appears on the image.
@@ -949,6 +992,7 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::trace(
             const V& y2 = light[s - 2];
             pdfs.from_camera[s - 2] = to_vertex_measure(eval_at(y, -w, -y.wo).pdf, y.p, y2) * y.nulls_in * y2.event;
             const float wt = strategy_weight(kernels_.heuristic(), pdfs, s);
+            record(s, f, pdfs, volume_start, true);
             observe(s, 1, f, wt, pdfs,
                     PathVertices<typename Sc::Spectral>{light, s, camera, 1, light[0].p, light[0].at_infinity});
             const Spectrum value = f * wt;

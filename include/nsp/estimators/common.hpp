@@ -105,7 +105,8 @@ struct EstimatorOptions {
     /// it trades variance for the shadow rays' cost where tracking finds the light well (a large
     /// light, an environment); NeeCountLearner chooses it per pixel tile. nsp::PathEstimator and
     /// nsp::SpectralPathEstimator (every strategy that samples lights, NEE from equiangular
-    /// vertices excepted: they exist for it); nsp::BdptEstimator rejects a value other than 1.
+    /// vertices excepted: they exist for it); nsp::BdptEstimator (s = 1 toward the lights at each
+    /// camera vertex; NEE toward an emitting volume keeps count 1).
     float nee_count = 1.f;
 };
 
@@ -268,18 +269,6 @@ inline void validate(const EstimatorOptions& opts) {
                      " is not allowed: it must lie in (0, 1]");
     validate_count("EstimatorOptions nee_count", opts.nee_count);
     validate_count("EstimatorOptions emission_segment_count", opts.emission_segment_count);
-}
-
-/// Throws InvalidArgument unless opts.nee_count and opts.emission_segment_count are 1: for the
-/// estimators that do not take expected counts (`estimator` names it), so that a count is never
-/// silently ignored.
-inline void require_unit_counts(const EstimatorOptions& opts, const char* estimator) {
-    if (opts.nee_count != 1.f)
-        detail::fail("EstimatorOptions nee_count = ", opts.nee_count, " is not allowed for ", estimator,
-                     ": it takes NEE at every vertex (nee_count 1); expected counts are nsp::PathEstimator's");
-    if (opts.emission_segment_count != 1.f)
-        detail::fail("EstimatorOptions emission_segment_count = ", opts.emission_segment_count, " is not allowed for ",
-                     estimator, ": it takes no segment technique count (1); expected counts are nsp::PathEstimator's");
 }
 
 }  // namespace nsp
