@@ -107,17 +107,24 @@ Row render_image(const Sc& scene, const E& estimator, const std::string& name, i
     return row;
 }
 
-/// render_image for an estimator that splats (BdptEstimator::sample with light tracing) through
-/// `camera` (an nsp::Camera): each pixel is the sum of its samples' returns and of the splats it
-/// received, over spp. A pixel's own samples no longer give its variance (its splats come from
-/// other pixels' light subpaths), so the samples are dealt into kBatches batches by index, each
-/// batch an independent image, and a pixel's variance of one sample is the variance of its batch
-/// means times the batch size; the image mean's standard error is that of the batch images' means.
+namespace detail {
+
+/// The core of render_image_splatting and render_image_splatting_learned: `ladder` holds the
+/// estimator at every candidate pair of counts (NEE x light subpath, NeeCountLearner's order), or
+/// one estimator; with `pilot` > 0 the first `pilot` samples of each pixel run ladder[0] (counts
+/// 1) with an nsp::NeeCountLearner as their counter, one per 16x16 tile merged in a fixed order
+/// into kSlots learners and those into one (so the counts do not depend on the thread count), and
+/// the rest of every pixel's samples the image's chosen pair (written to `chosen`). One pair for
+/// the image, not one per tile: a splat's MIS weight takes the counts of the sample that drew its
+/// light subpath, and they must be those of the pixel it lands in. The pilot's samples and their
+/// splats form an unbiased image at counts 1, the rest one at the chosen counts; every sample is
+/// in the statistics.
 template <class Sc, class E, class Cam>
-Row render_image_splatting(const Sc& scene, const E& estimator, const Cam& camera, const std::string& name, int res,
-                           int spp, int threads, std::uint64_t seed) {
+Row render_splatting(const Sc& scene, const std::vector<E>& ladder, const Cam& camera, const std::string& name, int res,
+                     int spp, int threads, std::uint64_t seed, int pilot, nsp::TechniqueCounts* chosen) {
     constexpr int kChannels = Sc::Spectral::channels;
     constexpr int kBatches = 8;
+    constexpr int kC = nsp::NeeCountLearner::kCandidates;
     const std::size_t n_pix = std::size_t(res) * std::size_t(res);
     Row row;
     row.name = name;
@@ -134,40 +141,84 @@ Row render_image_splatting(const Sc& scene, const E& estimator, const Cam& camer
         b.batch.assign(kBatches * n_pix, 0.0);
         b.rgb.assign(3 * n_pix, 0.0);
     }
-    std::atomic<int> next{0};
+    std::vector<nsp::Pcg32> rngs;
+    rngs.reserve(n_pix);
+    for (std::size_t p = 0; p < n_pix; ++p) rngs.emplace_back(seed, p);
+    constexpr int kTile = 16, kSlots = 16;
+    const int tiles_x = (res + kTile - 1) / kTile, n_tiles = tiles_x * tiles_x;
+    std::size_t pair = 0;  // index into ladder
+    if (chosen) *chosen = nsp::TechniqueCounts{};
     const auto start = std::chrono::steady_clock::now();
     auto add = [&](Buffers& out, int batch, std::size_t pixel, const auto& value) {
         out.batch[std::size_t(batch) * n_pix + pixel] += double(value.mean());
         for (int c = 0; c < 3; ++c) out.rgb[3 * pixel + std::size_t(c)] += double(value[kChannels == 3 ? c : 0]);
     };
+    // Samples k0..k1-1 of pixel (x, y) with `estimator` and `counter`, each one's own value to `each`.
+    auto run_samples = [&](Buffers& out, const E& estimator, auto& counter, int x, int y, int k0, int k1, auto&& each) {
+        const std::size_t pixel = std::size_t(y) * std::size_t(res) + std::size_t(x);
+        nsp::Pcg32& rng = rngs[pixel];
+        for (int k = k0; k < k1; ++k) {
+            const int batch = k % kBatches;
+            auto splat = [&](float u, float v, const auto& value) {
+                const int px = std::clamp(int(u * float(res)), 0, res - 1);
+                const int py = std::clamp(int((1.f - v) * float(res)), 0, res - 1);
+                add(out, batch, std::size_t(py) * std::size_t(res) + std::size_t(px), value);
+            };
+            const float u = (float(x) + rng.uniform()) / float(res);
+            const float v = 1.f - (float(y) + rng.uniform()) / float(res);
+            const auto r = estimator.sample(scene, camera, u, v, {}, rng, counter, splat);
+            if (r.status != nsp::Status::Ok) ++out.failed;
+            add(out, batch, pixel, r.value);
+            each(double(r.value.mean()));
+        }
+    };
+    auto run_pool = [&](auto& work) {
+        std::vector<std::thread> pool;
+        for (int t = 0; t < threads; ++t) pool.emplace_back(work, std::ref(buffers[std::size_t(t)]));
+        for (auto& t : pool) t.join();
+    };
+    const int first = std::min(pilot, spp);
+    if (first > 0) {
+        // Slot j learns tiles j, j + kSlots, ... in order; threads take whole slots.
+        std::vector<nsp::NeeCountLearner> slots(static_cast<std::size_t>(kSlots));
+        std::atomic<int> next_slot{0};
+        auto learn = [&](Buffers& out) {
+            const double cpu0 = thread_cpu_seconds();
+            for (int j; (j = next_slot.fetch_add(1)) < kSlots;)
+                for (int t = j; t < n_tiles; t += kSlots) {
+                    nsp::NeeCountLearner learner;
+                    const int x0 = (t % tiles_x) * kTile, y0 = (t / tiles_x) * kTile;
+                    for (int y = y0; y < std::min(res, y0 + kTile); ++y)
+                        for (int x = x0; x < std::min(res, x0 + kTile); ++x) {
+                            run_samples(out, ladder[0], learner, x, y, 0, first,
+                                        [&](double v) { learner.end_sample(v); });
+                            learner.end_pixel();
+                        }
+                    slots[std::size_t(j)].merge(learner);
+                    out.lookups += learner.count();
+                    out.steps += learner.steps();
+                }
+            out.cpu += thread_cpu_seconds() - cpu0;
+        };
+        run_pool(learn);
+        nsp::NeeCountLearner all;
+        for (const nsp::NeeCountLearner& l : slots) all.merge(l);
+        const nsp::TechniqueCounts c = all.choose_counts();
+        if (chosen) *chosen = c;
+        auto index = [](float count) { return std::size_t(std::lround(-std::log2(count))); };
+        if (ladder.size() == std::size_t(kC * kC)) pair = index(c.nee) * std::size_t(kC) + index(c.light_subpath);
+    }
+    std::atomic<int> next{0};
     auto work = [&](Buffers& out) {
         const double cpu0 = thread_cpu_seconds();
         nsp::LookupCount counter;
         for (int y; (y = next.fetch_add(1)) < res;)
-            for (int x = 0; x < res; ++x) {
-                const std::size_t pixel = std::size_t(y) * std::size_t(res) + std::size_t(x);
-                nsp::Pcg32 rng(seed, pixel);
-                for (int k = 0; k < spp; ++k) {
-                    const int batch = k % kBatches;
-                    auto splat = [&](float u, float v, const auto& value) {
-                        const int px = std::clamp(int(u * float(res)), 0, res - 1);
-                        const int py = std::clamp(int((1.f - v) * float(res)), 0, res - 1);
-                        add(out, batch, std::size_t(py) * std::size_t(res) + std::size_t(px), value);
-                    };
-                    const float u = (float(x) + rng.uniform()) / float(res);
-                    const float v = 1.f - (float(y) + rng.uniform()) / float(res);
-                    const auto r = estimator.sample(scene, camera, u, v, {}, rng, counter, splat);
-                    if (r.status != nsp::Status::Ok) ++out.failed;
-                    add(out, batch, pixel, r.value);
-                }
-            }
-        out.lookups = counter.count();
-        out.steps = counter.steps;
-        out.cpu = thread_cpu_seconds() - cpu0;
+            for (int x = 0; x < res; ++x) run_samples(out, ladder[pair], counter, x, y, first, spp, [](double) {});
+        out.lookups += counter.count();
+        out.steps += counter.steps;
+        out.cpu += thread_cpu_seconds() - cpu0;
     };
-    std::vector<std::thread> pool;
-    for (int t = 0; t < threads; ++t) pool.emplace_back(work, std::ref(buffers[std::size_t(t)]));
-    for (auto& t : pool) t.join();
+    run_pool(work);
     row.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     double lookups = 0.0, steps = 0.0;
     for (const Buffers& b : buffers) {
@@ -213,6 +264,35 @@ Row render_image_splatting(const Sc& scene, const E& estimator, const Cam& camer
     }
     row.se = batches > 1 ? std::sqrt(m2 / (batches - 1) / batches) : 0.0;
     return row;
+}
+
+}  // namespace detail
+
+/// render_image for an estimator that splats (BdptEstimator::sample with light tracing) through
+/// `camera` (an nsp::Camera): each pixel is the sum of its samples' returns and of the splats it
+/// received, over spp. A pixel's own samples no longer give its variance (its splats come from
+/// other pixels' light subpaths), so the samples are dealt into kBatches batches by index, each
+/// batch an independent image, and a pixel's variance of one sample is the variance of its batch
+/// means times the batch size; the image mean's standard error is that of the batch images' means.
+template <class Sc, class E, class Cam>
+Row render_image_splatting(const Sc& scene, const E& estimator, const Cam& camera, const std::string& name, int res,
+                           int spp, int threads, std::uint64_t seed) {
+    return detail::render_splatting(scene, std::vector<E>{estimator}, camera, name, res, spp, threads, seed, 0, nullptr);
+}
+
+/// render_image_splatting with BDPT's NEE count and light subpath probability learned for the
+/// image (THEORY 5.9, nsp::NeeCountLearner; see detail::render_splatting): a pilot of `pilot`
+/// samples per pixel at counts 1, the rest at the chosen pair, which goes to `chosen`;
+/// `make(nee_count, light_subpath_probability)` builds the estimator at a pair.
+template <class Sc, class Make, class Cam>
+Row render_image_splatting_learned(const Sc& scene, Make make, const Cam& camera, const std::string& name, int res,
+                                   int spp, int threads, std::uint64_t seed, int pilot, nsp::TechniqueCounts* chosen) {
+    constexpr int kC = nsp::NeeCountLearner::kCandidates;
+    std::vector<decltype(make(1.f, 1.f))> ladder;
+    for (int jn = 0; jn < kC; ++jn)
+        for (int jl = 0; jl < kC; ++jl)
+            ladder.push_back(make(nsp::NeeCountLearner::candidate(jn), nsp::NeeCountLearner::candidate(jl)));
+    return detail::render_splatting(scene, ladder, camera, name, res, spp, threads, seed, pilot, chosen);
 }
 
 }  // namespace nsp_examples

@@ -7,7 +7,8 @@
 // nsp::SpectralPathEstimator's per-channel pdfs, then the glowing plume (the cloud's smoke with a
 // flame in it, an emissive medium; Mono, half the size and spp) with emission and lights in one MIS,
 // then the lantern (the lamp boxed above the cloud, opening into it: the BDPT scene; half the
-// size and spp) with the path tracers against BdptEstimator's directional and null-scattering MIS.
+// size and spp) with the path tracers against BdptEstimator's directional and null-scattering MIS
+// and BDPT with its expected counts learned (_learned: nsp::NeeCountLearner over the image).
 // On request (--tables cloud) the main job's cloud in empty space, set-ups A and B, as a
 // SurfaceScene (its sphere light a shape the geometry reports), path tracers against BDPT.
 //
@@ -127,6 +128,33 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "  room: %-44s %6.2f s\n", name, rows.back().seconds);
     };
 
+    std::vector<std::string> learned_notes;  // printed under the table they belong to
+    auto print_notes = [&] {
+        for (const std::string& n : learned_notes) std::printf("%s\n", n.c_str());
+        learned_notes.clear();
+    };
+    // BDPT (null-scattering MIS, balance, light tracing) with its NEE count and light subpath
+    // probability learned for the image from a pilot of spp / 32 samples per pixel (2-16) at
+    // counts 1 (THEORY 5.9, nsp::NeeCountLearner); the choice printed under the table.
+    auto learned_render = [&](const auto& scene, const nsp::PinholeCamera& camera) {
+        const char* name = "bdpt_null-mis_balance_learned";
+        nsp::TechniqueCounts chosen;
+        auto make = [](float nee, float light) {
+            nsp::EstimatorOptions o = BdptEstimator<>::default_options();
+            o.nee_count = nee;
+            return BdptEstimator<bdpt::NullScattering, mis::Balance>(o, {}, light);
+        };
+        const int pilot = std::min(run_spp, std::clamp(run_spp / 32, 2, 16));
+        rows.push_back(nsp_examples::render_image_splatting_learned(scene, make, camera, name, run_res, run_spp, threads,
+                                                                    seed++, pilot, &chosen));
+        std::fprintf(stderr, "  room: %-44s %6.2f s\n", name, rows.back().seconds);
+        char text[256];
+        std::snprintf(text, sizeof text,
+                      "learned counts (%s, a %d-spp pilot at counts 1 over the image): NEE %g, light subpaths %g", name,
+                      pilot, double(chosen.nee), double(chosen.light_subpath));
+        learned_notes.emplace_back(text);
+    };
+
     std::uint64_t failed = 0;
     // Table 1: the grey cloud, Mono, one global majorant, every grey strategy.
     const auto grey = nsp_examples::make_room_scene();
@@ -215,6 +243,7 @@ int main(int argc, char** argv) {
         run_splatting(lantern, BdptEstimator<bdpt::NullScattering, mis::Power>{}, "bdpt_null-mis_power");
         run(lantern, BdptEstimator<bdpt::Directional, mis::Balance>{}, "bdpt_directional-mis_balance_no-t1");
         run(lantern, BdptEstimator<bdpt::NullScattering, mis::Balance>{}, "bdpt_null-mis_balance_no-t1");
+        learned_render(lantern, nsp_examples::room_pinhole());
         std::vector<Row> lantern_rows(rows.begin() + std::ptrdiff_t(first_lantern), rows.end());
         failed += print_table("Lantern (mono", lantern_rows, 4, run_res, run_spp, threads,
                         "the cloud over a floor, lit only by a lamp in a box that opens downward into it");
@@ -222,6 +251,9 @@ int main(int argc, char** argv) {
                     "tracing: %.3g); / best path tracer: %.3g\n",
                     cost(lantern_rows, 4) / cost(lantern_rows, 3), cost(lantern_rows, 7) / cost(lantern_rows, 6),
                     cost(lantern_rows, 4) / std::min({cost(lantern_rows, 0), cost(lantern_rows, 1), cost(lantern_rows, 2)}));
+        std::printf("lantern: bdpt_null-mis_balance_learned / bdpt_null-mis_balance in cpu-s*var: %.3g\n",
+                    cost(lantern_rows, 8) / cost(lantern_rows, 4));
+        print_notes();
     }
 
     // Table "sky" (--tables sky only): the grey room, BDPT with the sky reached by hits and NEE
@@ -266,6 +298,7 @@ int main(int argc, char** argv) {
             cloud_render(BdptEstimator<bdpt::NullScattering, mis::Balance>{}, "bdpt_null-mis_balance");
             cloud_render(BdptEstimator<bdpt::NullScattering, mis::Balance>(BdptEstimator<>::default_options(), {}, 0.25f),
                          "bdpt_null-mis_balance_light-0.25");  // a light subpath on 1/4 of the samples
+            learned_render(cloud, nsp_examples::cloud_pinhole());
             std::vector<Row> setup_rows(rows.begin() + std::ptrdiff_t(first_setup), rows.end());
             const bool a = setup == nsp_examples::LightSetup::A;
             failed += print_table(a ? "Cloud, set-up A (mono" : "Cloud, set-up B (mono", setup_rows, 2, run_res, run_spp,
@@ -278,6 +311,10 @@ int main(int argc, char** argv) {
                         cost(setup_rows, 4) / std::min({setup_rows[0].variance > 0.0 ? cost(setup_rows, 0) : nsp::kInf,
                                                         cost(setup_rows, 1), cost(setup_rows, 2)}),
                         cost(setup_rows, 4) / cost(setup_rows, 3));
+            std::printf("cloud %s: bdpt_null-mis_balance_learned / best path tracer in cpu-s*var: %.3g\n", a ? "A" : "B",
+                        cost(setup_rows, 6) / std::min({setup_rows[0].variance > 0.0 ? cost(setup_rows, 0) : nsp::kInf,
+                                                        cost(setup_rows, 1), cost(setup_rows, 2)}));
+            print_notes();
         }
     }
 
