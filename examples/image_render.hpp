@@ -36,55 +36,103 @@ struct Row {
     nsp_examples::Image image;
 };
 
-/// Renders `scene` with `estimator` at res x res through `camera(u, v)` ((u, v) in [0, 1)^2, v up),
-/// spp samples per pixel, one Pcg32 stream per pixel (seeded by `seed`), rows shared among
-/// `threads` workers. The per-pixel statistics are of the channel mean of each sample (Mono: its value).
+namespace detail {
+
+/// The core of render_image and render_image_learned: `ladder` holds the estimator at every
+/// candidate pair of counts (NEE x emission segment technique, NeeCountLearner's order), or one
+/// estimator; with `pilot` > 0 the first `pilot` samples of each pixel run ladder[0] (counts 1)
+/// with an nsp::NeeCountLearner per 16x16 tile as their counter (tiles handed to threads, so the
+/// counts do not depend on the thread count), the rest the tile's chosen pair (written to
+/// `chosen`, a tile per entry, row-major); every sample is in the statistics. Per-tile counts are
+/// sound here: every strategy of radiance() adds to its own sample's pixel alone.
 template <class Sc, class E, class Camera>
-Row render_image(const Sc& scene, const E& estimator, const std::string& name, int res, int spp, int threads,
-                 std::uint64_t seed, const Camera& camera) {
+Row render_pixels(const Sc& scene, const std::vector<E>& ladder, const std::string& name, int res, int spp, int threads,
+                  std::uint64_t seed, const Camera& camera, int pilot, std::vector<nsp::TechniqueCounts>* chosen) {
     constexpr int kChannels = Sc::Spectral::channels;
+    constexpr int kC = nsp::NeeCountLearner::kCandidates, kTile = 16;
+    const std::size_t n_pix = std::size_t(res) * std::size_t(res);
     Row row;
     row.name = name;
     row.image.width = row.image.height = res;
-    row.image.rgb.assign(std::size_t(res) * std::size_t(res) * 3u, 0.f);
-    std::vector<double> pixel_var(std::size_t(res) * std::size_t(res), 0.0), pixel_mean(pixel_var.size(), 0.0);
-    std::atomic<int> next{0};
+    row.image.rgb.assign(n_pix * 3u, 0.f);
+    struct Pixel {
+        nsp::Pcg32 rng;
+        int k = 0;
+        double mean = 0.0, m2 = 0.0;
+        std::array<double, 3> rgb{};
+    };
+    std::vector<Pixel> pixels;
+    pixels.reserve(n_pix);
+    for (std::size_t p = 0; p < n_pix; ++p) pixels.push_back(Pixel{nsp::Pcg32(seed, p)});
     struct Totals {
         std::uint64_t lookups = 0, steps = 0, failed = 0;
         double cpu = 0.0;
     };
     std::vector<Totals> totals(static_cast<std::size_t>(threads));
+    const int tiles_x = (res + kTile - 1) / kTile, n_tiles = tiles_x * tiles_x;
+    std::vector<std::size_t> tile_pair(std::size_t(n_tiles), 0);  // index into ladder
+    if (chosen) chosen->assign(std::size_t(n_tiles), nsp::TechniqueCounts{});
+    // Samples of pixel (x, y) up to the k1-th with `estimator` and `counter`, each one's value to `each`.
+    auto run_samples = [&](Totals& out, const E& estimator, auto& counter, int x, int y, int k1, auto&& each) {
+        Pixel& px = pixels[std::size_t(y) * std::size_t(res) + std::size_t(x)];
+        while (px.k < k1) {
+            const float u = (float(x) + px.rng.uniform()) / float(res);
+            const float v = 1.f - (float(y) + px.rng.uniform()) / float(res);
+            const auto r = estimator.radiance(scene, camera(u, v), {}, px.rng, counter);
+            if (r.status != nsp::Status::Ok) ++out.failed;
+            for (int c = 0; c < 3; ++c) px.rgb[std::size_t(c)] += r.value[kChannels == 3 ? c : 0];
+            const double L = double(r.value.mean()), d = L - px.mean;
+            ++px.k;
+            px.mean += d / px.k;
+            px.m2 += d * (L - px.mean);
+            each(L);
+        }
+    };
+    auto run_pool = [&](auto& work) {
+        std::vector<std::thread> pool;
+        for (int t = 0; t < threads; ++t) pool.emplace_back(work, std::ref(totals[std::size_t(t)]));
+        for (auto& t : pool) t.join();
+    };
     const auto start = std::chrono::steady_clock::now();
+    const int first = std::min(pilot, spp);
+    if (first > 0) {
+        std::atomic<int> next_tile{0};
+        auto learn = [&](Totals& out) {
+            const double cpu0 = thread_cpu_seconds();
+            for (int t; (t = next_tile.fetch_add(1)) < n_tiles;) {
+                nsp::NeeCountLearner learner;
+                const int x0 = (t % tiles_x) * kTile, y0 = (t / tiles_x) * kTile;
+                for (int y = y0; y < std::min(res, y0 + kTile); ++y)
+                    for (int x = x0; x < std::min(res, x0 + kTile); ++x) {
+                        run_samples(out, ladder[0], learner, x, y, first, [&](double v) { learner.end_sample(v); });
+                        learner.end_pixel();
+                    }
+                const nsp::TechniqueCounts c = learner.choose_counts();
+                if (chosen) (*chosen)[std::size_t(t)] = c;
+                auto index = [](float count) { return std::size_t(std::lround(-std::log2(count))); };
+                if (ladder.size() == std::size_t(kC * kC))
+                    tile_pair[std::size_t(t)] = index(c.nee) * std::size_t(kC) + index(c.emission_segment);
+                out.lookups += learner.count();
+                out.steps += learner.steps();
+            }
+            out.cpu += thread_cpu_seconds() - cpu0;
+        };
+        run_pool(learn);
+    }
+    std::atomic<int> next{0};
     auto work = [&](Totals& out) {
         const double cpu0 = thread_cpu_seconds();
         nsp::LookupCount counter;
         for (int y; (y = next.fetch_add(1)) < res;)
             for (int x = 0; x < res; ++x) {
-                const std::size_t pixel = std::size_t(y) * std::size_t(res) + std::size_t(x);
-                nsp::Pcg32 rng(seed, pixel);
-                double mean = 0.0, m2 = 0.0;
-                std::array<double, 3> rgb{};
-                for (int k = 1; k <= spp; ++k) {
-                    const float u = (float(x) + rng.uniform()) / float(res);
-                    const float v = 1.f - (float(y) + rng.uniform()) / float(res);
-                    const auto r = estimator.radiance(scene, camera(u, v), {}, rng, counter);
-                    if (r.status != nsp::Status::Ok) ++out.failed;
-                    for (int c = 0; c < 3; ++c) rgb[std::size_t(c)] += r.value[kChannels == 3 ? c : 0];
-                    const double L = double(r.value.mean()), d = L - mean;
-                    mean += d / k;
-                    m2 += d * (L - mean);
-                }
-                for (int c = 0; c < 3; ++c) row.image.rgb[3 * pixel + std::size_t(c)] = float(rgb[std::size_t(c)] / spp);
-                pixel_mean[pixel] = mean;
-                pixel_var[pixel] = m2 / (spp - 1);
+                const std::size_t t = std::size_t((y / kTile) * tiles_x + x / kTile);
+                run_samples(out, ladder[tile_pair[t]], counter, x, y, spp, [](double) {});
             }
-        out.lookups = counter.count();
-        out.steps = counter.steps;
-        out.cpu = thread_cpu_seconds() - cpu0;
+        out.lookups += counter.count();
+        out.steps += counter.steps;
+        out.cpu += thread_cpu_seconds() - cpu0;
     };
-    std::vector<std::thread> pool;
-    for (int t = 0; t < threads; ++t) pool.emplace_back(work, std::ref(totals[std::size_t(t)]));
-    for (auto& t : pool) t.join();
+    run_pool(work);
     row.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     double lookups = 0.0, steps = 0.0;
     for (const Totals& t : totals) {
@@ -93,11 +141,13 @@ Row render_image(const Sc& scene, const E& estimator, const std::string& name, i
         row.cpu_seconds += t.cpu;
         row.failed += t.failed;
     }
-    const double n_pixels = double(res) * res, samples = n_pixels * spp;
+    const double n_pixels = double(n_pix), samples = n_pixels * spp;
     double sum_var = 0.0, sum_mean = 0.0;
-    for (std::size_t p = 0; p < pixel_var.size(); ++p) {
-        sum_var += pixel_var[p];
-        sum_mean += pixel_mean[p];
+    for (std::size_t p = 0; p < n_pix; ++p) {
+        const Pixel& px = pixels[p];
+        for (int c = 0; c < 3; ++c) row.image.rgb[3 * p + std::size_t(c)] = float(px.rgb[std::size_t(c)] / spp);
+        sum_var += px.m2 / (spp - 1);
+        sum_mean += px.mean;
     }
     row.lookups = lookups / samples;
     row.steps = steps / samples;
@@ -105,6 +155,32 @@ Row render_image(const Sc& scene, const E& estimator, const std::string& name, i
     row.mean = sum_mean / n_pixels;
     row.se = std::sqrt(row.variance / samples);  // the image mean's standard error (pixels independent)
     return row;
+}
+
+}  // namespace detail
+
+/// Renders `scene` with `estimator` at res x res through `camera(u, v)` ((u, v) in [0, 1)^2, v up),
+/// spp samples per pixel, one Pcg32 stream per pixel (seeded by `seed`), rows shared among
+/// `threads` workers. The per-pixel statistics are of the channel mean of each sample (Mono: its value).
+template <class Sc, class E, class Camera>
+Row render_image(const Sc& scene, const E& estimator, const std::string& name, int res, int spp, int threads,
+                 std::uint64_t seed, const Camera& camera) {
+    return detail::render_pixels(scene, std::vector<E>{estimator}, name, res, spp, threads, seed, camera, 0, nullptr);
+}
+
+/// render_image with the NEE count and the emission segment count learned per 16x16 tile (THEORY
+/// 5.9, nsp::NeeCountLearner; see detail::render_pixels): a pilot of `pilot` samples per pixel at
+/// counts 1, the rest at the tile's pair, the tiles' pairs to `chosen`;
+/// `make(nee_count, emission_segment_count)` builds the estimator at a pair.
+template <class Sc, class Make, class Camera>
+Row render_image_learned(const Sc& scene, Make make, const std::string& name, int res, int spp, int threads,
+                         std::uint64_t seed, const Camera& camera, int pilot, std::vector<nsp::TechniqueCounts>* chosen) {
+    constexpr int kC = nsp::NeeCountLearner::kCandidates;
+    std::vector<decltype(make(1.f, 1.f))> ladder;
+    for (int jn = 0; jn < kC; ++jn)
+        for (int js = 0; js < kC; ++js)
+            ladder.push_back(make(nsp::NeeCountLearner::candidate(jn), nsp::NeeCountLearner::candidate(js)));
+    return detail::render_pixels(scene, ladder, name, res, spp, threads, seed, camera, pilot, chosen);
 }
 
 namespace detail {

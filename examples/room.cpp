@@ -8,7 +8,8 @@
 // flame in it, an emissive medium; Mono, half the size and spp) with emission and lights in one MIS,
 // then the lantern (the lamp boxed above the cloud, opening into it: the BDPT scene; half the
 // size and spp) with the path tracers against BdptEstimator's directional and null-scattering MIS
-// and BDPT with its expected counts learned (_learned: nsp::NeeCountLearner over the image).
+// and BDPT with its expected counts learned (_learned: nsp::NeeCountLearner over the image). The
+// grey room's and the plume's tables end with uni + NEE MIS at counts learned per 16x16 tile.
 // On request (--tables cloud) the main job's cloud in empty space, set-ups A and B, as a
 // SurfaceScene (its sphere light a shape the geometry reports), path tracers against BDPT.
 //
@@ -155,6 +156,35 @@ int main(int argc, char** argv) {
         learned_notes.emplace_back(text);
     };
 
+    // uni + NEE MIS (balance) with its NEE count and emission segment count learned per 16x16 tile
+    // from the same pilot (nsp::NeeCountLearner; per tile: every strategy stays in its pixel).
+    auto learned_path_render = [&](const auto& scene) {
+        const char* name = "uni-nee-mis_balance_learned";
+        std::vector<nsp::TechniqueCounts> chosen;
+        auto make = [](float nee, float segment) {
+            nsp::EstimatorOptions o;
+            o.nee_count = nee;
+            o.emission_segment_count = segment;
+            return PathEstimator<strategy::NullScatteringMis, mis::Balance>(o);
+        };
+        const int pilot = std::min(run_spp, std::clamp(run_spp / 32, 2, 16));
+        rows.push_back(nsp_examples::render_image_learned(
+            scene, make, name, run_res, run_spp, threads, seed++,
+            [](float u, float v) { return nsp_examples::room_camera_ray(u, v, 1.f); }, pilot, &chosen));
+        std::fprintf(stderr, "  room: %-44s %6.2f s\n", name, rows.back().seconds);
+        std::array<int, nsp::NeeCountLearner::kCandidates> nee{}, segment{};
+        for (const nsp::TechniqueCounts& c : chosen) {
+            ++nee[std::size_t(std::lround(-std::log2(c.nee)))];
+            ++segment[std::size_t(std::lround(-std::log2(c.emission_segment)))];
+        }
+        std::string text = "learned counts (" + std::string(name) + ", a " + std::to_string(pilot) +
+                           "-spp pilot at counts 1 per 16x16 tile), tiles at 1, 1/2, .., 1/64: NEE";
+        for (const int n : nee) text += " " + std::to_string(n);
+        text += "; emission segment";
+        for (const int n : segment) text += " " + std::to_string(n);
+        learned_notes.push_back(text);
+    };
+
     std::uint64_t failed = 0;
     // Table 1: the grey cloud, Mono, one global majorant, every grey strategy.
     const auto grey = nsp_examples::make_room_scene();
@@ -168,13 +198,18 @@ int main(int argc, char** argv) {
         run(grey, PathEstimator<strategy::EquiangularNextEvent>{}, "equiangular-nee");  // aimed at the lamp's centre
         run(grey, PathEstimator<strategy::EquiangularMis, mis::Balance>{}, "equiangular-mis_balance");
         run_splatting(grey, BdptEstimator<bdpt::NullScattering, mis::Balance>{}, "bdpt_null-mis_balance");
+        learned_path_render(grey);  // rows[9]; appended, so the rows above keep their seeds
         failed += print_table("Room (mono", rows, 4, res, spp, threads);  // z against uni-nee-mis_balance
+        const double best_single = std::min(cost(rows, 0), cost(rows, 1));
         std::printf("room: uni-nee-mis_balance / best single strategy (%s) in cpu-s*var: %.3g; unidirectional / ratio-nee: %.3g\n",
-                    rows[cost(rows, 0) <= cost(rows, 1) ? 0 : 1].name.c_str(), cost(rows, 4) / std::min(cost(rows, 0), cost(rows, 1)),
+                    rows[cost(rows, 0) <= cost(rows, 1) ? 0 : 1].name.c_str(), cost(rows, 4) / best_single,
                     cost(rows, 0) / cost(rows, 1));
+        std::printf("room: uni-nee-mis_balance_learned / best single strategy in cpu-s*var: %.3g\n", cost(rows, 9) / best_single);
         double best_path = nsp::kInf;
-        for (std::size_t i = 0; i + 1 < rows.size(); ++i) best_path = std::min(best_path, cost(rows, i));
-        std::printf("room: bdpt_null-mis_balance / best path tracer in cpu-s*var: %.3g\n", cost(rows, rows.size() - 1) / best_path);
+        for (std::size_t i = 0; i < rows.size(); ++i)
+            if (i != 8) best_path = std::min(best_path, cost(rows, i));
+        std::printf("room: bdpt_null-mis_balance / best path tracer in cpu-s*var: %.3g\n", cost(rows, 8) / best_path);
+        print_notes();
     }
 
     // Table 2: the chromatic cloud (extinction 5, 20, 80 per unit density), Rgb: the grey-majorant
@@ -218,14 +253,18 @@ int main(int argc, char** argv) {
         run(plume_room, PathEstimator<strategy::NullScatteringMis, mis::Balance>{}, "uni-nee-mis_balance");
         run(plume_room, PathEstimator<strategy::EquiangularMis, mis::Balance>{}, "equiangular-mis_balance");
         run_splatting(plume_room, BdptEstimator<bdpt::NullScattering, mis::Balance>{}, "bdpt_null-mis_balance");
+        learned_path_render(plume_room);  // plume_rows[5]
         std::vector<Row> plume_rows(rows.begin() + std::ptrdiff_t(first_plume), rows.end());
         failed += print_table("Room, glowing plume (mono", plume_rows, 2, run_res, run_spp, threads);
         std::printf("room plume: uni-nee-mis_balance / best single strategy (%s) in cpu-s*var: %.3g\n",
                     plume_rows[cost(plume_rows, 0) <= cost(plume_rows, 1) ? 0 : 1].name.c_str(),
                     cost(plume_rows, 2) / std::min(cost(plume_rows, 0), cost(plume_rows, 1)));
+        std::printf("room plume: uni-nee-mis_balance_learned / best single strategy in cpu-s*var: %.3g\n",
+                    cost(plume_rows, 5) / std::min(cost(plume_rows, 0), cost(plume_rows, 1)));
         std::printf("room plume: bdpt_null-mis_balance / best path tracer in cpu-s*var: %.3g\n",
                     cost(plume_rows, 4) / std::min({cost(plume_rows, 0), cost(plume_rows, 1), cost(plume_rows, 2),
-                                                    cost(plume_rows, 3)}));
+                                                    cost(plume_rows, 3), cost(plume_rows, 5)}));
+        print_notes();
     }
     // Table 4: the lantern (the BDPT scene): the lamp shut in a box that opens into the cloud,
     // the path tracers against bidirectional path tracing with directional and with full
