@@ -38,6 +38,17 @@ struct Row {
 
 namespace detail {
 
+/// make(a, b) at every pair of NeeCountLearner's candidate counts, in its order (a outer).
+template <class Make>
+auto count_ladder(Make make) {
+    constexpr int kC = nsp::NeeCountLearner::kCandidates;
+    std::vector<decltype(make(1.f, 1.f))> ladder;
+    for (int a = 0; a < kC; ++a)
+        for (int b = 0; b < kC; ++b)
+            ladder.push_back(make(nsp::NeeCountLearner::candidate(a), nsp::NeeCountLearner::candidate(b)));
+    return ladder;
+}
+
 /// The core of render_image and render_image_learned: `ladder` holds the estimator at every
 /// candidate pair of counts (NEE x emission segment technique, NeeCountLearner's order), or one
 /// estimator; with `pilot` > 0 the first `pilot` samples of each pixel run ladder[0] (counts 1)
@@ -175,12 +186,7 @@ Row render_image(const Sc& scene, const E& estimator, const std::string& name, i
 template <class Sc, class Make, class Camera>
 Row render_image_learned(const Sc& scene, Make make, const std::string& name, int res, int spp, int threads,
                          std::uint64_t seed, const Camera& camera, int pilot, std::vector<nsp::TechniqueCounts>* chosen) {
-    constexpr int kC = nsp::NeeCountLearner::kCandidates;
-    std::vector<decltype(make(1.f, 1.f))> ladder;
-    for (int jn = 0; jn < kC; ++jn)
-        for (int js = 0; js < kC; ++js)
-            ladder.push_back(make(nsp::NeeCountLearner::candidate(jn), nsp::NeeCountLearner::candidate(js)));
-    return detail::render_pixels(scene, ladder, name, res, spp, threads, seed, camera, pilot, chosen);
+    return detail::render_pixels(scene, detail::count_ladder(make), name, res, spp, threads, seed, camera, pilot, chosen);
 }
 
 namespace detail {
@@ -363,12 +369,8 @@ Row render_image_splatting(const Sc& scene, const E& estimator, const Cam& camer
 template <class Sc, class Make, class Cam>
 Row render_image_splatting_learned(const Sc& scene, Make make, const Cam& camera, const std::string& name, int res,
                                    int spp, int threads, std::uint64_t seed, int pilot, nsp::TechniqueCounts* chosen) {
-    constexpr int kC = nsp::NeeCountLearner::kCandidates;
-    std::vector<decltype(make(1.f, 1.f))> ladder;
-    for (int jn = 0; jn < kC; ++jn)
-        for (int jl = 0; jl < kC; ++jl)
-            ladder.push_back(make(nsp::NeeCountLearner::candidate(jn), nsp::NeeCountLearner::candidate(jl)));
-    return detail::render_splatting(scene, ladder, camera, name, res, spp, threads, seed, pilot, chosen);
+    return detail::render_splatting(scene, detail::count_ladder(make), camera, name, res, spp, threads, seed, pilot,
+                                    chosen);
 }
 
 }  // namespace nsp_examples
