@@ -120,9 +120,9 @@ Row render_pixels(const Sc& scene, const std::vector<E>& ladder, const std::stri
                     }
                 const nsp::TechniqueCounts c = learner.choose_counts();
                 if (chosen) (*chosen)[std::size_t(t)] = c;
-                auto index = [](float count) { return std::size_t(std::lround(-std::log2(count))); };
                 if (ladder.size() == std::size_t(kC * kC))
-                    tile_pair[std::size_t(t)] = index(c.nee) * std::size_t(kC) + index(c.emission_segment);
+                    tile_pair[std::size_t(t)] = std::size_t(nsp::NeeCountLearner::candidate_index(c.nee) * kC +
+                                                            nsp::NeeCountLearner::candidate_index(c.emission_segment));
                 out.lookups += learner.count();
                 out.steps += learner.steps();
             }
@@ -287,8 +287,9 @@ Row render_splatting(const Sc& scene, const std::vector<E>& ladder, const Cam& c
         for (const nsp::NeeCountLearner& l : slots) all.merge(l);
         const nsp::TechniqueCounts c = all.choose_counts();
         if (chosen) *chosen = c;
-        auto index = [](float count) { return std::size_t(std::lround(-std::log2(count))); };
-        if (ladder.size() == std::size_t(kC * kC)) pair = index(c.nee) * std::size_t(kC) + index(c.light_subpath);
+        if (ladder.size() == std::size_t(kC * kC))
+            pair = std::size_t(nsp::NeeCountLearner::candidate_index(c.nee) * kC +
+                               nsp::NeeCountLearner::candidate_index(c.light_subpath));
     }
     std::atomic<int> next{0};
     auto work = [&](Buffers& out) {

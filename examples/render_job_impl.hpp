@@ -283,7 +283,6 @@ RenderStats render(const typename C::Scene& scene, const RenderRequest& rq, std:
                     o.emission_segment_count = nsp::NeeCountLearner::candidate(js);
                     at_count.emplace_back(o);
                 }
-            auto index = [](float count) { return int(std::lround(-std::log2(count))); };
             auto work = [&](ThreadTotals& out) {
                 ThreadTotals t;
                 const double cpu0 = thread_cpu_seconds();
@@ -291,8 +290,9 @@ RenderStats render(const typename C::Scene& scene, const RenderRequest& rq, std:
                     for (int x = 0; x < w; ++x) {
                         const std::size_t pixel = std::size_t(y) * std::size_t(w) + std::size_t(x);
                         const std::size_t tile = std::size_t((y / ts) * tiles_x + x / ts);
-                        const int js = kEmissive ? index(st.segment_counts[tile]) : 0;
-                        const Estimator& est = at_count[std::size_t(index(st.nee_counts[tile]) * kS + js)];
+                        const int js = kEmissive ? nsp::NeeCountLearner::candidate_index(st.segment_counts[tile]) : 0;
+                        const Estimator& est =
+                            at_count[std::size_t(nsp::NeeCountLearner::candidate_index(st.nee_counts[tile]) * kS + js)];
                         PixelState& state = px[pixel];
                         while (state.k < rq.spp) sample(est, t.counter, state, x, y, t);
                         finish_pixel(state, pixel, t);

@@ -37,6 +37,7 @@
 
 #include "image_render.hpp"
 #include "png_writer.hpp"
+#include "render_job.hpp"
 #include "room_scene.hpp"
 
 namespace {
@@ -145,7 +146,7 @@ int main(int argc, char** argv) {
             o.nee_count = nee;
             return BdptEstimator<bdpt::NullScattering, mis::Balance>(o, {}, light);
         };
-        const int pilot = std::min(run_spp, std::clamp(run_spp / 32, 2, 16));
+        const int pilot = nsp_examples::RenderRequest::pilot_spp(run_spp);
         rows.push_back(nsp_examples::render_image_splatting_learned(scene, make, camera, name, run_res, run_spp, threads,
                                                                     seed++, pilot, &chosen));
         std::fprintf(stderr, "  room: %-44s %6.2f s\n", name, rows.back().seconds);
@@ -167,15 +168,15 @@ int main(int argc, char** argv) {
             o.emission_segment_count = segment;
             return PathEstimator<strategy::NullScatteringMis, mis::Balance>(o);
         };
-        const int pilot = std::min(run_spp, std::clamp(run_spp / 32, 2, 16));
+        const int pilot = nsp_examples::RenderRequest::pilot_spp(run_spp);
         rows.push_back(nsp_examples::render_image_learned(
             scene, make, name, run_res, run_spp, threads, seed++,
             [](float u, float v) { return nsp_examples::room_camera_ray(u, v, 1.f); }, pilot, &chosen));
         std::fprintf(stderr, "  room: %-44s %6.2f s\n", name, rows.back().seconds);
         std::array<int, nsp::NeeCountLearner::kCandidates> nee{}, segment{};
         for (const nsp::TechniqueCounts& c : chosen) {
-            ++nee[std::size_t(std::lround(-std::log2(c.nee)))];
-            ++segment[std::size_t(std::lround(-std::log2(c.emission_segment)))];
+            ++nee[std::size_t(nsp::NeeCountLearner::candidate_index(c.nee))];
+            ++segment[std::size_t(nsp::NeeCountLearner::candidate_index(c.emission_segment))];
         }
         std::string text = "learned counts (" + std::string(name) + ", a " + std::to_string(pilot) +
                            "-spp pilot at counts 1 per 16x16 tile), tiles at 1, 1/2, .., 1/64: NEE";

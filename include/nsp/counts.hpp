@@ -201,6 +201,8 @@ public:
 
     /// The j-th candidate count, 2^-j.
     static constexpr float candidate(int j) noexcept { return 1.f / float(1 << j); }
+    /// The index j of a candidate count (the inverse of candidate()), e.g. of a chosen one.
+    static int candidate_index(float count) noexcept { return int(std::lround(-std::log2(count))); }
 
     /// A shadow walk's work besides its lookups and steps (the light sample, the phase or BSDF
     /// evaluation, the walk's set-up), in lookups: an assumption of the cost model, about what a
@@ -236,12 +238,9 @@ public:
                      BdptTechnique t, bool splat) noexcept {
         set_second(Second::LightSubpath);
         if (nee_count != 1.f || light_count != 1.f) invalid_ = true;
-        if (!(p_fixed >= 0.f && p_nee >= 0.f && p_light >= 0.f) || !std::isfinite(f_over_ref) || f_over_ref == 0.f)
-            return;
+        double v1 = 0.0, d1 = 0.0;
+        if (!at_counts_1(f_over_ref, p_fixed, p_nee, p_light, v1, d1)) return;
         const double u = f_over_ref, h = p_fixed, n = p_nee, l = p_light;
-        const double d1 = h + n + l;
-        if (!(d1 > 0.0) || !std::isfinite(d1)) return;
-        const double v1 = u / d1;
         for (int jn = 0; jn < kCandidates; ++jn)
             for (int jl = 0; jl < kCandidates; ++jl) {
                 const std::size_t k = pair(jn, jl);
@@ -509,6 +508,17 @@ private:
         return mean + kSignificance * se < 0.0;
     }
 
+    /// A recorded contribution u at counts 1: its balance denominator d1 = a + b + c and its value
+    /// v1 = u / d1; false where it cannot enter the prediction (a negative or NaN pdf, u zero or
+    /// not finite, no or an infinite denominator).
+    static bool at_counts_1(float u, float a, float b, float c, double& v1, double& d1) noexcept {
+        if (!(a >= 0.f && b >= 0.f && c >= 0.f) || !std::isfinite(u) || u == 0.f) return false;
+        d1 = double(a) + double(b) + double(c);
+        if (!(d1 > 0.0) || !std::isfinite(d1)) return false;
+        v1 = double(u) / d1;
+        return true;
+    }
+
     /// Which count a path estimator's contribution depends on: NEE's (the first of a pair) or the
     /// segment technique's (the second).
     enum class Axis : std::uint8_t { Nee, Second };
@@ -521,12 +531,9 @@ private:
     void add_contribution(Axis axis, float f_over_ref, float p_fixed, float p_counted, float p_other, float count,
                           bool drawn_by_counted) noexcept {
         if (count != 1.f) invalid_ = true;
-        if (!(p_fixed >= 0.f && p_counted >= 0.f && p_other >= 0.f) || !std::isfinite(f_over_ref) || f_over_ref == 0.f)
-            return;
+        double v1 = 0.0, d1 = 0.0;
+        if (!at_counts_1(f_over_ref, p_fixed, p_counted, p_other, v1, d1)) return;
         const double u = f_over_ref, h = p_fixed, n = p_counted, o = p_other;
-        const double d1 = h + n + o;
-        if (!(d1 > 0.0) || !std::isfinite(d1)) return;
-        const double v1 = u / d1;
         for (int j = 0; j < kCandidates; ++j) {
             const double c = candidate(j), d = h + c * n + o;
             const double x = d > 0.0 ? u / d : 0.0;
