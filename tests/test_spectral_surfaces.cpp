@@ -185,59 +185,21 @@ TEST_CASE_TEMPLATE_APPLY(spectral_nested, SpectralEquiangular);
 
 TEST_CASE_TEMPLATE_DEFINE("spectral surfaces: single scattering from two point lights in a cube over a floor (quadrature)",
                           E, spectral_point_lights) {
-    // tests/test_surface_estimators.cpp's scene per channel: two point lights of chromatic
-    // intensity in a cube [-1, 1]^3 of chromatic sigma_s, sigma_a (HG 0.4) behind null interfaces
-    // over a Lambertian floor at y = -1.5 of chromatic albedo; max_depth 1; the camera ray passes
-    // 0.15 from light 0. Per channel, with T_c(l) = exp(-sigma_t,c l):
-    //   L_c = sum_i int sigma_s,c f_p T_c(s - s_in) I_i,c T_c(r_i) / r_i^2 ds + T_c(s_out - s_in) sum_i rho_c / pi I_i,c cos_i T_c(c_i) / d_i^2
-    // (composite Simpson in double, 20000 intervals).
+    // tests/test_surface_estimators.cpp's scene per channel (support/spectral.hpp's
+    // TwoPointLights: its closed form by quadrature).
     if constexpr (std::is_same_v<typename E::Strategy, strategy::Unidirectional>) return;  // a point light is never hit
     CAPTURE(spectral_estimator_name<E>());
     using M = HomogeneousMedium<Rgb>;
     using Ps = LightSampler<Rgb, PointLight<Rgb>>;
     using PSc = SurfaceScene<Shapes, M, MajorantFor<typename E::Channels, M>, HenyeyGreensteinPhase, Mats<Rgb>, Ps>;
-    const Rgb::Spectrum sigma_s(0.8f, 0.5f, 1.1f), sigma_a(0.2f, 0.4f, 0.1f), rho(0.6f, 0.3f, 0.8f);
-    const Rgb::Spectrum sigma_t = sigma_s + sigma_a;
-    const Box cube{Vec3(-1.f), Vec3(1.f)};
+    const TwoPointLights setup;
     Shapes shapes;
-    shapes.boxes.push_back({cube.lo, cube.hi, {-1, -1, 0, -1}});
+    shapes.boxes.push_back({setup.cube.lo, setup.cube.hi, {-1, -1, 0, -1}});
     shapes.quads.push_back({Vec3(-20.f, -1.5f, 20.f), Vec3(40.f, 0.f, 0.f), Vec3(0.f, 0.f, -40.f), {0, -1, -1, -1}});
-    const std::vector<PointLight<Rgb>> points{{Vec3(0.1f, -0.7f, -0.45f), Rgb::Spectrum(2.f, 1.f, 1.5f)},
-                                              {Vec3(-0.5f, -0.3f, 0.6f), Rgb::Spectrum(0.5f, 1.f, 0.8f)}};
-    const PSc sc(shapes, {medium_for<E, Rgb>(cube, sigma_a, sigma_s)}, Mats<Rgb>({LambertianBsdf<Rgb>(rho)}, {}),
-                 Ps(LightSelection::Power, 4.f, points), -1);
-    const Vec3 eye(0.1f, 0.8f, -4.f), dir = glm::normalize(Vec3(-0.1f, -2.3f, 5.f));
-    const double s_in = (-1.0 - eye.z) / dir.z, s_out = (-1.0 - eye.y) / dir.y, s_floor = (-1.5 - eye.y) / dir.y;
-    const HenyeyGreensteinPhase phase{0.4f};
-    Rgb::Spectrum expected;
-    for (int c = 0; c < 3; ++c) {
-        const double st = sigma_t[c];
-        auto single = [&](double s) {
-            const Vec3 x = eye + float(s) * dir;
-            double sum = 0.0;
-            for (const auto& l : points) {
-                const Vec3 to = l.position - x;
-                const double r = glm::length(to);
-                sum += double(sigma_s[c]) * phase.eval(dir, to / float(r)) * std::exp(-st * (s - s_in)) * l.intensity[c] *
-                       std::exp(-st * r) / (r * r);
-            }
-            return sum;
-        };
-        const int n = 20000;
-        const double h = (s_out - s_in) / n;
-        double integral = single(s_in) + single(s_out);
-        for (int i = 1; i < n; ++i) integral += (i % 2 ? 4.0 : 2.0) * single(s_in + i * h);
-        integral *= h / 3.0;
-        const Vec3 f = eye + float(s_floor) * dir;
-        double floor_term = 0.0;
-        for (const auto& l : points) {
-            const Vec3 to = l.position - f;
-            const double dist = glm::length(to);
-            const Vec3 w = to / float(dist);
-            floor_term += rho[c] / kPi * l.intensity[c] * w.y * std::exp(-st * exit_distance(cube, l.position, -w)) / (dist * dist);
-        }
-        expected[c] = float(integral + std::exp(-st * (s_out - s_in)) * floor_term);
-    }
+    const PSc sc(shapes, {medium_for<E, Rgb>(setup.cube, setup.sigma_a, setup.sigma_s)},
+                 Mats<Rgb>({LambertianBsdf<Rgb>(setup.rho)}, {}), Ps(LightSelection::Power, 4.f, setup.points), -1);
+    const Vec3 eye = setup.eye, dir = setup.dir;
+    const Rgb::Spectrum expected = setup.expected();
     EstimatorOptions opts;
     opts.max_depth = 1;
     check_zero_error(run(E(opts), sc, 20000, 47, [&](Pcg32&) { return Ray{eye, dir}; }, expected));

@@ -40,6 +40,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <concepts>
 #include <cstddef>
 #include <cstdint>
 #include <limits>
@@ -51,10 +52,13 @@
 #include "../geometry.hpp"
 #include "../camera.hpp"
 #include "../media/emissive.hpp"
+#include "../channel_tracking.hpp"
 #include "../mis.hpp"
+#include "../path_pdf.hpp"
 #include "../surface_scene.hpp"
 #include "../vertex.hpp"
 #include "common.hpp"
+#include "spectral_surface_equiangular.hpp"
 #include "surface_emission.hpp"
 #include "surface_walk.hpp"
 
@@ -79,6 +83,43 @@ concept MisPolicy = requires {
     { T::null_pdfs } -> std::convertible_to<bool>;
 };
 
+/// One pdf for every channel (the default): the path is tracked with grey event probabilities
+/// and a grey majorant, as PathEstimator tracks it.
+struct Grey {
+    static constexpr const char* name = "grey";
+};
+
+/// What the channel axis of BdptEstimator may be: Grey, or channels::SpectralMis (each channel its
+/// own majorant and event probabilities, one sampling channel per sample chosen uniformly, the
+/// one-sample balance or power heuristic over channels x strategies, THEORY 5.3 with 5.5).
+template <class T>
+concept ChannelAxis = std::same_as<T, Grey> || std::same_as<T, channels::SpectralMis>;
+
+/// Where a grey path keeps no per-channel factor.
+struct NoGamma {};
+
+/// The type of a vertex's densities: one float (Grey) or one per channel.
+template <class Ch, SpectralMode S>
+using PdfType = std::conditional_t<std::same_as<Ch, Grey>, float, typename S::Spectrum>;
+
+/// The type of a path's per-channel shared factors: nothing for Grey.
+template <class P>
+using GammaOf = std::conditional_t<std::is_same_v<P, float>, NoGamma, P>;
+
+/// Shared factors of 1 in every channel (a path with no segment yet).
+template <class P>
+GammaOf<P> unit_gamma() noexcept {
+    if constexpr (std::is_same_v<P, float>) return NoGamma{};
+    else return P::Ones();
+}
+
+/// Broadcasts a density common to every channel (a light's emission, a direction pdf) into P.
+template <class P>
+P broadcast(float v) noexcept {
+    if constexpr (std::is_same_v<P, float>) return v;
+    else return P::Constant(v);
+}
+
 /// The densities of one path x_0 (on a light, or at infinity) .. x_k (the camera) under every
 /// strategy, as the weights need them (k <= N - 1):
 /// - from_light[i], i in 1..k-1: the density of x_i drawn from x_{i-1} on the light side;
@@ -93,20 +134,27 @@ concept MisPolicy = requires {
 ///   from_camera[k-1] is the camera's own density of x_{k-1} (its pdf_dir converted), else any
 ///   value > 0 (it is the same in every strategy and cancels).
 /// Strategy s draws x_0..x_{s-1} from the light and x_s..x_k from the camera.
-template <int N>
+///
+/// Per channel (P a Spectrum, THEORY 5.3 with 5.5), from_light and from_camera hold every
+/// channel's density (its own majorant and event probabilities in the null and event factors),
+/// `gamma` every channel's factor that all strategies of the path share (its Tbar_c and the
+/// nulls' mu_bar_c), relative to the largest, and `channel` the sample's sampling channel.
+template <int N, class P = float>
 struct PathPdfs {
     int k = 0;
     bool light_tracing = false;
     float emit = 0.f, nee = 0.f;
-    float from_light[N] = {};
-    float from_camera[N] = {};
+    P from_light[N] = {};
+    P from_camera[N] = {};
     bool connectible[N] = {};
+    [[no_unique_address]] GammaOf<P> gamma = unit_gamma<P>();
+    [[no_unique_address]] std::conditional_t<std::is_same_v<P, float>, NoGamma, int> channel{};
 };
 
 /// How many strategies the path has: s = 0..k-1, and s = k (t = 1, light tracing) when
 /// `light_tracing` and k >= 2.
-template <int N>
-int strategy_count(const PathPdfs<N>& p) noexcept {
+template <int N, class P>
+int strategy_count(const PathPdfs<N, P>& p) noexcept {
     return p.light_tracing && p.k >= 2 ? p.k + 1 : p.k;
 }
 
@@ -183,20 +231,106 @@ float strategy_weight(const H& h, const PathPdfs<N>& p, int s) noexcept {
     return float(double(h.power(float(q[s]))) / sum);
 }
 
+/// Per channel (THEORY 5.3 with 5.5): every channel's pdf of the path under every strategy,
+/// gamma_c x the strategy's product of densities, written into q[c * (N + 1) + s], all relative
+/// to one scale (each vertex's densities scaled by the largest over both directions and every
+/// channel, the products in double, the whole divided by the largest), as strategy_pdfs does for
+/// one channel. Returns false when no strategy of any channel can draw the path. NaN gives NaN.
+template <int N, class P>
+bool channel_strategy_pdfs(const PathPdfs<N, P>& p, double* q) noexcept {
+    constexpr int C = int(P::SizeAtCompileTime);
+    const int k = p.k;
+    if (k < 1 || k >= N) return false;
+    const int last = strategy_count(p);
+    // Every vertex's scale, common to its channels and directions: an infinite density wins.
+    auto scale_of = [](const P& a, const P& b, bool& nan) {
+        nan = nan || a.isNaN().any() || b.isNaN().any();
+        return std::max(double(a.maxCoeff()), double(b.maxCoeff()));
+    };
+    bool nan = false;
+    double inv[N];  // 1 / the scale of vertex i (0 where all its densities are 0)
+    bool inf[N];
+    for (int i = 1; i < k; ++i) {
+        const double m = scale_of(p.from_light[i], p.from_camera[i], nan);
+        inf[i] = std::isinf(m);
+        inv[i] = m > 0.0 && !inf[i] ? 1.0 / m : 0.0;
+    }
+    const double m0 = std::max({double(p.from_camera[0].maxCoeff()), double(p.nee), double(p.emit)});
+    nan = nan || p.from_camera[0].isNaN().any() || std::isnan(p.nee) || std::isnan(p.emit) || p.gamma.isNaN().any();
+    if (nan) {
+        for (int i = 0; i < C * (N + 1); ++i) q[i] = std::numeric_limits<double>::quiet_NaN();
+        return true;
+    }
+    const bool inf0 = std::isinf(m0);
+    const double inv0 = m0 > 0.0 && !inf0 ? 1.0 / m0 : 0.0;
+    // A density relative to its vertex's scale: an infinite one becomes 1, a finite one beside it 0.
+    auto rel = [](double v, double iv, bool is_inf) { return is_inf ? (std::isinf(v) ? 1.0 : 0.0) : v * iv; };
+    double largest = 0.0;
+    for (int ch = 0; ch < C; ++ch) {
+        double* qc = q + ch * (N + 1);
+        double suffix[N + 1];
+        suffix[k] = 1.0;
+        for (int i = k - 1; i >= 1; --i) suffix[i] = suffix[i + 1] * rel(double(p.from_camera[i][ch]), inv[i], inf[i]);
+        const double x0[3] = {rel(double(p.from_camera[0][ch]), inv0, inf0), rel(double(p.nee), inv0, inf0),
+                              rel(double(p.emit), inv0, inf0)};
+        const double g = double(p.gamma[ch]);
+        double prefix = 1.0;
+        for (int s = 0; s < last; ++s) {
+            if (s >= 2) prefix *= rel(double(p.from_light[s - 1][ch]), inv[s - 1], inf[s - 1]);
+            double v = 0.0;
+            if (s == 0) v = x0[0] * suffix[1];
+            else if (s == 1) v = p.connectible[1] ? x0[1] * suffix[1] : 0.0;
+            else if (s == k) v = p.connectible[k - 1] ? x0[2] * prefix : 0.0;
+            else if (p.connectible[s - 1] && p.connectible[s]) v = x0[2] * prefix * suffix[s];
+            qc[s] = g * v;
+            largest = std::max(largest, qc[s]);
+        }
+    }
+    if (!(largest > 0.0)) return false;
+    for (int ch = 0; ch < C; ++ch)
+        for (int s = 0; s < last; ++s) q[ch * (N + 1) + s] /= largest;
+    return true;
+}
+
+/// Per channel: the factor by which the sampling channel's sample of strategy s multiplies its
+/// throughput f_lambda / p_(s,c*) (THEORY 5.3 with 5.5): w_(s,c*) / q_(c*) with w_(s,c) =
+/// power(q_c p_(s,c)) / sum over channels c' and strategies s' of power(q_c' p_(s',c')), uniform
+/// selection q_c = 1 / C. Under the balance heuristic the estimate is f_lambda / sum_c q_c sum_s'
+/// p_(s',c). The w of all channels and strategies of a path sum to 1. 0 where s cannot draw it in
+/// channel c*; NaN densities give NaN.
+template <mis::CombiningHeuristic H, int N, class P>
+float channel_strategy_weight(const H& h, const PathPdfs<N, P>& p, int s) noexcept {
+    constexpr int C = int(P::SizeAtCompileTime);
+    const int n = strategy_count(p);
+    if (s < 0 || s >= n || p.channel < 0 || p.channel >= C) return 0.f;
+    double q[C * (N + 1)];
+    if (!channel_strategy_pdfs(p, q)) return 0.f;
+    const double own = q[p.channel * (N + 1) + s];
+    if (!(own > 0.0)) return std::isnan(own) ? float(own) : 0.f;
+    const float sel = 1.f / float(C);
+    double sum = 0.0;
+    for (int ch = 0; ch < C; ++ch)
+        for (int r = 0; r < n; ++r) sum += double(h.power(sel * float(q[ch * (N + 1) + r])));
+    return float(double(h.power(sel * float(own))) / sum / double(sel));
+}
+
 /// What one vertex of a subpath is.
 enum class VertexKind : std::uint8_t { Camera, Light, Surface, Medium };
 
-/// A real vertex of a camera or light subpath.
-template <SpectralMode S>
+/// A real vertex of a camera or light subpath; P the type of its densities (PdfType).
+template <SpectralMode S, class P = float>
 struct Vertex {
     Vec3 p{0.f};
     Vec3 ng{0.f, 0.f, 1.f}, ns{0.f, 0.f, 1.f};  ///< normals (surfaces; a light vertex: its emitting normal)
     Vec3 wo{0.f, 0.f, 1.f};                      ///< the subpath's direction of travel arriving at p
     typename S::Spectrum beta = S::Spectrum::Zero();  ///< the subpath's throughput up to p
-    float pdf_fwd = 0.f;   ///< density of p drawn by its own subpath (area / volume measure, with N and E)
-    float pdf_rev = 0.f;   ///< density of p drawn from the other side, from the next vertex of its subpath
-    float nulls_in = 1.f;  ///< N: prod P_n of the segment arriving at p (1 under Directional)
-    float event = 1.f;     ///< E: mu_bar P_s at a medium vertex (1 on surfaces and under Directional)
+    P pdf_fwd = broadcast<P>(0.f);   ///< density of p drawn by its own subpath (area / volume measure, with N and E)
+    P pdf_rev = broadcast<P>(0.f);   ///< density of p drawn from the other side, from the next vertex of its subpath
+    P nulls_in = broadcast<P>(1.f);  ///< N: prod P_n of the segment arriving at p (1 under Directional)
+    P event = broadcast<P>(1.f);     ///< E: mu_bar P_s at a medium vertex (1 on surfaces and under Directional)
+    /// Per channel: every channel's factor that all strategies share (Tbar_c, the nulls' mu_bar_c)
+    /// over the subpath up to p, relative to the largest.
+    [[no_unique_address]] GammaOf<P> gamma = unit_gamma<P>();
     int material = -1, medium = -1, medium_front = -1, medium_back = -1, light = -1;
     VertexKind kind = VertexKind::Camera;
     bool delta = false;           ///< a delta lobe was sampled here: no connection may end at p
@@ -215,11 +349,11 @@ struct Vertex {
 /// s = 0 the emitter hit is not among them), and x_0's position (the light point; for a light at
 /// infinity, `x0_at_infinity`, the light subpath's ray origin outside the scene or else the last
 /// camera vertex's).
-template <SpectralMode S>
+template <SpectralMode S, class P = float>
 struct PathVertices {
-    const Vertex<S>* light = nullptr;
+    const Vertex<S, P>* light = nullptr;
     int s = 0;
-    const Vertex<S>* camera = nullptr;
+    const Vertex<S, P>* camera = nullptr;
     int t = 0;
     Vec3 x0{0.f};
     bool x0_at_infinity = false;
@@ -228,8 +362,8 @@ struct PathVertices {
 /// Converts a solid-angle density at `from` toward vertex `to` into `to`'s measure: |n . w| / d^2
 /// on a surface or light, 1 / d^2 in a medium; 0 for a point light and the camera. A light at
 /// infinity is a direction: its measure is the solid angle, pdf_dir unchanged.
-template <SpectralMode S>
-float to_vertex_measure(float pdf_dir, const Vec3& from, const Vertex<S>& to) noexcept {
+template <SpectralMode S, class P>
+float to_vertex_measure(float pdf_dir, const Vec3& from, const Vertex<S, P>& to) noexcept {
     if (to.at_infinity) return pdf_dir;
     const Vec3 d = to.p - from;
     const float d2 = glm::dot(d, d);
@@ -246,8 +380,8 @@ float to_vertex_measure(float pdf_dir, const Vec3& from, const Vertex<S>& to) no
 /// Converts the density of a ray from a light at infinity, per area perpendicular to its direction
 /// w, into the measure of the vertex `to` it reaches: x |ng . w| on a surface, x 1 in a medium
 /// (the ray's length is the tracking's own measure); 0 for a light and the camera.
-template <SpectralMode S>
-float from_infinity_measure(float pdf_perpendicular, const Vec3& w, const Vertex<S>& to) noexcept {
+template <SpectralMode S, class P>
+float from_infinity_measure(float pdf_perpendicular, const Vec3& w, const Vertex<S, P>& to) noexcept {
     switch (to.kind) {
         case VertexKind::Medium: return pdf_perpendicular;
         case VertexKind::Surface: return pdf_perpendicular * std::abs(glm::dot(to.ng, w));
@@ -280,17 +414,27 @@ int light_start_medium(const Sc& sc, const Vec3& p, const Vec3& w) noexcept {
 /// must not exceed it). radiance() has PathEstimator's signature, so a host's pixel loop calls
 /// either the same way. Grey: exact for Mono and grey media, as PathEstimator.
 template <bdpt::MisPolicy Mis = bdpt::NullScattering, mis::CombiningHeuristic H = mis::Balance,
-          AbsorptionPolicy A = absorption::Weight, int MaxDepth = 32>
+          AbsorptionPolicy A = absorption::Weight, int MaxDepth = 32, bdpt::ChannelAxis Ch = bdpt::Grey>
 class BdptEstimator {
     static_assert(MaxDepth >= 1 && MaxDepth <= 256, "nsp::BdptEstimator: MaxDepth must lie in [1, 256]");
+    static_assert(std::same_as<Ch, bdpt::Grey> || Mis::null_pdfs,
+                  "nsp::BdptEstimator: per-channel pdfs are null-scattering pdfs (bdpt::NullScattering); "
+                  "bdpt::Directional has none");
 
 public:
     using MisType = Mis;
     using HeuristicType = H;
     using Absorption = A;
+    using Channels = Ch;
+    static constexpr bool kPerChannel = !std::same_as<Ch, bdpt::Grey>;
     static constexpr int kMaxDepth = MaxDepth;
     static constexpr int kMaxPath = 2 * MaxDepth + 3;  ///< most vertices of a path x_0..x_k
-    using Pdfs = bdpt::PathPdfs<kMaxPath>;
+    using Pdfs = bdpt::PathPdfs<kMaxPath>;  ///< the grey densities (PdfsFor: a scene's)
+    /// The densities of a path through scenes of spectral mode S: one float or one per channel.
+    template <SpectralMode S>
+    using PdfsFor = bdpt::PathPdfs<kMaxPath, bdpt::PdfType<Ch, S>>;
+    template <SpectralMode S>
+    using VertexFor = bdpt::Vertex<S, bdpt::PdfType<Ch, S>>;
 
     /// EstimatorOptions' defaults with max_depth = MaxDepth (theirs, 1000, would not fit).
     static EstimatorOptions default_options() noexcept {
@@ -392,15 +536,21 @@ private:
     template <class Sc>
     static constexpr void check_scene() {
         static_assert(is_surface_scene_v<Sc>, "nsp::BdptEstimator renders a SurfaceScene (NoSurfaces for media alone)");
-        static_assert(!is_per_channel_majorant_v<typename Sc::MajorantType, typename Sc::MediumType>,
-                      "nsp::BdptEstimator drives every channel with one pdf and needs a grey majorant");
+        if constexpr (!kPerChannel)
+            static_assert(!is_per_channel_majorant_v<typename Sc::MajorantType, typename Sc::MediumType>,
+                          "nsp::BdptEstimator<..., bdpt::Grey> drives every channel with one pdf and needs a grey "
+                          "majorant (channels::SpectralMis: one per channel)");
+        else
+            static_assert(!EmissiveMedium<typename Sc::MediumType>,
+                          "nsp::BdptEstimator with per-channel pdfs renders media without emission (grey BDPT "
+                          "or SpectralPathEstimator render emissive media)");
         static_assert(std::remove_cvref_t<decltype(std::declval<Sc>().lights)>::bidirectional_ready(),
                       "nsp::BdptEstimator: every light model must start light subpaths (EmittingLight: "
                       "sample_emission, emission_pdf) or lie at infinity / be a delta light");
     }
 
     template <class Sc>
-    using VertexT = bdpt::Vertex<typename Sc::Spectral>;
+    using VertexT = VertexFor<typename Sc::Spectral>;
 
     /// A walk's emission callback that does nothing (light subpaths, media without emission).
     struct NoEmission {};
@@ -422,10 +572,39 @@ private:
         }
     };
 
+    /// Per channel: every channel's null probabilities P_n,c over a tracked piece and its event
+    /// density mu_bar_c P_s,c at the piece's real collision, from the coefficients at each
+    /// tentative collision (all but a scattering end are nulls).
+    template <SpectralMode S>
+    struct ChannelNullVisit {
+        static constexpr bool enabled = true;
+        using Spec = typename S::Spectrum;
+        detail::DoubleSpectrum<Spec>* nulls;  // the product of the nulls before the last collision
+        Spec* last_null;                      // the last collision's P_n,c, should it be a null
+        Spec* last_event;                     // its mu_bar_c P_s,c, should it scatter
+        bool* pending;
+        template <class State>
+        void operator()(float, const Coefficients<S>& k, const Spec& mu, const Spec&, const State&) const {
+            if (*pending) *nulls *= last_null->template cast<double>();
+            const ChannelEventDensities<Spec> d = channel_event_densities<A, S>(k, mu);
+            *last_null = (mu > 0.f).select(d.null / mu, 0.f);
+            *last_event = d.scatter;
+            *pending = true;
+        }
+    };
+
+    /// Every channel's factors shared by all strategies, relative to the largest (0 where none is
+    /// positive).
+    template <class Spec>
+    static Spec relative_to_largest(const Spec& g) noexcept {
+        const float m = g.maxCoeff();
+        return m > 0.f && std::isfinite(m) ? Spec(g / m) : Spec(Spec::Zero());
+    }
+
     template <class Sc, UniformRng R, LookupCounter C, class OnHit, class OnEmission = NoEmission>
     int walk(const Sc& sc, VertexT<Sc>* path, int count, int max_vertices, Ray ray, int medium, float pdf_dir,
-             typename Sc::Spectrum beta, const typename Sc::Spectral::Wavelengths& lambda, R& rng, C& counter,
-             OnHit on_hit, Status& status, OnEmission on_emission = {}) const;
+             typename Sc::Spectrum beta, const typename Sc::Spectral::Wavelengths& lambda, int channel, R& rng,
+             C& counter, OnHit on_hit, Status& status, OnEmission on_emission = {}) const;
 
     Kernels kernels_;
     float light_probability_ = 1.f;
@@ -433,17 +612,33 @@ private:
 
 // ---------------------------------------------------------------------------------------------
 
-template <bdpt::MisPolicy Mis, mis::CombiningHeuristic H, AbsorptionPolicy A, int MaxDepth>
+template <bdpt::MisPolicy Mis, mis::CombiningHeuristic H, AbsorptionPolicy A, int MaxDepth, bdpt::ChannelAxis Ch>
 template <class Sc, UniformRng R, LookupCounter C, class OnHit, class OnEmission>
-int BdptEstimator<Mis, H, A, MaxDepth>::walk(const Sc& sc, VertexT<Sc>* path, int count, int max_vertices, Ray ray,
-                                             int medium, float pdf_dir, typename Sc::Spectrum beta,
-                                             const typename Sc::Spectral::Wavelengths& lambda, R& rng, C& counter,
-                                             OnHit on_hit, Status& status, OnEmission on_emission) const {
+int BdptEstimator<Mis, H, A, MaxDepth, Ch>::walk(const Sc& sc, VertexT<Sc>* path, int count, int max_vertices,
+                                                 Ray ray, int medium, float pdf_dir, typename Sc::Spectrum beta,
+                                                 const typename Sc::Spectral::Wavelengths& lambda, int channel, R& rng,
+                                                 C& counter, OnHit on_hit, Status& status,
+                                                 OnEmission on_emission) const {
     using namespace bdpt;
     using V = VertexT<Sc>;
+    using S = typename Sc::Spectral;
+    using Spectrum = typename Sc::Spectrum;
+    using P = PdfType<Ch, S>;
     const float beta_scale = float(beta.abs().maxCoeff());
-    float nulls = 1.f;
+    P nulls = broadcast<P>(1.f);
     int crossings = 0;
+    // Per channel: the segment's state since the last real vertex (f_c and p_c of channel c's
+    // tracking, and in its eq.vertex slot the factor every strategy shares, prod mu_bar_c(n_j)
+    // Tbar_c), and the throughput where the segment started (THEORY 5.3 with 5.5).
+    using State = std::conditional_t<kPerChannel, ChannelPathState<S, true>, NoGamma>;
+    [[maybe_unused]] State st{};
+    [[maybe_unused]] Spectrum beta0 = beta;
+    if constexpr (kPerChannel) st.eq.vertex = Spectrum::Ones();
+    // The subpath's shared factors up to the segment's start, and to where it is now.
+    auto gamma_here = [&]() {
+        if constexpr (kPerChannel) return relative_to_largest<Spectrum>(path[count - 1].gamma * st.eq.vertex);
+        else return NoGamma{};
+    };
     while (count < max_vertices) {
         const SurfaceHit hit = sc.geometry.intersect(ray, kInf);
         if (!detail::usable_hit(sc, hit)) {
@@ -452,7 +647,32 @@ int BdptEstimator<Mis, H, A, MaxDepth>::walk(const Sc& sc, VertexT<Sc>* path, in
         }
         V v;
         bool scattered = false;
-        if (sc.has_medium(medium)) {
+        if constexpr (kPerChannel) {
+            if (sc.has_medium(medium)) {
+                const auto& m = sc.media[std::size_t(medium)];
+                detail::DoubleSpectrum<Spectrum> piece_nulls = detail::DoubleSpectrum<Spectrum>::Ones();
+                Spectrum last_null = Spectrum::Ones(), last_event = Spectrum::Ones();
+                bool pending = false;
+                const ChannelTrack seg = track_channels_delta_visiting<Ch, A>(
+                    m.medium, m.majorant, ray, hit.t, lambda, channel, st, false, rng, counter,
+                    ChannelNullVisit<S>{&piece_nulls, &last_null, &last_event, &pending});
+                if (const Status fs = flight_status(seg.end); fs != Status::Ok) {
+                    status = fs;
+                    return count;
+                }
+                if (seg.end != SegmentEnd::Scattered && seg.end != SegmentEnd::Passed) return count;  // absorbed, or no pdf left
+                if (seg.end == SegmentEnd::Passed && pending) piece_nulls *= last_null.template cast<double>();
+                nulls *= piece_nulls.template cast<float>();
+                beta = beta0 * st.f / st.uni[channel];
+                if (seg.end == SegmentEnd::Scattered) {
+                    scattered = true;
+                    v.kind = VertexKind::Medium;
+                    v.p = ray.at(seg.t);
+                    v.medium = medium;
+                    v.event = last_event;
+                }
+            }
+        } else if (sc.has_medium(medium)) {  // grey: one pdf for every channel
             const auto& m = sc.media[std::size_t(medium)];
             DeltaTrack<typename Sc::Spectral> seg;
             if constexpr (!std::is_same_v<OnEmission, NoEmission>) {
@@ -482,10 +702,10 @@ int BdptEstimator<Mis, H, A, MaxDepth>::walk(const Sc& sc, VertexT<Sc>* path, in
         }
         if (!scattered) {
             if (!hit.found()) {
-                on_hit(path, count, hit, ray, nulls, beta);  // the lights at infinity
+                on_hit(path, count, hit, ray, nulls, beta, gamma_here());  // the lights at infinity
                 return count;
             }
-            if (hit.light >= 0) on_hit(path, count, hit, ray, nulls, beta);
+            if (hit.light >= 0) on_hit(path, count, hit, ray, nulls, beta, gamma_here());
             if (detail::crosses(sc, hit)) {
                 if (++crossings > detail::kMaxInterfaceCrossings) {
                     status = Status::InvalidInput;
@@ -510,9 +730,10 @@ int BdptEstimator<Mis, H, A, MaxDepth>::walk(const Sc& sc, VertexT<Sc>* path, in
         v.nulls_in = nulls;
         // From the camera: its own density of the ray converted (light tracing), or 1, which every
         // strategy with t >= 2 shares.
-        if (prev.kind == VertexKind::Camera && !(pdf_dir > 0.f)) v.pdf_fwd = 1.f;
+        if (prev.kind == VertexKind::Camera && !(pdf_dir > 0.f)) v.pdf_fwd = broadcast<P>(1.f);
         else if (prev.at_infinity) v.pdf_fwd = from_infinity_measure(pdf_dir, ray.d, v) * nulls * v.event;
         else v.pdf_fwd = to_vertex_measure(pdf_dir, prev.p, v) * nulls * v.event;
+        if constexpr (kPerChannel) v.gamma = gamma_here();
         path[count] = v;
         V& cur = path[count++];
         if (count >= max_vertices) return count;
@@ -535,16 +756,21 @@ int BdptEstimator<Mis, H, A, MaxDepth>::walk(const Sc& sc, VertexT<Sc>* path, in
         if (!(beta != 0.f).any()) return count;
         if (cur.kind == VertexKind::Surface) medium = cur.medium_toward(next.wi);
         pdf_dir = next.pdf;
-        nulls = 1.f;
+        nulls = broadcast<P>(1.f);
+        if constexpr (kPerChannel) {
+            beta0 = beta;
+            st = State{};
+            st.eq.vertex = Spectrum::Ones();
+        }
         crossings = 0;
         ray = Ray{cur.p, next.wi};
     }
     return count;
 }
 
-template <bdpt::MisPolicy Mis, mis::CombiningHeuristic H, AbsorptionPolicy A, int MaxDepth>
+template <bdpt::MisPolicy Mis, mis::CombiningHeuristic H, AbsorptionPolicy A, int MaxDepth, bdpt::ChannelAxis Ch>
 template <class Sc, class Cam, UniformRng R, LookupCounter C, class Splat, class Observe>
-RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::trace(
+RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::trace(
     const Sc& sc, const Ray& camera_ray, const Cam* cam, const typename Sc::Spectral::Wavelengths& lambda, R& rng,
     C& counter, Splat& splat, Observe& observe) const {
     check_scene<Sc>();
@@ -552,6 +778,11 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::trace(
     using namespace bdpt;
     using Spectrum = typename Sc::Spectrum;
     using V = VertexT<Sc>;
+    using P = PdfType<Ch, typename Sc::Spectral>;
+    using PathPdfsT = PdfsFor<typename Sc::Spectral>;
+    static_assert(!(kPerChannel && BdptRecorder<C>),
+                  "nsp::BdptEstimator: a NeeCountLearner learns the grey BDPT's counts; per-channel BDPT takes "
+                  "fixed counts");
     const int depth = kernels_.options().max_depth;
     Spectrum L = Spectrum::Zero();
     Status status = Status::Ok;
@@ -563,8 +794,23 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::trace(
     alignas(V) std::byte light_storage[sizeof(V) * (MaxDepth + 1)];
     V* const camera = std::launder(reinterpret_cast<V*>(camera_storage));  // z_0 .. z_{depth+1}
     V* const light = std::launder(reinterpret_cast<V*>(light_storage));    // y_0 .. y_{depth-1}, y_depth (light tracing)
-    Pdfs pdfs;
+    PathPdfsT pdfs;
     pdfs.light_tracing = kLightTracing;
+    // Per channel: the sample's sampling channel, chosen uniformly (THEORY 5.3). Its light
+    // subpath, connections and splats use the same channel, so the one-sample weights of every
+    // pixel's strategies share one denominator.
+    int channel = 0;
+    if constexpr (kPerChannel) {
+        constexpr int kChannels = int(Spectrum::SizeAtCompileTime);
+        channel = std::min(int(rng.uniform() * float(kChannels)), kChannels - 1);
+        pdfs.channel = channel;
+    }
+    // The weight of strategy s for the path in pdfs (per channel: its factor of the sampling
+    // channel's throughput).
+    auto weight_of = [&](const PathPdfsT& p, int s) {
+        if constexpr (kPerChannel) return channel_strategy_weight(kernels_.heuristic(), p, s);
+        else return strategy_weight(kernels_.heuristic(), p, s);
+    };
     // A light subpath is traced with probability light_probability_; it starts in the emitting
     // volume with probability q_volume_share, at a light otherwise (both kinds: one half each);
     // every density of a light subpath's start carries both.
@@ -579,8 +825,8 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::trace(
     // A BdptRecorder (NeeCountLearner) sees every strategy's contribution with the path's pdfs
     // summed by count group: s = 0 (and NEE toward the volume, `volume_x0`) at count 1, NEE toward
     // a light at nee_count, s >= 2 and t = 1 at the light subpath probability (THEORY 5.9).
-    auto record = [&](int s, const Spectrum& f, const Pdfs& p, bool volume_x0, bool splatted) {
-        if constexpr (BdptRecorder<C>) {
+    auto record = [&](int s, const Spectrum& f, const PathPdfsT& p, bool volume_x0, bool splatted) {
+        if constexpr (BdptRecorder<C> && !kPerChannel) {
             double q[kMaxPath + 1];
             if (!strategy_pdfs(p, q)) return;
             const int n = strategy_count(p);
@@ -598,12 +844,12 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::trace(
             (void)s, (void)f, (void)p, (void)volume_x0, (void)splatted;
         }
     };
-    auto add = [&](int s, int t, const Spectrum& f, const Pdfs& p, const Vec3& x0, bool x0_at_infinity = false,
+    auto add = [&](int s, int t, const Spectrum& f, const PathPdfsT& p, const Vec3& x0, bool x0_at_infinity = false,
                    bool volume_x0 = false) {
-        const float w = strategy_weight(kernels_.heuristic(), p, s);
+        const float w = weight_of(p, s);
         record(s, f, p, volume_x0, false);
         observe(s, t, f, w, p,
-                PathVertices<typename Sc::Spectral>{light, s, camera, s == 0 ? t - 1 : t, x0, x0_at_infinity});
+                PathVertices<typename Sc::Spectral, P>{light, s, camera, s == 0 ? t - 1 : t, x0, x0_at_infinity});
         L += f * w;
     };
     auto eval_at = [&](const V& v, const Vec3& wo, const Vec3& wi) {
@@ -630,17 +876,19 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::trace(
     };
 
     // s = 0: the camera subpath reaches an emitter after camera[0..t-2]; and the lights at infinity.
-    auto on_camera_hit = [&](V* path, int count, const SurfaceHit& hit, const Ray& ray, float nulls,
-                             const Spectrum& beta) {
+    auto on_camera_hit = [&](V* path, int count, const SurfaceHit& hit, const Ray& ray, const P& nulls,
+                             const Spectrum& beta, const auto& gamma) {
         const int t = count + 1;  // the emitter is z_{t-1}
         if (t - 2 > depth) return;
         const V& z = path[count - 1];  // the vertex the segment left (x_1)
         auto one_light = [&](int light_index, const Spectrum& Le, float dist) {
             if (!(Le != 0.f).any()) return;
             const Spectrum f = beta * Le;
+            if constexpr (kPerChannel) pdfs.gamma = gamma;
+            else (void)gamma;
             if (t == 2) {  // the camera sees the emitter: the only strategy
                 pdfs.k = 1;
-                pdfs.from_camera[0] = 1.f;
+                pdfs.from_camera[0] = broadcast<P>(1.f);
                 pdfs.nee = pdfs.emit = 0.f;
                 add(0, 2, f, pdfs, std::isfinite(dist) ? hit.p : z.p, !std::isfinite(dist));
                 return;
@@ -653,7 +901,7 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::trace(
                 const float d2 = glm::dot(d, d);
                 const EmissionDensity e = sc.lights.emission_pdf(light_index, hit.p, -w);
                 const float cos0 = std::abs(glm::dot(hit.ng, w));
-                pdfs.from_camera[0] = z.delta ? 1.f * cos0 / d2 * nulls : pdf_dir_z * cos0 / d2 * nulls;
+                pdfs.from_camera[0] = (z.delta ? 1.f : pdf_dir_z) * cos0 / d2 * nulls;
                 pdfs.emit = q_lights * e.pdf_pos;
                 pdfs.nee = nee_count * sc.lights.pdf(light_index, z.p, w) * cos0 / d2;
                 pdfs.from_light[1] = to_vertex_measure(e.pdf_dir, hit.p, z) * nulls * z.event;
@@ -695,7 +943,7 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::trace(
             const Spectrum f = beta * c.sigma_a * le / mu_bar;
             if (t == 2) {  // seen from the camera: the only strategy
                 pdfs.k = 1;
-                pdfs.from_camera[0] = 1.f;
+                pdfs.from_camera[0] = broadcast<P>(1.f);
                 pdfs.nee = pdfs.emit = 0.f;
                 add(0, 2, f, pdfs, y, false, true);
                 return;
@@ -726,19 +974,21 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::trace(
     camera[0].p = camera_ray.o;
     camera[0].beta = Spectrum::Ones();
     camera[0].medium = sc.camera_medium;
+    if constexpr (kPerChannel) camera[0].gamma = Spectrum::Ones();
     float camera_pdf = 0.f;  // the camera's density of the ray's direction (light tracing), else 0
     if constexpr (kLightTracing) camera_pdf = cam->pdf_dir(camera_ray.d);
     int nc = 0;
-    if constexpr (kEmissive)
-        nc = walk(sc, camera, 1, depth + 2, camera_ray, sc.camera_medium, camera_pdf, Spectrum::Ones(), lambda, rng,
-                  counter, on_camera_hit, status, on_camera_emission);
+    if constexpr (kEmissive && !kPerChannel)
+        nc = walk(sc, camera, 1, depth + 2, camera_ray, sc.camera_medium, camera_pdf, Spectrum::Ones(), lambda, channel,
+                  rng, counter, on_camera_hit, status, on_camera_emission);
     else
-        nc = walk(sc, camera, 1, depth + 2, camera_ray, sc.camera_medium, camera_pdf, Spectrum::Ones(), lambda, rng,
-                  counter, on_camera_hit, status);
+        nc = walk(sc, camera, 1, depth + 2, camera_ray, sc.camera_medium, camera_pdf, Spectrum::Ones(), lambda, channel,
+                  rng, counter, on_camera_hit, status);
 
     // The light subpath: from a light, or from the emitting volume.
     int nl = 0;
     float nee_y0 = 0.f;         // NEE's density of y_0 from y_1 (with its count at a light)
+    float emit_y0 = 0.f;        // the light subpath's density of y_0
     bool volume_start = true;  // y_0 lies in the emitting volume (else on a light)
     const int light_vertices = kLightTracing ? depth + 1 : depth;
     const bool traced = draw_technique(light_probability_, rng);
@@ -746,7 +996,7 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::trace(
     if (traced && depth >= (kLightTracing ? 1 : 2)) {
         const float uq = q_volume_share > 0.f && q_volume_share < 1.f ? rng.uniform() : 0.f;
         if (q_volume_share > 0.f && uq < q_volume_share) {
-            if constexpr (kEmissive) {
+            if constexpr (kEmissive && !kPerChannel) {
                 const float us = rng.uniform(), u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform(),
                             u3 = rng.uniform(), u4 = rng.uniform(), u5 = rng.uniform();
                 const int i = sc.select_emission(us);
@@ -771,10 +1021,11 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::trace(
                             y0.p = yv.p;
                             y0.medium = i;
                             y0.event = c->mu;  // a tentative collision's density there: mu_bar
-                            y0.pdf_fwd = q_volume * select * yv.pdf;
+                            y0.pdf_fwd = emit_y0 = q_volume * select * yv.pdf;
                             y0.beta = source / y0.pdf_fwd;
                             nl = walk(sc, light, 1, light_vertices, Ray{yv.p, w}, i, kInv4Pi,
-                                      Spectrum(y0.beta * (4.f * kPi)), lambda, rng, counter, [](auto&&...) {}, status);
+                                      Spectrum(y0.beta * (4.f * kPi)), lambda, channel, rng, counter,
+                                      [](auto&&...) {}, status);
                             nee_y0 = select * yv.pdf;
                         }
                     }
@@ -793,13 +1044,15 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::trace(
                 y0.light = e.light;
                 y0.delta_position = e.emission.delta_position;
                 y0.at_infinity = e.emission.at_infinity;
-                y0.pdf_fwd = q_lights * e.emission.pdf_pos;
-                y0.beta = e.emission.radiance / y0.pdf_fwd;
+                emit_y0 = q_lights * e.emission.pdf_pos;
+                y0.pdf_fwd = broadcast<P>(emit_y0);
+                y0.beta = e.emission.radiance / (q_lights * e.emission.pdf_pos);
+                if constexpr (kPerChannel) y0.gamma = Spectrum::Ones();
                 const int start = light_start_medium(sc, e.emission.p, e.emission.w);
                 if (start == -3) status = Status::InvalidInput;
                 else
                     nl = walk(sc, light, 1, light_vertices, Ray{e.emission.p, e.emission.w}, start, e.emission.pdf_dir,
-                              Spectrum(y0.beta * (e.emission.cos / e.emission.pdf_dir)), lambda, rng, counter,
+                              Spectrum(y0.beta * (e.emission.cos / e.emission.pdf_dir)), lambda, channel, rng, counter,
                               [](auto&&...) {}, status);
                 if (nl >= 2) {
                     const Vec3 d = y0.p - light[1].p;
@@ -815,23 +1068,62 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::trace(
     }
     if (traced) detail::record_light_walk(counter, light_work_before);
 
-    // Transmittance of a connection a -> b through the scene, with its nulls' P_n product (its
-    // work the light subpath's).
-    auto transmit = [&](const V& a, const V& b, float& nulls) -> Spectrum {
+    // A shadow ray's (a connection's) transmittance through the scene, ratio-tracked: its
+    // throughput (per channel f_lambda / p_c*), its nulls' P_n product and, per channel, the
+    // factor every strategy of the path shares over it (prod mu_bar_c(n_j) Tbar_c).
+    using GammaT = GammaOf<P>;
+    struct Shadow {
+        Status status = Status::Ok;
+        Spectrum tr = Spectrum::Zero();
+        P nulls = broadcast<P>(1.f);
+        GammaT gamma = unit_gamma<P>();
+    };
+    auto shadow = [&](const Ray& r, float distance, int start) {
+        Shadow out;
+        if constexpr (kPerChannel) {
+            const auto sh = detail::channel_shadow_through<Ch, A>(sc, r, distance, start, lambda, channel,
+                                                                  Spectrum::Ones(), true, rng, counter);
+            if (sh.end != SegmentEnd::Passed) {
+                out.status = detail::shadow_status(sh.end);
+                return out;
+            }
+            // A sampling channel's density below float's range beside another's: its weight is 0.
+            if (!(sh.f != 0.f).any() || !(sh.nee[channel] > 0.f)) return out;
+            out.tr = sh.f / sh.nee[channel];
+            out.nulls = (sh.nee > 0.f).select(sh.uni / sh.nee, 0.f);
+            out.gamma = relative_to_largest<Spectrum>(sh.nee);
+        } else {
+            const auto sh = detail::shadow_through(kernels_, sc, r, distance, start, lambda, rng, counter);
+            out.status = sh.status;
+            if (sh.status != Status::Ok) return out;
+            out.tr = sh.transmittance;
+            out.nulls = Mis::null_pdfs ? sh.null_pdf_product : 1.f;
+        }
+        return out;
+    };
+    // The shared factors of a path made of pieces (per channel), relative to the largest.
+    auto path_gamma = [&](const auto&... g) {
+        if constexpr (kPerChannel) return relative_to_largest<Spectrum>((... * g));
+        else return NoGamma{};
+    };
+
+    // Transmittance of a connection a -> b through the scene, with its nulls' P_n product and
+    // shared factors (its work the light subpath's).
+    auto transmit = [&](const V& a, const V& b, P& nulls, GammaT& gamma) -> Spectrum {
         const Vec3 d = b.p - a.p;
         const float dist = glm::length(d);
         if (!(dist > 0.f)) return Spectrum::Zero();
         const Vec3 w = d / dist;
         const double before = detail::recorder_work(counter);
-        const auto sh = detail::shadow_through(kernels_, sc, Ray{a.p, w}, detail::shadow_distance(dist),
-                                               a.medium_toward(w), lambda, rng, counter);
+        const Shadow sh = shadow(Ray{a.p, w}, detail::shadow_distance(dist), a.medium_toward(w));
         detail::record_light_walk(counter, before);
         if (sh.status != Status::Ok) {
             status = sh.status;
             return Spectrum::Zero();
         }
-        nulls = Mis::null_pdfs ? sh.null_pdf_product : 1.f;
-        return sh.transmittance;
+        nulls = sh.nulls;
+        gamma = sh.gamma;
+        return sh.tr;
     };
 
     for (int t = 2; t <= std::min(nc, depth + 1); ++t) {
@@ -852,24 +1144,25 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::trace(
                     y0.delta_position = ls.sample.delta;
                     const bool at_infinity = !std::isfinite(ls.sample.distance);
                     y0.p = at_infinity ? z.p : z.p + ls.sample.distance * w;
-                    const auto sh = detail::shadow_through(kernels_, sc, Ray{z.p, w},
-                                                           detail::shadow_distance(ls.sample.distance),
-                                                           z.medium_toward(w), lambda, rng, counter);
+                    const Shadow sh = shadow(Ray{z.p, w}, detail::shadow_distance(ls.sample.distance),
+                                             z.medium_toward(w));
                     detail::record_shadow_walk(counter, before, true);
                     if (sh.status != Status::Ok) status = sh.status;
-                    if (sh.status == Status::Ok && (sh.transmittance != 0.f).any()) {
-                        const float nulls = Mis::null_pdfs ? sh.null_pdf_product : 1.f;
-                        const Spectrum f = z.beta * fz.value * sh.transmittance * ls.sample.radiance /
-                                           (nee_count * ls.sample.pdf);
+                    if (sh.status == Status::Ok && (sh.tr != 0.f).any()) {
+                        const P& nulls = sh.nulls;
+                        const Spectrum f = z.beta * fz.value * sh.tr * ls.sample.radiance / (nee_count * ls.sample.pdf);
                         gather(0, t, t);  // camera[0..t-1]; the light point is x_0
+                        if constexpr (kPerChannel) pdfs.gamma = path_gamma(z.gamma, sh.gamma);
                         const float d2 = ls.sample.distance * ls.sample.distance;
                         if (ls.sample.delta) {  // a point or directional light: NEE alone reaches it
-                            pdfs.from_camera[0] = 0.f;
+                            pdfs.from_camera[0] = broadcast<P>(0.f);
                             pdfs.nee = nee_count * ls.sample.pdf;
                             pdfs.emit = at_infinity ? 0.f : q_lights * sc.lights.emission_pdf(ls.light, y0.p, -w).pdf_pos;
-                            pdfs.from_light[1] = at_infinity ? 0.f
-                                                             : to_vertex_measure(sc.lights.emission_pdf(ls.light, y0.p, -w).pdf_dir,
-                                                                                 y0.p, z) * nulls * z.event;
+                            if (at_infinity)
+                                pdfs.from_light[1] = broadcast<P>(0.f);
+                            else
+                                pdfs.from_light[1] = to_vertex_measure(sc.lights.emission_pdf(ls.light, y0.p, -w).pdf_dir,
+                                                                       y0.p, z) * nulls * z.event;
                         } else if (at_infinity) {
                             const EmissionDensity e = sc.lights.emission_pdf(ls.light, z.p, -w);
                             pdfs.from_camera[0] = fz.pdf * nulls;
@@ -943,12 +1236,14 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::trace(
             if (!(fy.value != 0.f).any()) continue;
             const auto fz = eval_at(z, z.wo, -w);
             if (!(fz.value != 0.f).any()) continue;
-            float nulls = 1.f;
-            const Spectrum tr = transmit(y, z, nulls);
+            P nulls = broadcast<P>(1.f);
+            GammaT gamma = unit_gamma<P>();
+            const Spectrum tr = transmit(y, z, nulls, gamma);
             if (!(tr != 0.f).any()) continue;
             const Spectrum f = y.beta * fy.value * tr * fz.value * z.beta / d2;
             gather(s, t, s + t - 1);
-            pdfs.emit = light[0].pdf_fwd;
+            if constexpr (kPerChannel) pdfs.gamma = path_gamma(y.gamma, gamma, z.gamma);
+            pdfs.emit = emit_y0;
             pdfs.nee = nee_y0;
             // The four densities the connection changes.
             pdfs.from_light[s] = to_vertex_measure(fy.pdf, y.p, z) * nulls * z.event;
@@ -981,20 +1276,22 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::trace(
             if (!(fy.value != 0.f).any()) continue;
             V eye_vertex;
             eye_vertex.p = eye;
-            float nulls = 1.f;
-            const Spectrum tr = transmit(y, eye_vertex, nulls);
+            P nulls = broadcast<P>(1.f);
+            GammaT gamma = unit_gamma<P>();
+            const Spectrum tr = transmit(y, eye_vertex, nulls, gamma);
             if (!(tr != 0.f).any()) continue;
             const Spectrum f = y.beta * fy.value * tr * (pc / d2);
             gather(s, 0, s);
-            pdfs.emit = light[0].pdf_fwd;
+            if constexpr (kPerChannel) pdfs.gamma = path_gamma(y.gamma, gamma);
+            pdfs.emit = emit_y0;
             pdfs.nee = nee_y0;
             pdfs.from_camera[s - 1] = to_vertex_measure(pc, eye, y) * nulls * y.event;
             const V& y2 = light[s - 2];
             pdfs.from_camera[s - 2] = to_vertex_measure(eval_at(y, -w, -y.wo).pdf, y.p, y2) * y.nulls_in * y2.event;
-            const float wt = strategy_weight(kernels_.heuristic(), pdfs, s);
+            const float wt = weight_of(pdfs, s);
             record(s, f, pdfs, volume_start, true);
             observe(s, 1, f, wt, pdfs,
-                    PathVertices<typename Sc::Spectral>{light, s, camera, 1, light[0].p, light[0].at_infinity});
+                    PathVertices<typename Sc::Spectral, P>{light, s, camera, 1, light[0].p, light[0].at_infinity});
             const Spectrum value = f * wt;
             if (all_finite(value)) splat(u, v, value);
             else status = Status::NonFinite;
@@ -1003,5 +1300,13 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth>::trace(
     if (!all_finite(L)) return {Spectrum::Zero(), Status::NonFinite};
     return {L, status};
 }
+
+/// Volumetric BDPT with per-channel pdfs (THEORY 5.3 with 5.5): each sample tracks its subpaths
+/// and connections with one channel chosen uniformly, every channel keeps its own densities of
+/// every vertex (its majorant and event probabilities in the nulls' and events' factors), and the
+/// heuristic runs over channels x strategies with one denominator. Media without emission; any
+/// majorant (per-channel ones are what it is for).
+template <mis::CombiningHeuristic H = mis::Balance, AbsorptionPolicy A = absorption::Weight, int MaxDepth = 32>
+using SpectralBdptEstimator = BdptEstimator<bdpt::NullScattering, H, A, MaxDepth, channels::SpectralMis>;
 
 }  // namespace nsp

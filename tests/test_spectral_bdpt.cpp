@@ -1,0 +1,564 @@
+// tests/test_spectral_bdpt.cpp: nsp::SpectralBdptEstimator, BDPT with per-channel pdfs (THEORY
+// 5.3 with 5.5): the weights over channels x strategies equal the brute-force heuristics and sum to
+// 1; each strategy alone, MIS over channels only, is unbiased and the channel-averaged pdfs of the
+// strategies are their true densities (the symmetry of tests/test_bdpt.cpp); against closed forms
+// per channel (the furnace of six emitting walls around a chromatic medium of albedo 1, with and
+// without light tracing, in Rgb and Hero<4>; single scattering from two point lights, by
+// quadrature) and against SpectralPathEstimator on a strongly chromatic cube over a floor; finite
+// output when the channels' densities lie 12 decades apart.
+#include <algorithm>
+#include <array>
+#include <cstdio>
+#include <cstdlib>
+#include <cmath>
+#include <map>
+#include <string>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
+#include "common.hpp"
+#include "host/shapes.hpp"
+#include "spectral.hpp"
+#include "surfaces.hpp"
+
+namespace {
+
+using namespace nsp_test;
+using nsp_host::Shapes;
+
+// k = 5 standard errors per channel, estimated from the samples, with fixed seeds: deterministic.
+constexpr double kSigmas = 5.0;
+
+template <SpectralMode S>
+using Mats = Materials<S, LambertianBsdf<S>, MirrorBsdf<S>>;
+template <SpectralMode S>
+using Ls = LightSampler<S, QuadLight<S>, EnvironmentLight<S>>;
+template <SpectralMode S>
+using M = HomogeneousMedium<S>;
+template <SpectralMode S>
+using Sc = SurfaceScene<Shapes, M<S>, ChannelMajorant<M<S>>, HenyeyGreensteinPhase, Mats<S>, Ls<S>>;
+
+/// A homogeneous chromatic medium over `box` under per-channel majorants 1.5 times each channel's
+/// extinction: every channel has nulls of its own P_n, and their pdfs enter the weights.
+template <SpectralMode S>
+SceneMedium<M<S>, ChannelMajorant<M<S>>, HenyeyGreensteinPhase> chromatic(Box box, typename S::Coefficient sigma_a,
+                                                                         typename S::Coefficient sigma_s, float g) {
+    const M<S> m(box, sigma_a, sigma_s);
+    return {m, ChannelMajorant<M<S>>(m, 1.5f), HenyeyGreensteinPhase(g)};
+}
+
+/// Runs `check(estimator, name)` for the balance heuristic (absorption as a weight) and the
+/// power heuristic (absorption as an event).
+template <int D = 32, class F>
+void for_each_spectral_bdpt(F check, EstimatorOptions opts = BdptEstimator<>::default_options()) {
+    check(SpectralBdptEstimator<mis::Balance, absorption::Weight, D>(opts), "balance");
+    check(SpectralBdptEstimator<mis::Power, absorption::Event, D>(opts), "power event");
+}
+
+/// Mean and SE per channel of n estimates along rays from make_ray, every status Ok.
+template <class E, class Scene, class Make>
+SpecStat<typename Scene::Spectral> estimate_channels(const E& est, const Scene& sc, int n, std::uint64_t seed,
+                                                     Make make_ray) {
+    using S = typename Scene::Spectral;
+    Pcg32 rng(seed, 5);
+    LookupCount counter;
+    SpecStat<S> s;
+    for (int i = 0; i < n; ++i) {
+        const auto lambda = draw_wavelengths<S>(rng);
+        const auto r = est.radiance(sc, make_ray(rng), lambda, rng, counter);
+        REQUIRE(r.status == Status::Ok);
+        s.add(r.value);
+    }
+    return s;
+}
+
+/// The image's average per channel over uniform (u, v) through `camera` with light tracing: each
+/// sample's return plus its light subpath's splats (wherever they land).
+template <class E, class Scene>
+SpecStat<typename Scene::Spectral> image_average_channels(const E& est, const Scene& sc, const PinholeCamera& camera,
+                                                          int n, std::uint64_t seed) {
+    using S = typename Scene::Spectral;
+    using Spectrum = typename S::Spectrum;
+    Pcg32 rng(seed, 2);
+    LookupCount counter;
+    SpecStat<S> s;
+    for (int i = 0; i < n; ++i) {
+        const auto lambda = draw_wavelengths<S>(rng);
+        Spectrum x = Spectrum::Zero();
+        auto splat = [&](float, float, const Spectrum& value) { x += value; };
+        const auto r = est.sample(sc, camera, rng.uniform(), rng.uniform(), lambda, rng, counter, splat);
+        REQUIRE(r.status == Status::Ok);
+        s.add(Spectrum(x + r.value));
+    }
+    return s;
+}
+
+template <SpectralMode S>
+void check_channels(const SpecStat<S>& s, const typename S::Spectrum& expected) {
+    for (std::size_t c = 0; c < s.ch.size(); ++c) {
+        CAPTURE(c);
+        CAPTURE(s.ch[c].mean);
+        CAPTURE(s.ch[c].se());
+        CAPTURE(expected[int(c)]);
+        CHECK(std::abs(s.ch[c].mean - expected[int(c)]) <= kSigmas * s.ch[c].se());
+    }
+}
+
+using Pdfs3 = bdpt::PathPdfs<16, Rgb::Spectrum>;
+
+/// Channel c's pdf of the path under strategy s, as a plain product times its shared factor
+/// gamma_c (THEORY 5.5 per channel, 5.3); 0 where a connection would end at a delta vertex.
+double brute_channel_pdf(const Pdfs3& p, int c, int s) {
+    if (s == p.k) {
+        if (!p.light_tracing || p.k < 2 || !p.connectible[p.k - 1]) return 0.0;
+    } else {
+        if (s == 1 && !p.connectible[1]) return 0.0;
+        if (s >= 2 && !(p.connectible[s - 1] && p.connectible[s])) return 0.0;
+    }
+    double v = s == 0 ? p.from_camera[0][c] : s == 1 ? p.nee : p.emit;
+    for (int i = 1; i < s; ++i) v *= p.from_light[i][c];
+    for (int i = std::max(s, 1); i < p.k; ++i) v *= p.from_camera[i][c];
+    return v * p.gamma[c];
+}
+
+TEST_CASE("spectral bdpt: the weights over channels x strategies are the heuristics of their pdfs and sum to 1") {
+    // Random per-channel densities over 12 decades, shared factors gamma_c over 6, delta vertices,
+    // paths of 2 to 15 vertices, with and without light tracing; uniform selection q_c = 1/3. The
+    // sampling channel c*'s weight w_(s,c*) = power(q p_(s,c*)) / sum_(c,s') power(q p_(s',c)) is
+    // returned divided by q (the factor of the throughput f / p_(s,c*)), so sum_(c*,s) q W = 1.
+    Pcg32 rng(23, 3);
+    const mis::Balance balance;
+    const mis::Power power(2.f);
+    const double q = 1.0 / 3.0;
+    for (int trial = 0; trial < 2000; ++trial) {
+        Pdfs3 p;
+        p.k = 1 + int(rng.uniform() * 14.f);
+        auto density = [&] { return std::pow(10.f, 12.f * rng.uniform() - 6.f); };
+        auto channels = [&] { return Rgb::Spectrum(density(), density(), density()); };
+        for (int i = 0; i < p.k; ++i) {
+            p.from_light[i] = channels();
+            p.from_camera[i] = channels();
+            p.connectible[i] = rng.uniform() > 0.15f;
+        }
+        p.connectible[0] = true;
+        p.light_tracing = rng.uniform() < 0.5f;
+        if (!p.light_tracing) p.from_camera[p.k - 1] = Rgb::Spectrum::Ones();
+        p.nee = density();
+        p.emit = rng.uniform() < 0.2f ? 0.f : density();
+        if (rng.uniform() < 0.2f) p.from_camera[0] = Rgb::Spectrum::Zero();
+        for (int c = 0; c < 3; ++c) p.gamma[c] = std::pow(10.f, -6.f * rng.uniform());
+        p.gamma /= p.gamma.maxCoeff();
+        const int count = bdpt::strategy_count(p);
+        double total = 0.0, total2 = 0.0;
+        for (int c = 0; c < 3; ++c)
+            for (int s = 0; s < count; ++s) {
+                const double x = q * brute_channel_pdf(p, c, s);
+                total += x;
+                total2 += x * x;
+            }
+        double sum_b = 0.0, sum_p = 0.0;
+        for (int c = 0; c < 3; ++c) {
+            p.channel = c;
+            for (int s = 0; s < count; ++s) {
+                const double x = q * brute_channel_pdf(p, c, s);
+                const float wb = bdpt::channel_strategy_weight(balance, p, s);
+                const float wp = bdpt::channel_strategy_weight(power, p, s);
+                CAPTURE(trial);
+                CAPTURE(c);
+                CAPTURE(s);
+                CHECK(q * wb == doctest::Approx(total > 0.0 ? x / total : 0.0).epsilon(1e-4));
+                CHECK(q * wp == doctest::Approx(total2 > 0.0 ? x * x / total2 : 0.0).epsilon(1e-4));
+                sum_b += q * wb;
+                sum_p += q * wp;
+            }
+        }
+        if (total > 0.0) {
+            CHECK(sum_b == doctest::Approx(1.0).epsilon(1e-5));
+            CHECK(sum_p == doctest::Approx(1.0).epsilon(1e-5));
+        }
+    }
+}
+
+/// The furnace of mode S: six walls of [-1, 1]^3 (Lambertian, albedo 0.5, two of them mirrors of
+/// reflectance 0.5) emitting 1 inward around a medium of albedo 1 in every channel whose
+/// extinction differs per channel; the camera inside. L = 1 / (1 - 0.5) = 2 in every channel.
+template <SpectralMode S>
+Sc<S> chromatic_furnace() {
+    Shapes shapes;
+    std::vector<QuadLight<S>> walls;
+    for (const CubeFace& f : inward_cube_faces()) {
+        const int index = int(walls.size());
+        const bool mirror = index == 1 || index == 4;
+        walls.push_back({f.corner, f.u, f.v, constant_coefficient<S>(1.f)});
+        shapes.quads.push_back({f.corner, f.u, f.v, {mirror ? 1 : 0, index, -1, 0}});
+    }
+    return Sc<S>(shapes, {chromatic<S>(Box{Vec3(-1.f), Vec3(1.f)}, constant_coefficient<S>(0.f), chroma<S>(0.5f, 1.5f, 4.f), 0.3f)},
+                 Mats<S>({LambertianBsdf<S>(constant_coefficient<S>(0.5f))}, {MirrorBsdf<S>(constant_coefficient<S>(0.5f))}),
+                 Ls<S>(LightSelection::Uniform, 2.f, walls, {}), 0);
+}
+
+TEST_CASE_TEMPLATE("spectral bdpt: the furnace of six emitting walls around a chromatic medium of albedo 1 (L = 2)", S,
+                   Rgb, Hero<4>) {
+    // Extinctions 0.5, 1.5 and 4 per channel (Hero<4>: a smooth curve between them), albedo 1:
+    // L = 2 in every channel whatever the extinction. Subpaths of up to 64 vertices (the walls
+    // halve the throughput about every third vertex). radiance() from inside, and the image with
+    // light tracing (its average over (u, v) is 2 too).
+    const Sc<S> sc = chromatic_furnace<S>();
+    const auto expected = S::Spectrum::Constant(2.f);
+    EstimatorOptions opts;
+    opts.max_depth = 64;
+    const PinholeCamera camera(Vec3(0.1f, -0.2f, 0.3f), Vec3(0.5f, 0.f, -1.f), Vec3(0.f, 1.f, 0.f), 70.f, 1.3f);
+    for_each_spectral_bdpt<64>(
+        [&](const auto& est, const char* name) {
+            CAPTURE(std::string(name));
+            check_channels<S>(estimate_channels(est, sc, 6000, 13, [](Pcg32& rng) {
+                                  return Ray{Vec3(0.1f, -0.2f, 0.3f), uniform_sphere(rng.uniform(), rng.uniform())};
+                              }),
+                              expected);
+            check_channels<S>(image_average_channels(est, sc, camera, 6000, 19), expected);
+        },
+        opts);
+}
+
+TEST_CASE("spectral bdpt: single scattering from two point lights in a cube over a floor (quadrature)") {
+    // tests/test_spectral_surfaces.cpp's scene and closed form (support/spectral.hpp): two point
+    // lights of chromatic intensity in a chromatic cube (HG 0.4) behind null interfaces over a
+    // floor of chromatic albedo, max_depth 1, the camera ray 0.15 from light 0. NEE and the
+    // connections from light subpaths started at the point lights draw these paths.
+    using PLs = LightSampler<Rgb, PointLight<Rgb>>;
+    using PSc = SurfaceScene<Shapes, M<Rgb>, ChannelMajorant<M<Rgb>>, HenyeyGreensteinPhase, Mats<Rgb>, PLs>;
+    const TwoPointLights setup;
+    Shapes shapes;
+    shapes.boxes.push_back({setup.cube.lo, setup.cube.hi, {-1, -1, 0, -1}});
+    shapes.quads.push_back({Vec3(-20.f, -1.5f, 20.f), Vec3(40.f, 0.f, 0.f), Vec3(0.f, 0.f, -40.f), {0, -1, -1, -1}});
+    const M<Rgb> m(setup.cube, setup.sigma_a, setup.sigma_s);
+    const PSc sc(shapes, {{m, ChannelMajorant<M<Rgb>>(m, 1.5f), HenyeyGreensteinPhase(0.4f)}},
+                 Mats<Rgb>({LambertianBsdf<Rgb>(setup.rho)}, {}), PLs(LightSelection::Power, 4.f, setup.points), -1);
+    EstimatorOptions opts = BdptEstimator<>::default_options();
+    opts.max_depth = 1;
+    for_each_spectral_bdpt(
+        [&](const auto& est, const char* name) {
+            CAPTURE(std::string(name));
+            check_channels<Rgb>(estimate_channels(est, sc, 20000, 47, [&](Pcg32&) { return Ray{setup.eye, setup.dir}; }),
+                                setup.expected());
+        },
+        opts);
+}
+
+template <class Maj>
+using CubeScene = SurfaceScene<Shapes, M<Rgb>, Maj, HenyeyGreensteinPhase, Mats<Rgb>, Ls<Rgb>>;
+
+/// The strongly chromatic cube over a floor under a quad lamp (and a dim sky when `sky`):
+/// extinction 0.4, 1.5 and 5 per channel, albedo 0.9, 0.7 and 0.95, HG 0.6, behind null
+/// interfaces; a floor of chromatic albedo. Majorant Maj: per channel (`slack` = 1.5 times each
+/// channel's extinction: every channel's Tbar_c and mu_bar_c its own, its P_n 1/3) or grey (1.5
+/// times the largest: one Tbar, but P_n,c of 0.95, 0.8 and 0.33).
+template <class Maj = ChannelMajorant<M<Rgb>>>
+CubeScene<Maj> chromatic_cube(bool sky, float slack = 1.5f) {
+    using Spectrum = Rgb::Spectrum;
+    Shapes shapes;
+    shapes.boxes.push_back({Vec3(-1.f), Vec3(1.f), {-1, -1, 0, -1}});
+    shapes.quads.push_back({Vec3(-3.f, -1.05f, 3.f), Vec3(6.f, 0.f, 0.f), Vec3(0.f, 0.f, -6.f), {0, -1, -1, -1}});
+    const QuadLight<Rgb> lamp{Vec3(-0.6f, 2.6f, -0.6f), Vec3(1.2f, 0.f, 0.f), Vec3(0.f, 0.f, 1.2f), Spectrum::Constant(12.f)};
+    shapes.quads.push_back({lamp.corner, lamp.edge_u, lamp.edge_v, {-1, 0, -1, -1}});
+    std::vector<EnvironmentLight<Rgb>> env;
+    if (sky) env.push_back(EnvironmentLight<Rgb>{Spectrum(0.03f, 0.05f, 0.08f)});
+    const Spectrum sigma_t(0.4f, 1.5f, 5.f), albedo(0.9f, 0.7f, 0.95f);
+    const M<Rgb> m(Box{Vec3(-1.f), Vec3(1.f)}, sigma_t * (1.f - albedo), sigma_t * albedo);
+    Maj majorant = [&] {
+        if constexpr (std::is_same_v<Maj, GlobalMajorant<M<Rgb>>>) return Maj(m, slack * m.max_extinction());
+        else return Maj(m, slack);
+    }();
+    return CubeScene<Maj>(shapes, {{m, majorant, HenyeyGreensteinPhase(0.6f)}},
+                          Mats<Rgb>({LambertianBsdf<Rgb>(Spectrum(0.7f, 0.5f, 0.3f))}, {MirrorBsdf<Rgb>(Spectrum::Constant(0.8f))}),
+                          Ls<Rgb>(LightSelection::Power, 4.f, {lamp}, env), -1);
+}
+
+Ray cube_ray(Pcg32& rng) {
+    const float u = rng.uniform(), v = rng.uniform();
+    return Ray{Vec3(0.f, 0.3f, -4.5f), glm::normalize(Vec3(0.7f * (2.f * u - 1.f), 0.7f * (1.f - 2.f * v), 1.f))};
+}
+
+PinholeCamera cube_view() {
+    return PinholeCamera(Vec3(0.f, 0.3f, -4.5f), Vec3(0.f, 0.3f, 0.f), Vec3(0.f, 1.f, 0.f),
+                         2.f * std::atan(0.7f) * 180.f / kPi, 1.f);
+}
+
+TEST_CASE("spectral bdpt: agrees with SpectralPathEstimator on a strongly chromatic cube over a floor") {
+    // No closed form: against spectral MIS + NEE (SpectralPathEstimator<SpectralMis,
+    // NullScatteringMis>) per channel, within 5 combined SE of the two independent estimates: the
+    // camera's rays (radiance()), and the image's average with light tracing against the same
+    // average of the path tracer over the same uniform (u, v).
+    const SpectralPathEstimator<channels::SpectralMis, strategy::NullScatteringMis, mis::Balance> pt(
+        BdptEstimator<>::default_options());
+    const PinholeCamera camera = cube_view();
+    for (const bool sky : {false, true}) {
+        const auto sc = chromatic_cube(sky);
+        const auto reference = estimate_channels(pt, sc, 60000, 3, cube_ray);
+        const auto reference_image = estimate_channels(pt, sc, 60000, 4, [&](Pcg32& rng) {
+            const float u = rng.uniform(), v = rng.uniform();
+            return camera.ray(u, v);
+        });
+        for_each_spectral_bdpt([&](const auto& est, const char* name) {
+            CAPTURE(std::string(name));
+            CAPTURE(sky);
+            const auto a = estimate_channels(est, sc, 30000, 5, cube_ray);
+            const auto b = image_average_channels(est, sc, camera, 30000, 6);
+            for (int c = 0; c < 3; ++c) {
+                CAPTURE(c);
+                CAPTURE(a.ch[c].mean);
+                CAPTURE(reference.ch[c].mean);
+                CAPTURE(b.ch[c].mean);
+                CAPTURE(reference_image.ch[c].mean);
+                CHECK(std::abs(a.ch[c].mean - reference.ch[c].mean) <=
+                      kSigmas * std::hypot(a.ch[c].se(), reference.ch[c].se()));
+                CHECK(std::abs(b.ch[c].mean - reference_image.ch[c].mean) <=
+                      kSigmas * std::hypot(b.ch[c].se(), reference_image.ch[c].se()));
+            }
+        });
+    }
+}
+
+/// Per channel and strategy (s, t) of paths of 1..3 interior vertices whose consecutive real
+/// vertices lie 0.3 apart: the strategy alone with MIS over channels only (f_lambda gamma_c* p_(s,c*)
+/// / sum_c q_c gamma_c p_(s,c), the one-sample estimate of s alone), and for every other strategy o
+/// the share pbar_o / sum_r pbar_r of the path s drew, pbar_s = sum_c q_c p_(s,c) the density of
+/// strategy s over the channel selection.
+struct ChannelStrategyRecord {
+    std::map<std::pair<int, int>, SpecStat<Rgb>> alone;
+    std::map<std::pair<int, int>, std::map<int, Stat>> share;
+    /// Per sampling channel c: p_(o,c) / sum_r p_(r,c) of the paths that s drew with c (0 on the
+    /// samples of the other channels).
+    std::array<std::map<std::pair<int, int>, std::map<int, Stat>>, 3> channel_share;
+};
+
+template <class E, class Scene>
+ChannelStrategyRecord record_channel_strategies(const E& est, const Scene& sc, int n_samples) {
+    constexpr int N = E::kMaxPath;
+    using Spectrum = Rgb::Spectrum;
+    ChannelStrategyRecord rec;
+    Pcg32 rng(43, 7);
+    LookupCount counter;
+    const PinholeCamera camera = cube_view();
+    std::map<std::pair<int, int>, Spectrum> value;
+    std::map<std::pair<int, int>, std::vector<double>> shares;
+    std::map<std::pair<int, int>, std::vector<double>> own_shares;
+    int channel = 0;
+    auto far_apart = [](const auto& v) {
+        std::vector<Vec3> x{v.x0};
+        for (int i = 1; i < v.s; ++i) x.push_back(v.light[i].p);
+        for (int j = v.t - 1; j >= 1; --j) x.push_back(v.camera[j].p);
+        for (std::size_t i = 1; i < x.size(); ++i)
+            if (glm::length(x[i] - x[i - 1]) < 0.3f) return false;
+        return true;
+    };
+    for (int i = 0; i < n_samples; ++i) {
+        value.clear();
+        shares.clear();
+        own_shares.clear();
+        auto observe = [&](int s, int t, const Spectrum& f, float, const auto& pdfs, const auto& vertices) {
+            if (!far_apart(vertices)) return;
+            double q[3 * (N + 1)];
+            REQUIRE(bdpt::channel_strategy_pdfs(pdfs, q));
+            const int count = bdpt::strategy_count(pdfs);
+            double own_sum = 0.0, total = 0.0;
+            std::vector<double> mixture(std::size_t(count), 0.0);
+            for (int c = 0; c < 3; ++c) {
+                own_sum += q[c * (N + 1) + s] / 3.0;
+                for (int o = 0; o < count; ++o) mixture[std::size_t(o)] += q[c * (N + 1) + o] / 3.0;
+            }
+            for (const double x : mixture) total += x;
+            REQUIRE(own_sum > 0.0);
+            value.try_emplace({s, t}, Spectrum::Zero());
+            value[{s, t}] += f * float(q[pdfs.channel * (N + 1) + s] / own_sum);
+            auto& sh = shares[{s, t}];
+            sh.resize(std::max(sh.size(), std::size_t(count)), 0.0);
+            for (int o = 0; o < count; ++o) sh[std::size_t(o)] += mixture[std::size_t(o)] / total;
+            channel = pdfs.channel;
+            double own_total = 0.0;
+            for (int o = 0; o < count; ++o) own_total += q[channel * (N + 1) + o];
+            auto& osh = own_shares[{s, t}];
+            osh.resize(std::max(osh.size(), std::size_t(count)), 0.0);
+            for (int o = 0; o < count; ++o) osh[std::size_t(o)] += q[channel * (N + 1) + o] / own_total;
+        };
+        auto splat = [](float, float, const Spectrum&) {};
+        const float u = rng.uniform(), v = rng.uniform();
+        const auto r = est.sample_observed(sc, camera, u, v, Rgb::Wavelengths{}, rng, counter, splat, observe);
+        REQUIRE(r.status == Status::Ok);
+        for (int n = 1; n <= 3; ++n)
+            for (int s = 0; s <= n + 1; ++s) {
+                const auto key = std::make_pair(s, n + 2 - s);
+                rec.alone[key].add(value.count(key) ? value[key] : Spectrum(Spectrum::Zero()));
+                const auto it = shares.find(key);
+                const auto own = own_shares.find(key);
+                for (int o = 0; o <= n + 1; ++o) {
+                    rec.share[key][o].add(it == shares.end() || std::size_t(o) >= it->second.size()
+                                              ? 0.0
+                                              : it->second[std::size_t(o)]);
+                    for (int c = 0; c < 3; ++c)
+                        rec.channel_share[std::size_t(c)][key][o].add(
+                            c != channel || own == own_shares.end() || std::size_t(o) >= own->second.size()
+                                ? 0.0
+                                : own->second[std::size_t(o)]);
+                }
+            }
+    }
+    return rec;
+}
+
+/// The checks on a record of paths of 1..3 interior vertices (see the test below).
+void check_channel_strategies(ChannelStrategyRecord& rec) {
+    for (int n = 1; n <= 3; ++n) {
+        const SpecStat<Rgb>& nee = rec.alone[{1, n + 1}];
+        for (int s = 0; s <= n + 1; ++s) {
+            const SpecStat<Rgb>& a = rec.alone[{s, n + 2 - s}];
+            for (int c = 0; c < 3; ++c) {
+                CAPTURE(n);
+                CAPTURE(s);
+                CAPTURE(c);
+                CAPTURE(a.ch[c].mean);
+                CAPTURE(nee.ch[c].mean);
+                CHECK(a.ch[c].mean > 0.0);
+                CHECK(std::abs(a.ch[c].mean - nee.ch[c].mean) <= kSigmas * std::hypot(a.ch[c].se(), nee.ch[c].se()));
+            }
+        }
+    }
+    auto worst_asymmetry = [](std::map<std::pair<int, int>, std::map<int, Stat>>& share) {
+        double worst = 0.0;
+        for (int n = 1; n <= 3; ++n)
+            for (int s = 0; s <= n + 1; ++s)
+                for (int o = s + 1; o <= n + 1; ++o) {
+                    const Stat& a = share[{s, n + 2 - s}][o];
+                    const Stat& b = share[{o, n + 2 - o}][s];
+                    worst = std::max(worst, std::abs(a.mean - b.mean) / std::hypot(a.se(), b.se()));
+                }
+        return worst;
+    };
+    const double mixture = worst_asymmetry(rec.share);
+    CAPTURE(mixture);
+    CHECK(mixture <= kSigmas);
+    for (int c = 0; c < 3; ++c) {
+        const double own = worst_asymmetry(rec.channel_share[std::size_t(c)]);
+        CAPTURE(c);
+        CAPTURE(own);
+        if (getenv("BDPT_DEBUG")) printf("mixture %.2f SE, channel %d %.2f SE\n", mixture, c, own);
+        CHECK(own <= kSigmas);
+    }
+}
+
+TEST_CASE("spectral bdpt: each strategy alone is unbiased per channel, every channel's pdfs true densities") {
+    // The chromatic cube under the lamp alone, no roulette, paths of n = 1..3 interior vertices,
+    // the image's average over uniform (u, v) with light tracing, under a per-channel and under a
+    // grey majorant.
+    // - Each (s, t) alone, with MIS over channels only, estimates every channel's radiance of its
+    //   paths: against NEE's (s = 1), 5 combined SE per channel. Any weights over channels that
+    //   sum to 1 leave this unbiased, so it checks the throughputs f_lambda / p_(s,c*).
+    // - The pdfs: channel c's densities are the strategies' true densities when c samples,
+    //   E_(s,c)[p_(o,c) / sum_r p_(r,c)] = E_(o,c)[p_(s,c) / sum_r p_(r,c)] (the symmetry of
+    //   tests/test_bdpt.cpp, per channel: a P_n,c misplaced breaks it), and the densities averaged
+    //   over the selection, pbar_s = sum_c q_c p_(s,c), are those of the mixture that a sample
+    //   draws from: E_s[pbar_o / sum pbar] = E_o[pbar_s / sum pbar] (a channel's shared factor
+    //   Tbar_c prod mu_bar_c left out breaks it). 5 combined SE.
+    EstimatorOptions opts;
+    opts.russian_roulette = false;
+    opts.max_depth = 3;
+    SUBCASE("per-channel majorant") {
+        ChannelStrategyRecord rec = record_channel_strategies(SpectralBdptEstimator<>(opts), chromatic_cube(false), 200000);
+        check_channel_strategies(rec);
+    }
+    SUBCASE("grey majorant") {
+        ChannelStrategyRecord rec = record_channel_strategies(SpectralBdptEstimator<>(opts),
+                                                              chromatic_cube<GlobalMajorant<M<Rgb>>>(false), 200000);
+        check_channel_strategies(rec);
+    }
+}
+
+TEST_CASE("spectral bdpt: every strategy's shared factors gamma_c are exp(-mu_c times the path's length in the medium)") {
+    // The chromatic cube under a per-channel majorant equal to its extinction (no nulls): the
+    // factor every strategy of a path shares in channel c, Tbar_c, is exp(-mu_t,c L) with L the
+    // length of the path inside the cube, whichever strategy drew it and however its segments
+    // were tracked or connected. The observer's gamma (relative to the largest channel) against
+    // that closed form, from the path's vertices, for every strategy of paths of up to 3 interior
+    // vertices, light tracing included. Tolerance 5e-3 relative: shadow rays and connections stop
+    // 1e-4 of their length short of their end (detail::shadow_distance, so that they do not hit
+    // the surface they end on), which leaves out up to 5 x 1e-4 x 6 = 3e-3 of optical depth here;
+    // a segment's factor left out or counted twice is off by exp(-5 x 0.3) or more.
+    // (Homogeneous media under these majorants make every channel's pdfs proportional across
+    // strategies, so the symmetry test above cannot see gamma; this checks it directly.)
+    using Spectrum = Rgb::Spectrum;
+    const Spectrum sigma_t(0.4f, 1.5f, 5.f);
+    const Box cube{Vec3(-1.f), Vec3(1.f)};
+    const auto sc = chromatic_cube(false, 1.f);  // extinction sigma_t
+    EstimatorOptions opts;
+    opts.russian_roulette = false;
+    opts.max_depth = 3;
+    const SpectralBdptEstimator<> est(opts);
+    const PinholeCamera camera = cube_view();
+    Pcg32 rng(29, 3);
+    LookupCount counter;
+    int checked = 0;
+    double worst = 0.0;
+    auto inside = [&](const Vec3& a, const Vec3& b) {
+        const float len = glm::length(b - a);
+        if (!(len > 0.f)) return 0.0;
+        const Interval in = cube.clip(Ray{a, (b - a) / len}, 0.f, len);
+        return in.t1 > in.t0 ? double(in.t1 - in.t0) : 0.0;
+    };
+    for (int i = 0; i < 20000; ++i) {
+        auto observe = [&](int s, int, const Spectrum&, float, const auto& pdfs, const auto& v) {
+            std::vector<Vec3> x{v.x0};
+            for (int j = 1; j < s; ++j) x.push_back(v.light[j].p);
+            for (int j = v.t - 1; j >= 0; --j) x.push_back(v.camera[j].p);
+            double length = 0.0;
+            for (std::size_t j = 1; j < x.size(); ++j) length += inside(x[j - 1], x[j]);
+            Spectrum expected;
+            for (int c = 0; c < 3; ++c) expected[c] = float(std::exp(-double(sigma_t[c]) * length));
+            expected /= expected.maxCoeff();
+            for (int c = 0; c < 3; ++c)
+                worst = std::max(worst, std::abs(double(pdfs.gamma[c]) - expected[c]) / (double(expected[c]) + 1e-30));
+            ++checked;
+        };
+        auto splat = [](float, float, const Spectrum&) {};
+        const auto r = est.sample_observed(sc, camera, rng.uniform(), rng.uniform(), Rgb::Wavelengths{}, rng, counter,
+                                           splat, observe);
+        REQUIRE(r.status == Status::Ok);
+    }
+    CAPTURE(checked);
+    CHECK(checked > 10000);
+    CHECK(worst <= 5e-3);
+}
+
+TEST_CASE("spectral bdpt: finite estimates and splats with channel densities 12 decades apart") {
+    // Extinction 1e-6, 1 and 1e6 in the three channels (optical depth 2e6 across the cube in the
+    // last), the camera inside: every return and splat finite, every status Ok.
+    using Spectrum = Rgb::Spectrum;
+    Shapes shapes;
+    shapes.boxes.push_back({Vec3(-1.f), Vec3(1.f), {-1, -1, 0, -1}});
+    shapes.quads.push_back({Vec3(-3.f, -1.05f, 3.f), Vec3(6.f, 0.f, 0.f), Vec3(0.f, 0.f, -6.f), {0, -1, -1, -1}});
+    const QuadLight<Rgb> lamp{Vec3(-0.5f, 2.6f, -0.5f), Vec3(1.f, 0.f, 0.f), Vec3(0.f, 0.f, 1.f), Spectrum::Constant(12.f)};
+    shapes.quads.push_back({lamp.corner, lamp.edge_u, lamp.edge_v, {-1, 0, -1, -1}});
+    const Spectrum sigma(1e-6f, 1.f, 1e6f);
+    const Sc<Rgb> sc(shapes, {chromatic<Rgb>(Box{Vec3(-1.f), Vec3(1.f)}, 0.5f * sigma, 0.5f * sigma, 0.3f)},
+                     Mats<Rgb>({LambertianBsdf<Rgb>(Spectrum::Constant(0.6f))}, {}),
+                     Ls<Rgb>(LightSelection::Power, 4.f, {lamp}, {EnvironmentLight<Rgb>{Spectrum::Constant(0.05f)}}), 0);
+    const PinholeCamera camera(Vec3(0.f, 0.2f, 0.f), Vec3(0.f, 0.f, 1.f), Vec3(0.f, 1.f, 0.f), 60.f);
+    for_each_spectral_bdpt([&](const auto& est, const char* name) {
+        CAPTURE(std::string(name));
+        Pcg32 rng(5, 5);
+        LookupCount counter;
+        bool finite = true;
+        auto splat = [&](float, float, const Spectrum& v) { finite = finite && v.allFinite(); };
+        for (int i = 0; i < 300; ++i) {
+            const auto a = est.radiance(sc, camera.ray(rng.uniform(), rng.uniform()), {}, rng, counter);
+            const auto b = est.sample(sc, camera, rng.uniform(), rng.uniform(), {}, rng, counter, splat);
+            CHECK(a.status == Status::Ok);
+            CHECK(b.status == Status::Ok);
+            CHECK(a.value.allFinite());
+            CHECK(b.value.allFinite());
+        }
+        CHECK(finite);
+    });
+}
+
+}  // namespace
