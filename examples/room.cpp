@@ -231,12 +231,19 @@ int main(int argc, char** argv) {
             "uni-nee-mis_spectral-mis_global");
         run(chroma_channel, SpectralPathEstimator<channels::SpectralMis, strategy::NullScatteringMis, mis::Balance>{},
             "uni-nee-mis_spectral-mis_per-channel");
+        // BDPT (light tracing on), grey pdfs under the grey majorant and per-channel pdfs under the
+        // per-channel majorant; appended, so the rows above keep their seeds.
+        run_splatting(chroma_grey, BdptEstimator<bdpt::NullScattering, mis::Balance>{}, "bdpt_null-mis_grey_balance");
+        run_splatting(chroma_channel, SpectralBdptEstimator<mis::Balance>{}, "bdpt_spectral-mis_per-channel");
         std::vector<Row> chromatic(rows.begin() + std::ptrdiff_t(first), rows.end());
         failed += print_table("Room, chromatic cloud (rgb", chromatic, 3, run_res, run_spp, threads);
         std::printf("room chromatic: grey-majorant PathEstimator / spectral MIS (per-channel majorant) in cpu-s*var: %.3g "
                     "(the grey estimator's variance is practically infinite on this medium: its sample variance "
                     "understates it; docs/chromatic.md)\n",
                     cost(chromatic, 0) / cost(chromatic, 3));
+        std::printf("room chromatic: bdpt_spectral-mis_per-channel / uni-nee-mis_spectral-mis_per-channel in cpu-s*var: "
+                    "%.3g; / bdpt_null-mis_grey_balance: %.3g\n",
+                    cost(chromatic, 5) / cost(chromatic, 3), cost(chromatic, 5) / cost(chromatic, 4));
     }
 
     // Table 3: the plume (the cloud's smoke with a flame inside it, an emissive medium), Mono, in
