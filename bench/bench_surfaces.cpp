@@ -12,8 +12,13 @@
 //   strategy families' counts per sample (hits s = 0, NEE s = 1, connections s >= 2, each one
 //   evaluated path; splats t = 1 with light tracing) and the stack its subpaths take (bytes,
 //   MaxDepth = 32).
+// - BM_ChromaticRoom/<estimator>: one sample of the room around the chromatic cloud (Rgb,
+//   extinction 5, 20 and 80 per unit density: nsp_room's second table), spectral MIS + NEE and
+//   per-channel BDPT under per-channel majorants, grey BDPT under the grey one; the BDPT rows with
+//   light tracing through the room's pinhole camera, with their subpaths' stack (bytes).
 #include <array>
 #include <string>
+#include <type_traits>
 
 #include <benchmark/benchmark.h>
 
@@ -131,9 +136,54 @@ void BM_Lantern(benchmark::State& state) {
         state.counters["connections/sample"] = connections / n;
         state.counters["splats/sample"] = splats / n;
         state.counters["subpath_bytes"] =
-            double(sizeof(nsp::bdpt::Vertex<nsp::Mono>) * (2 * E::kMaxDepth + 3) + sizeof(typename E::Pdfs));
+            double(sizeof(typename E::template VertexFor<nsp::Mono>) * (2 * E::kMaxDepth + 3) + sizeof(typename E::Pdfs));
     }
 }
+
+/// The chromatic room under per-channel majorants (kPerChannel) or the grey one; one sample per
+/// iteration: BDPT through the room's pinhole camera with light tracing, the path tracer on the
+/// camera rays.
+template <class E, bool kPerChannelMajorant>
+void BM_ChromaticRoom(benchmark::State& state) {
+    using CM = nsp::DenseGridMedium<nsp::Rgb>;
+    using Maj = std::conditional_t<kPerChannelMajorant, nsp::ChannelMajorant<CM>, nsp::GlobalMajorant<CM>>;
+    static const auto scene = [] {
+        const CM chroma = nsp_examples::make_chromatic_medium<nsp::Rgb>();
+        return nsp_examples::make_room_scene(chroma, Maj(chroma));
+    }();
+    const E estimator;
+    nsp::Pcg32 rng(6, 66);
+    nsp::LookupCount counter;
+    std::size_t i = 0;
+    const nsp::PinholeCamera camera = nsp_examples::room_pinhole();
+    for (auto _ : state) {
+        if constexpr (requires { E::kMaxPath; }) {
+            const nsp::Ray& ray = room_rays()[i];
+            float u = 0.f, v = 0.f;
+            camera.raster(ray.d, u, v);
+            double sink = 0.0;
+            auto splat = [&](float, float, const auto& value) { sink += double(value[0]); };
+            auto r = estimator.sample(scene, camera, u, v, {}, rng, counter, splat);
+            benchmark::DoNotOptimize(r);
+            benchmark::DoNotOptimize(sink);
+        } else {
+            auto r = estimator.radiance(scene, room_rays()[i], {}, rng, counter);
+            benchmark::DoNotOptimize(r);
+        }
+        i = (i + 1) & kSetMask;
+    }
+    report_lookups(state, counter, "lookups/sample");
+    if constexpr (requires { E::kMaxPath; })
+        state.counters["subpath_bytes"] =
+            double(sizeof(typename E::template VertexFor<nsp::Rgb>) * (2 * E::kMaxDepth + 3) +
+                   sizeof(typename E::template PdfsFor<nsp::Rgb>));
+}
+
+using SpectralNsmis = nsp::SpectralPathEstimator<nsp::channels::SpectralMis, nsp::strategy::NullScatteringMis, nsp::mis::Balance>;
+BENCHMARK_TEMPLATE(BM_ChromaticRoom, SpectralNsmis, true)->Name("BM_ChromaticRoom/spectral-mis+nee:per-channel-majorant");
+BENCHMARK_TEMPLATE(BM_ChromaticRoom, nsp::BdptEstimator<>, false)->Name("BM_ChromaticRoom/bdpt-null-mis:grey+light-tracing");
+BENCHMARK_TEMPLATE(BM_ChromaticRoom, nsp::SpectralBdptEstimator<>, true)
+    ->Name("BM_ChromaticRoom/bdpt-spectral-mis:per-channel-majorant+light-tracing");
 
 using Uni = nsp::PathEstimator<nsp::strategy::Unidirectional>;
 using Nee = nsp::PathEstimator<nsp::strategy::NextEvent>;
