@@ -4,7 +4,8 @@
 // them): the grey cloud (Mono, 96x96 by default) with every strategy of nsp::PathEstimator that
 // renders surfaces (the equiangular ones aimed at the lamp's centre) and nsp::BdptEstimator, then the chromatic cloud
 // (Rgb, half the size and spp) with the grey-majorant PathEstimator against
-// nsp::SpectralPathEstimator's per-channel pdfs, then the glowing plume (the cloud's smoke with a
+// nsp::SpectralPathEstimator's per-channel pdfs and grey BDPT against nsp::SpectralBdptEstimator,
+// then the glowing plume (the cloud's smoke with a
 // flame in it, an emissive medium; Mono, half the size and spp) with emission and lights in one MIS,
 // then the lantern (the lamp boxed above the cloud, opening into it: the BDPT scene; half the
 // size and spp) with the path tracers against BdptEstimator's directional and null-scattering MIS
