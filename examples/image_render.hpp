@@ -12,7 +12,6 @@
 #include <ctime>
 #include <functional>
 #include <string>
-#include <stdexcept>
 #include <thread>
 #include <vector>
 
@@ -261,49 +260,36 @@ Row render_splatting(const Sc& scene, const std::vector<E>& ladder, const Cam& c
         for (auto& t : pool) t.join();
     };
     const int first = std::min(pilot, spp);
-    // A NeeCountLearner learns the grey BDPT's counts; per-channel BDPT renders at fixed counts.
-    constexpr bool kLearns = [] {
-        if constexpr (requires { E::kPerChannel; }) return !E::kPerChannel;
-        else return true;
-    }();
-    if (first > 0 && !kLearns) {
-        std::string message = "render_splatting: ";
-        message += name;
-        message += " cannot learn its counts";
-        throw std::invalid_argument(message);
-    }
-    if constexpr (kLearns) {
-        if (first > 0) {
-            // Slot j learns tiles j, j + kSlots, ... in order; threads take whole slots.
-            std::vector<nsp::NeeCountLearner> slots(static_cast<std::size_t>(kSlots));
-            std::atomic<int> next_slot{0};
-            auto learn = [&](Buffers& out) {
-                const double cpu0 = thread_cpu_seconds();
-                for (int j; (j = next_slot.fetch_add(1)) < kSlots;)
-                    for (int t = j; t < n_tiles; t += kSlots) {
-                        nsp::NeeCountLearner learner;
-                        const int x0 = (t % tiles_x) * kTile, y0 = (t / tiles_x) * kTile;
-                        for (int y = y0; y < std::min(res, y0 + kTile); ++y)
-                            for (int x = x0; x < std::min(res, x0 + kTile); ++x) {
-                                run_samples(out, ladder[0], learner, x, y, 0, first,
-                                            [&](double v) { learner.end_sample(v); });
-                                learner.end_pixel();
-                            }
-                        slots[std::size_t(j)].merge(learner);
-                        out.lookups += learner.count();
-                        out.steps += learner.steps();
-                    }
-                out.cpu += thread_cpu_seconds() - cpu0;
-            };
-            run_pool(learn);
-            nsp::NeeCountLearner all;
-            for (const nsp::NeeCountLearner& l : slots) all.merge(l);
-            const nsp::TechniqueCounts c = all.choose_counts();
-            if (chosen) *chosen = c;
-            if (ladder.size() == std::size_t(kC * kC))
-                pair = std::size_t(nsp::NeeCountLearner::candidate_index(c.nee) * kC +
-                                   nsp::NeeCountLearner::candidate_index(c.light_subpath));
-        }
+    if (first > 0) {
+        // Slot j learns tiles j, j + kSlots, ... in order; threads take whole slots.
+        std::vector<nsp::NeeCountLearner> slots(static_cast<std::size_t>(kSlots));
+        std::atomic<int> next_slot{0};
+        auto learn = [&](Buffers& out) {
+            const double cpu0 = thread_cpu_seconds();
+            for (int j; (j = next_slot.fetch_add(1)) < kSlots;)
+                for (int t = j; t < n_tiles; t += kSlots) {
+                    nsp::NeeCountLearner learner;
+                    const int x0 = (t % tiles_x) * kTile, y0 = (t / tiles_x) * kTile;
+                    for (int y = y0; y < std::min(res, y0 + kTile); ++y)
+                        for (int x = x0; x < std::min(res, x0 + kTile); ++x) {
+                            run_samples(out, ladder[0], learner, x, y, 0, first,
+                                        [&](double v) { learner.end_sample(v); });
+                            learner.end_pixel();
+                        }
+                    slots[std::size_t(j)].merge(learner);
+                    out.lookups += learner.count();
+                    out.steps += learner.steps();
+                }
+            out.cpu += thread_cpu_seconds() - cpu0;
+        };
+        run_pool(learn);
+        nsp::NeeCountLearner all;
+        for (const nsp::NeeCountLearner& l : slots) all.merge(l);
+        const nsp::TechniqueCounts c = all.choose_counts();
+        if (chosen) *chosen = c;
+        if (ladder.size() == std::size_t(kC * kC))
+            pair = std::size_t(nsp::NeeCountLearner::candidate_index(c.nee) * kC +
+                               nsp::NeeCountLearner::candidate_index(c.light_subpath));
     }
     std::atomic<int> next{0};
     auto work = [&](Buffers& out) {

@@ -139,13 +139,14 @@ int main(int argc, char** argv) {
     // BDPT (null-scattering MIS, balance, light tracing) with its NEE count and light subpath
     // probability learned for the image from a pilot of spp / 32 samples per pixel (2-16) at
     // counts 1 (THEORY 5.9, nsp::NeeCountLearner); the choice printed under the table.
-    auto learned_render = [&](const auto& scene, const nsp::PinholeCamera& camera) {
-        const char* name = "bdpt_null-mis_balance_learned";
+    // `channels`: bdpt::Grey{}, or channels::SpectralMis{} (per-channel pdfs, SpectralBdptEstimator).
+    auto learned_render = [&](const auto& scene, const nsp::PinholeCamera& camera, const char* name, auto channels) {
+        using Channels = decltype(channels);
         nsp::TechniqueCounts chosen;
         auto make = [](float nee, float light) {
             nsp::EstimatorOptions o = BdptEstimator<>::default_options();
             o.nee_count = nee;
-            return BdptEstimator<bdpt::NullScattering, mis::Balance>(o, {}, light);
+            return BdptEstimator<bdpt::NullScattering, mis::Balance, absorption::Weight, 32, Channels>(o, {}, light);
         };
         const int pilot = nsp_examples::RenderRequest::pilot_spp(run_spp);
         rows.push_back(nsp_examples::render_image_splatting_learned(scene, make, camera, name, run_res, run_spp, threads,
@@ -236,6 +237,8 @@ int main(int argc, char** argv) {
         // per-channel majorant; appended, so the rows above keep their seeds.
         run_splatting(chroma_grey, BdptEstimator<bdpt::NullScattering, mis::Balance>{}, "bdpt_null-mis_grey_balance");
         run_splatting(chroma_channel, SpectralBdptEstimator<mis::Balance>{}, "bdpt_spectral-mis_per-channel");
+        learned_render(chroma_channel, nsp_examples::room_pinhole(), "bdpt_spectral-mis_per-channel_learned",
+                       channels::SpectralMis{});
         std::vector<Row> chromatic(rows.begin() + std::ptrdiff_t(first), rows.end());
         failed += print_table("Room, chromatic cloud (rgb", chromatic, 3, run_res, run_spp, threads);
         std::printf("room chromatic: grey-majorant PathEstimator / spectral MIS (per-channel majorant) in cpu-s*var: %.3g "
@@ -245,6 +248,10 @@ int main(int argc, char** argv) {
         std::printf("room chromatic: bdpt_spectral-mis_per-channel / uni-nee-mis_spectral-mis_per-channel in cpu-s*var: "
                     "%.3g; / bdpt_null-mis_grey_balance: %.3g\n",
                     cost(chromatic, 5) / cost(chromatic, 3), cost(chromatic, 5) / cost(chromatic, 4));
+        std::printf("room chromatic: bdpt_spectral-mis_per-channel_learned / bdpt_spectral-mis_per-channel in "
+                    "cpu-s*var: %.3g\n",
+                    cost(chromatic, 6) / cost(chromatic, 5));
+        print_notes();
     }
 
     // Table 3: the plume (the cloud's smoke with a flame inside it, an emissive medium), Mono, in
@@ -291,7 +298,7 @@ int main(int argc, char** argv) {
         run_splatting(lantern, BdptEstimator<bdpt::NullScattering, mis::Power>{}, "bdpt_null-mis_power");
         run(lantern, BdptEstimator<bdpt::Directional, mis::Balance>{}, "bdpt_directional-mis_balance_no-t1");
         run(lantern, BdptEstimator<bdpt::NullScattering, mis::Balance>{}, "bdpt_null-mis_balance_no-t1");
-        learned_render(lantern, nsp_examples::room_pinhole());
+        learned_render(lantern, nsp_examples::room_pinhole(), "bdpt_null-mis_balance_learned", bdpt::Grey{});
         std::vector<Row> lantern_rows(rows.begin() + std::ptrdiff_t(first_lantern), rows.end());
         failed += print_table("Lantern (mono", lantern_rows, 4, run_res, run_spp, threads,
                         "the cloud over a floor, lit only by a lamp in a box that opens downward into it");
@@ -346,7 +353,7 @@ int main(int argc, char** argv) {
             cloud_render(BdptEstimator<bdpt::NullScattering, mis::Balance>{}, "bdpt_null-mis_balance");
             cloud_render(BdptEstimator<bdpt::NullScattering, mis::Balance>(BdptEstimator<>::default_options(), {}, 0.25f),
                          "bdpt_null-mis_balance_light-0.25");  // a light subpath on 1/4 of the samples
-            learned_render(cloud, nsp_examples::cloud_pinhole());
+            learned_render(cloud, nsp_examples::cloud_pinhole(), "bdpt_null-mis_balance_learned", bdpt::Grey{});
             std::vector<Row> setup_rows(rows.begin() + std::ptrdiff_t(first_setup), rows.end());
             const bool a = setup == nsp_examples::LightSetup::A;
             failed += print_table(a ? "Cloud, set-up A (mono" : "Cloud, set-up B (mono", setup_rows, 2, run_res, run_spp,

@@ -780,9 +780,6 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
     using V = VertexT<Sc>;
     using P = PdfType<Ch, typename Sc::Spectral>;
     using PathPdfsT = PdfsFor<typename Sc::Spectral>;
-    static_assert(!(kPerChannel && BdptRecorder<C>),
-                  "nsp::BdptEstimator: a NeeCountLearner learns the grey BDPT's counts; per-channel BDPT takes "
-                  "fixed counts");
     const int depth = kernels_.options().max_depth;
     Spectrum L = Spectrum::Zero();
     Status status = Status::Ok;
@@ -825,18 +822,33 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
     // A BdptRecorder (NeeCountLearner) sees every strategy's contribution with the path's pdfs
     // summed by count group: s = 0 (and NEE toward the volume, `volume_x0`) at count 1, NEE toward
     // a light at nee_count, s >= 2 and t = 1 at the light subpath probability (THEORY 5.9).
+    // Per channel the sums run over channels x strategies, each channel's weighed by its
+    // selection probability (the one-sample denominator, THEORY 5.3 with 5.9).
     auto record = [&](int s, const Spectrum& f, const PathPdfsT& p, bool volume_x0, bool splatted) {
-        if constexpr (BdptRecorder<C> && !kPerChannel) {
-            double q[kMaxPath + 1];
-            if (!strategy_pdfs(p, q)) return;
+        if constexpr (BdptRecorder<C>) {
             const int n = strategy_count(p);
-            double p_fixed = q[0], p_nee = 0.0, p_light = 0.0;
-            if (n > 1) (volume_x0 ? p_fixed : p_nee) += q[1];
-            for (int r = 2; r < n; ++r) p_light += q[r];
+            double p_fixed = 0.0, p_nee = 0.0, p_light = 0.0, own = 0.0;
+            auto add_group = [&](const double* q, double selection) {
+                p_fixed += selection * q[0];
+                if (n > 1) (volume_x0 ? p_fixed : p_nee) += selection * q[1];
+                for (int r = 2; r < n; ++r) p_light += selection * q[r];
+            };
+            if constexpr (kPerChannel) {
+                constexpr int kChannels = int(Spectrum::SizeAtCompileTime);
+                double q[kChannels * (kMaxPath + 1)];
+                if (!channel_strategy_pdfs(p, q)) return;
+                for (int ch = 0; ch < kChannels; ++ch) add_group(q + ch * (kMaxPath + 1), 1.0 / kChannels);
+                own = q[p.channel * (kMaxPath + 1) + s];
+            } else {
+                double q[kMaxPath + 1];
+                if (!strategy_pdfs(p, q)) return;
+                add_group(q, 1.0);
+                own = q[s];
+            }
             const BdptTechnique group = s == 0 ? BdptTechnique::Fixed
                                         : s == 1 ? (volume_x0 ? BdptTechnique::Fixed : BdptTechnique::Nee)
                                                  : BdptTechnique::Light;
-            detail::record_bdpt(counter, float(double(f.mean()) * q[s]), float(p_fixed),
+            detail::record_bdpt(counter, float(double(f.mean()) * own), float(p_fixed),
                                 float(p_nee / double(nee_count)), float(p_light / double(light_probability_)),
                                 nee_count, light_probability_, group,
                                 splatted);
