@@ -1,5 +1,7 @@
 // nsp/estimators/bdpt.hpp: volumetric bidirectional path tracing over a SurfaceScene with full
-// null-vertex MIS (THEORY 5.5), grey (one pdf for every channel, as PathEstimator).
+// null-vertex MIS (THEORY 5.5), grey (one pdf for every channel, as PathEstimator) or per channel
+// (SpectralBdptEstimator: every channel's pdfs, channels x strategies in one denominator, THEORY
+// 5.3 with 5.5).
 //
 // A camera subpath and a light subpath are delta-tracked through the scene's media and surfaces
 // (the same VertexKernels and interface crossings as estimators/surface_path.hpp). Every real
@@ -58,6 +60,7 @@
 #include "../surface_scene.hpp"
 #include "../vertex.hpp"
 #include "common.hpp"
+#include "spectral_surface_emission.hpp"
 #include "spectral_surface_equiangular.hpp"
 #include "surface_emission.hpp"
 #include "surface_walk.hpp"
@@ -111,6 +114,20 @@ template <class P>
 GammaOf<P> unit_gamma() noexcept {
     if constexpr (std::is_same_v<P, float>) return NoGamma{};
     else return P::Ones();
+}
+
+/// A majorant lookup's value (a float, or one per channel) as densities of type P.
+template <class P, class V>
+P majorants(const V& mu) noexcept {
+    if constexpr (std::is_same_v<P, float>) return float(mu);
+    else return nsp::detail::broadcast_majorant<P>(mu);
+}
+
+/// A majorant lookup's value in channel c (a grey majorant's in every channel).
+template <class P, class V>
+float majorant_at(const V& mu, int c) noexcept {
+    if constexpr (std::is_same_v<V, float>) return mu;
+    else return mu[c];
 }
 
 /// Broadcasts a density common to every channel (a light's emission, a direction pdf) into P.
@@ -412,7 +429,8 @@ int light_start_medium(const Sc& sc, const Vec3& p, const Vec3& w) noexcept {
 /// Volumetric BDPT (see the header comment): MIS policy Mis, heuristic H, absorption policy A of
 /// the tracked segments, subpaths of at most MaxDepth real vertices (EstimatorOptions::max_depth
 /// must not exceed it). radiance() has PathEstimator's signature, so a host's pixel loop calls
-/// either the same way. Grey: exact for Mono and grey media, as PathEstimator.
+/// either the same way. Channel axis Ch: bdpt::Grey (one pdf, exact for Mono and grey media, as
+/// PathEstimator) or channels::SpectralMis (every channel's pdfs: SpectralBdptEstimator).
 template <bdpt::MisPolicy Mis = bdpt::NullScattering, mis::CombiningHeuristic H = mis::Balance,
           AbsorptionPolicy A = absorption::Weight, int MaxDepth = 32, bdpt::ChannelAxis Ch = bdpt::Grey>
 class BdptEstimator {
@@ -540,10 +558,7 @@ private:
             static_assert(!is_per_channel_majorant_v<typename Sc::MajorantType, typename Sc::MediumType>,
                           "nsp::BdptEstimator<..., bdpt::Grey> drives every channel with one pdf and needs a grey "
                           "majorant (channels::SpectralMis: one per channel)");
-        else
-            static_assert(!EmissiveMedium<typename Sc::MediumType>,
-                          "nsp::BdptEstimator with per-channel pdfs renders media without emission (grey BDPT "
-                          "or SpectralPathEstimator render emissive media)");
+
         static_assert(std::remove_cvref_t<decltype(std::declval<Sc>().lights)>::bidirectional_ready(),
                       "nsp::BdptEstimator: every light model must start light subpaths (EmittingLight: "
                       "sample_emission, emission_pdf) or lie at infinity / be a delta light");
@@ -567,8 +582,8 @@ private:
         float nulls, pdf_dir;
         void operator()(float t, const Coefficients<typename Sc::Spectral>& c, float mu_bar,
                         const typename Sc::Spectrum& w, float null_pdf_product) const {
-            f(path, count, medium, ray.at(t), c, mu_bar, typename Sc::Spectrum(beta * w),
-              Mis::null_pdfs ? nulls * null_pdf_product : 1.f, pdf_dir);
+            f(path, count, medium, ray.at(t), c, mu_bar, mu_bar, typename Sc::Spectrum(beta * w),
+              Mis::null_pdfs ? nulls * null_pdf_product : 1.f, pdf_dir, bdpt::NoGamma{});
         }
     };
 
@@ -590,6 +605,36 @@ private:
             *last_null = (mu > 0.f).select(d.null / mu, 0.f);
             *last_event = d.scatter;
             *pending = true;
+        }
+    };
+
+    /// Per channel: the walk's visitor of a tracked piece, ChannelNullVisit's bookkeeping and, in an
+    /// emissive medium, the collision estimator at every tentative collision y (THEORY 5.7 with
+    /// 5.3): the throughput up to y over the sampling channel's density of reaching it, every
+    /// channel's null product before y and the subpath's shared factors up to y.
+    template <class Sc, class F>
+    struct ChannelWalkVisit {
+        static constexpr bool enabled = true;
+        using S = typename Sc::Spectral;
+        using Spec = typename S::Spectrum;
+        ChannelNullVisit<S> null_visit;
+        F* emission;  // the walk's emission callback (NoEmission: none)
+        const VertexT<Sc>* path;
+        int count, medium, channel;
+        const Ray& ray;
+        const Spec& beta0;  // the throughput where the segment started
+        const Spec& nulls;  // the segment's null product before this piece
+        float pdf_dir;
+        template <class State>
+        void operator()(float t, const Coefficients<S>& k, const Spec& mu, const Spec& tbar, const State& st) const {
+            null_visit(t, k, mu, tbar, st);
+            if constexpr (!std::is_same_v<F, NoEmission>) {
+                const float p_here = st.uni[channel] * tbar[channel];
+                if (!(p_here > 0.f)) return;
+                (*emission)(path, count, medium, ray.at(t), k, mu, mu[channel], Spec(beta0 * st.f * tbar / p_here),
+                            Spec(nulls * null_visit.nulls->template cast<float>()), pdf_dir,
+                            relative_to_largest<Spec>(path[count - 1].gamma * st.eq.vertex * tbar));
+            }
         }
     };
 
@@ -655,7 +700,9 @@ int BdptEstimator<Mis, H, A, MaxDepth, Ch>::walk(const Sc& sc, VertexT<Sc>* path
                 bool pending = false;
                 const ChannelTrack seg = track_channels_delta_visiting<Ch, A>(
                     m.medium, m.majorant, ray, hit.t, lambda, channel, st, false, rng, counter,
-                    ChannelNullVisit<S>{&piece_nulls, &last_null, &last_event, &pending});
+                    ChannelWalkVisit<Sc, OnEmission>{{&piece_nulls, &last_null, &last_event, &pending},
+                                                     &on_emission, path, count, medium, channel, ray, beta0, nulls,
+                                                     pdf_dir});
                 if (const Status fs = flight_status(seg.end); fs != Status::Ok) {
                     status = fs;
                     return count;
@@ -900,7 +947,9 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
             else (void)gamma;
             if (t == 2) {  // the camera sees the emitter: the only strategy
                 pdfs.k = 1;
-                pdfs.from_camera[0] = broadcast<P>(1.f);
+                // Per channel its nulls' P_n,c still weigh the channels; grey, 1 (one strategy).
+                if constexpr (kPerChannel) pdfs.from_camera[0] = nulls;
+                else pdfs.from_camera[0] = 1.f;
                 pdfs.nee = pdfs.emit = 0.f;
                 add(0, 2, f, pdfs, std::isfinite(dist) ? hit.p : z.p, !std::isfinite(dist));
                 return;
@@ -943,19 +992,26 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
     // s = 0 in an emissive medium: the camera subpath's tentative collision at y, after
     // camera[0..count-1], collects mu_a L_e / mu_bar (the collision estimator); as a path ending
     // at y its camera-side density is the direction pdf / d^2 x the nulls' P_n x mu_bar(y).
+    // `mu_bar` the majorant at y (per channel: every channel's), `mu_sample` the sampling
+    // channel's, `beta` the throughput up to y over the density of reaching it, `gamma` (per
+    // channel) the shared factors up to y.
     auto on_camera_emission = [&](const V* path, int count, int medium, const Vec3& y,
-                                  const Coefficients<typename Sc::Spectral>& c, float mu_bar, const Spectrum& beta,
-                                  float nulls, float pdf_dir) {
+                                  const Coefficients<typename Sc::Spectral>& c, const P& mu_bar, float mu_sample,
+                                  const Spectrum& beta, const P& nulls, float pdf_dir, const auto& gamma) {
         if constexpr (kEmissive) {
             const int t = count + 1;
-            if (t - 2 > depth || !(c.sigma_a > 0.f).any() || !(mu_bar > 0.f)) return;
+            if (t - 2 > depth || !(c.sigma_a > 0.f).any() || !(mu_sample > 0.f)) return;
             const auto& m = sc.media[std::size_t(medium)].medium;
             const Spectrum le = m.emission(y, lambda);
             if (!(le > 0.f).any()) return;
-            const Spectrum f = beta * c.sigma_a * le / mu_bar;
+            const Spectrum f = beta * c.sigma_a * le / mu_sample;
+            if constexpr (kPerChannel) pdfs.gamma = gamma;
+            else (void)gamma;
             if (t == 2) {  // seen from the camera: the only strategy
                 pdfs.k = 1;
-                pdfs.from_camera[0] = broadcast<P>(1.f);
+                // Per channel its nulls' P_n,c and mu_bar_c(y) still weigh the channels.
+                if constexpr (kPerChannel) pdfs.from_camera[0] = nulls * mu_bar;
+                else pdfs.from_camera[0] = 1.f;
                 pdfs.nee = pdfs.emit = 0.f;
                 add(0, 2, f, pdfs, y, false, true);
                 return;
@@ -976,7 +1032,8 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
             }
             add(0, t, f, pdfs, y, false, true);
         } else {
-            (void)path, (void)count, (void)medium, (void)y, (void)c, (void)mu_bar, (void)beta, (void)nulls, (void)pdf_dir;
+            (void)path, (void)count, (void)medium, (void)y, (void)c, (void)mu_bar, (void)mu_sample, (void)beta,
+                (void)nulls, (void)pdf_dir, (void)gamma;
         }
     };
 
@@ -990,7 +1047,7 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
     float camera_pdf = 0.f;  // the camera's density of the ray's direction (light tracing), else 0
     if constexpr (kLightTracing) camera_pdf = cam->pdf_dir(camera_ray.d);
     int nc = 0;
-    if constexpr (kEmissive && !kPerChannel)
+    if constexpr (kEmissive)
         nc = walk(sc, camera, 1, depth + 2, camera_ray, sc.camera_medium, camera_pdf, Spectrum::Ones(), lambda, channel,
                   rng, counter, on_camera_hit, status, on_camera_emission);
     else
@@ -1008,7 +1065,7 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
     if (traced && depth >= (kLightTracing ? 1 : 2)) {
         const float uq = q_volume_share > 0.f && q_volume_share < 1.f ? rng.uniform() : 0.f;
         if (q_volume_share > 0.f && uq < q_volume_share) {
-            if constexpr (kEmissive && !kPerChannel) {
+            if constexpr (kEmissive) {
                 const float us = rng.uniform(), u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform(),
                             u3 = rng.uniform(), u4 = rng.uniform(), u5 = rng.uniform();
                 const int i = sc.select_emission(us);
@@ -1025,16 +1082,18 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
                     const auto c = lookup_untracked(m.medium, m.majorant, Ray{yv.p, w}, 0.f, lambda, counter);
                     if (!c) {
                         status = Status::Rejected;
-                    } else if ((c->k.sigma_a > 0.f).any() && c->mu > 0.f) {
+                    } else if ((c->k.sigma_a > 0.f).any() && majorant_at<P>(c->mu, channel) > 0.f) {
                         const Spectrum source = c->k.sigma_a * m.medium.emission(yv.p, lambda);
                         if ((source > 0.f).any()) {
                             V& y0 = light[0] = V{};
                             y0.kind = VertexKind::Medium;
                             y0.p = yv.p;
                             y0.medium = i;
-                            y0.event = c->mu;  // a tentative collision's density there: mu_bar
-                            y0.pdf_fwd = emit_y0 = q_volume * select * yv.pdf;
-                            y0.beta = source / y0.pdf_fwd;
+                            y0.event = majorants<P>(c->mu);  // a tentative collision's density there: mu_bar
+                            if constexpr (kPerChannel) y0.gamma = Spectrum::Ones();
+                            emit_y0 = q_volume * select * yv.pdf;
+                            y0.pdf_fwd = broadcast<P>(emit_y0);
+                            y0.beta = source / emit_y0;
                             nl = walk(sc, light, 1, light_vertices, Ray{yv.p, w}, i, kInv4Pi,
                                       Spectrum(y0.beta * (4.f * kPi)), lambda, channel, rng, counter,
                                       [](auto&&...) {}, status);
@@ -1110,6 +1169,48 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
             if (sh.status != Status::Ok) return out;
             out.tr = sh.transmittance;
             out.nulls = Mis::null_pdfs ? sh.null_pdf_product : 1.f;
+        }
+        return out;
+    };
+    // A shadow ray toward a point drawn in emitting medium `target` (NEE toward the volume): its
+    // throughput, nulls and shared factors as `shadow`'s, whether it reached the point inside
+    // `target`, and the point's piece (the point is last.at(t_last)).
+    struct EmissionShadowT {
+        Status status = Status::Ok;
+        bool reached = false;
+        Spectrum tr = Spectrum::Zero();
+        P nulls = broadcast<P>(1.f);
+        GammaT gamma = unit_gamma<P>();
+        Ray last{};
+        float t_last = 0.f;
+    };
+    auto shadow_to_emission = [&](const Ray& r, float distance, int start, int target) {
+        EmissionShadowT out;
+        if constexpr (!kEmissive) {
+            (void)r, (void)distance, (void)start, (void)target;
+        } else if constexpr (kPerChannel) {
+            const auto sh = detail::channel_emission_shadow<Ch, A>(sc, r, distance, start, target, false, lambda, channel,
+                                                                   Spectrum::Ones(), rng, counter);
+            if (sh.end != SegmentEnd::Passed) {
+                out.status = detail::shadow_status(sh.end);
+                return out;
+            }
+            if (!sh.reached || !(sh.f != 0.f).any() || !(sh.nee[channel] > 0.f)) return out;
+            out.reached = true;
+            out.tr = sh.f / sh.nee[channel];
+            out.nulls = (sh.nee > 0.f).select(sh.uni / sh.nee, 0.f);
+            out.gamma = relative_to_largest<Spectrum>(sh.nee);
+            out.last = sh.last;
+            out.t_last = sh.t_last;
+        } else {
+            const auto sh = detail::emission_shadow(kernels_, sc, r, distance, start, target, false, lambda, rng, counter);
+            out.status = sh.status;
+            if (sh.status != Status::Ok) return out;
+            out.reached = sh.reached;
+            out.tr = sh.transmittance;
+            out.nulls = Mis::null_pdfs ? sh.nulls_before * sh.nulls_own : 1.f;
+            out.last = sh.last;
+            out.t_last = sh.t_last;
         }
         return out;
     };
@@ -1206,21 +1307,21 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
                     const auto& m = sc.media[std::size_t(e->index)];
                     const auto fz = eval_at(z, z.wo, e->wi);
                     if ((fz.value != 0.f).any()) {
-                        const auto sh = detail::emission_shadow(kernels_, sc, Ray{z.p, e->wi}, e->dist,
-                                                                z.medium_toward(e->wi), e->index, false, lambda, rng,
-                                                                counter);
+                        const EmissionShadowT sh =
+                            shadow_to_emission(Ray{z.p, e->wi}, e->dist, z.medium_toward(e->wi), e->index);
                         if (sh.status != Status::Ok) status = sh.status;
-                        if (sh.status == Status::Ok && sh.reached && (sh.transmittance != 0.f).any()) {
+                        if (sh.status == Status::Ok && sh.reached && (sh.tr != 0.f).any()) {
                             const auto c = lookup_untracked(m.medium, m.majorant, sh.last, sh.t_last, lambda, counter);
                             if (!c) {
                                 status = Status::Rejected;
-                            } else if ((c->k.sigma_a > 0.f).any() && c->mu > 0.f) {
+                            } else if ((c->k.sigma_a > 0.f).any() && majorant_at<P>(c->mu, channel) > 0.f) {
                                 const float p_v = e->select * e->y.pdf;
-                                const Spectrum f = z.beta * fz.value * sh.transmittance * c->k.sigma_a *
+                                const Spectrum f = z.beta * fz.value * sh.tr * c->k.sigma_a *
                                                    m.medium.emission(e->y.p, lambda) / (e->dist2 * p_v);
-                                const float nulls = Mis::null_pdfs ? sh.nulls_before * sh.nulls_own : 1.f;
+                                const P& nulls = sh.nulls;
                                 gather(0, t, t);  // camera[0..t-1]; the emission point is x_0
-                                pdfs.from_camera[0] = fz.pdf / e->dist2 * nulls * c->mu;
+                                if constexpr (kPerChannel) pdfs.gamma = path_gamma(z.gamma, sh.gamma);
+                                pdfs.from_camera[0] = fz.pdf / e->dist2 * nulls * majorants<P>(c->mu);
                                 pdfs.nee = p_v;
                                 pdfs.emit = q_volume * p_v;
                                 pdfs.from_light[1] = to_vertex_measure(kInv4Pi, e->y.p, z) * nulls * z.event;
@@ -1316,8 +1417,8 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
 /// Volumetric BDPT with per-channel pdfs (THEORY 5.3 with 5.5): each sample tracks its subpaths
 /// and connections with one channel chosen uniformly, every channel keeps its own densities of
 /// every vertex (its majorant and event probabilities in the nulls' and events' factors), and the
-/// heuristic runs over channels x strategies with one denominator. Media without emission; any
-/// majorant (per-channel ones are what it is for).
+/// heuristic runs over channels x strategies with one denominator. Any majorant (per-channel ones
+/// are what it is for), emissive media included.
 template <mis::CombiningHeuristic H = mis::Balance, AbsorptionPolicy A = absorption::Weight, int MaxDepth = 32>
 using SpectralBdptEstimator = BdptEstimator<bdpt::NullScattering, H, A, MaxDepth, channels::SpectralMis>;
 
