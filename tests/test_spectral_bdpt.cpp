@@ -128,9 +128,11 @@ TEST_CASE("spectral bdpt: the weights over channels x strategies are the heurist
     // paths of 2 to 15 vertices, with and without light tracing; uniform selection q_c = 1/3. The
     // sampling channel c*'s weight w_(s,c*) = power(q p_(s,c*)) / sum_(c,s') power(q p_(s',c)) is
     // returned divided by q (the factor of the throughput f / p_(s,c*)), so sum_(c*,s) q W = 1.
+    // Then under the power heuristic of exponent 100 the weights still sum to 1: q_c x the
+    // largest pdf raised to 100 underflows float, the pdfs alone do not.
     Pcg32 rng(23, 3);
     const mis::Balance balance;
-    const mis::Power power(2.f);
+    const mis::Power power(2.f), steep(100.f);
     const double q = 1.0 / 3.0;
     for (int trial = 0; trial < 2000; ++trial) {
         Pdfs3 p;
@@ -177,6 +179,13 @@ TEST_CASE("spectral bdpt: the weights over channels x strategies are the heurist
         if (total > 0.0) {
             CHECK(sum_b == doctest::Approx(1.0).epsilon(1e-5));
             CHECK(sum_p == doctest::Approx(1.0).epsilon(1e-5));
+            double sum_steep = 0.0;
+            for (int c = 0; c < 3; ++c) {
+                p.channel = c;
+                for (int s = 0; s < count; ++s) sum_steep += q * bdpt::channel_strategy_weight(steep, p, s);
+            }
+            CAPTURE(trial);
+            CHECK(sum_steep == doctest::Approx(1.0).epsilon(1e-5));
         }
     }
 }

@@ -215,6 +215,45 @@ void check_mis(Input& in) {
     }
 }
 
+/// BDPT's weights per channel (THEORY 5.3 with 5.5): three channels' densities in [0, inf] per
+/// vertex, delta vertices, shared factors in [0, 1], balance or a power heuristic of exponent up
+/// to 100: q_c times each channel's weight in [0, 1], summing to 1 over channels x strategies
+/// where any can draw the path, to 0 where none can. Reads its bytes after everything else, so the
+/// corpus's older inputs keep what they drive.
+template <class H>
+void check_channel_bdpt(Input& in, const H& h) {
+    bdpt::PathPdfs<12, Rgb::Spectrum> p;
+    p.k = 1 + int(in.pick(11));
+    p.light_tracing = in.pick(2) == 1;
+    for (int i = 0; i < p.k; ++i) {
+        p.from_light[i] = Rgb::Spectrum(ratio(in), ratio(in), ratio(in));
+        p.from_camera[i] = Rgb::Spectrum(ratio(in), ratio(in), ratio(in));
+        p.connectible[i] = in.pick(4) != 0;
+    }
+    p.nee = ratio(in);
+    p.emit = ratio(in);
+    const float gammas[] = {0.f, 1e-30f, 0.5f, 1.f};
+    p.gamma = Rgb::Spectrum(gammas[in.pick(4)], gammas[in.pick(4)], 1.f);
+    double q[3 * 13];
+    const bool drawable = bdpt::channel_strategy_pdfs(p, q);
+    float sum = 0.f;
+    for (int c = 0; c < 3; ++c) {
+        p.channel = c;
+        for (int s = 0; s < bdpt::strategy_count(p); ++s) {
+            const float w = bdpt::channel_strategy_weight(h, p, s) / 3.f;
+            NSP_FUZZ_CHECK(w >= 0.f && w <= 1.f + kWeightTol);
+            sum += w;
+        }
+    }
+    NSP_FUZZ_CHECK(drawable ? std::abs(sum - 1.f) <= kWeightTol : sum == 0.f);
+}
+
+void check_channel_bdpt(Input& in) {
+    const float betas[] = {1.f, 2.f, 10.f, 100.f};
+    if (in.pick(2) == 0) check_channel_bdpt(in, mis::Balance{});
+    else check_channel_bdpt(in, mis::Power(betas[in.pick(4)]));
+}
+
 // ---------------------------------------------------------------------------------------------
 // The medium
 
@@ -1008,5 +1047,6 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         case 1: run<nsp::Rgb>(in); break;
         default: run<nsp::Hero<4>>(in); break;
     }
+    check_channel_bdpt(in);
     return 0;
 }

@@ -312,7 +312,7 @@ bool channel_strategy_pdfs(const PathPdfs<N, P>& p, double* q) noexcept {
 /// Per channel: the factor by which the sampling channel's sample of strategy s multiplies its
 /// throughput f_lambda / p_(s,c*) (THEORY 5.3 with 5.5): w_(s,c*) / q_(c*) with w_(s,c) =
 /// power(q_c p_(s,c)) / sum over channels c' and strategies s' of power(q_c' p_(s',c')), uniform
-/// selection q_c = 1 / C. Under the balance heuristic the estimate is f_lambda / sum_c q_c sum_s'
+/// selection q_c = 1 / C. `p.gamma` must lie in [0, 1] (relative to its largest channel). Under the balance heuristic the estimate is f_lambda / sum_c q_c sum_s'
 /// p_(s',c). The w of all channels and strategies of a path sum to 1. 0 where s cannot draw it in
 /// channel c*; NaN densities give NaN.
 template <mis::CombiningHeuristic H, int N, class P>
@@ -324,11 +324,13 @@ float channel_strategy_weight(const H& h, const PathPdfs<N, P>& p, int s) noexce
     if (!channel_strategy_pdfs(p, q)) return 0.f;
     const double own = q[p.channel * (N + 1) + s];
     if (!(own > 0.0)) return std::isnan(own) ? float(own) : 0.f;
-    const float sel = 1.f / float(C);
+    // With one selection probability for every channel it factors out of the heuristic (balance
+    // and power are homogeneous): the pdfs enter as they are, the largest 1, so the sum is at
+    // least 1 (q_c x the largest under a power of 100 would underflow to 0).
     double sum = 0.0;
     for (int ch = 0; ch < C; ++ch)
-        for (int r = 0; r < n; ++r) sum += double(h.power(sel * float(q[ch * (N + 1) + r])));
-    return float(double(h.power(sel * float(own))) / sum / double(sel));
+        for (int r = 0; r < n; ++r) sum += double(h.power(float(q[ch * (N + 1) + r])));
+    return float(double(h.power(float(own))) / sum * double(C));
 }
 
 /// What one vertex of a subpath is.
