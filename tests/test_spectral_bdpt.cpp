@@ -106,6 +106,27 @@ void check_channels(const SpecStat<S>& s, const typename S::Spectrum& expected) 
     }
 }
 
+/// A furnace's closed form `expected` in every channel, for balance and power (subpaths of up to
+/// 64 vertices): radiance() from (0.1, -0.2, 0.3) in uniform directions, and the image's average
+/// with light tracing through a camera there; 6000 samples each, seeds `seed` and `seed + 1`.
+template <class Scene>
+void check_furnace(const Scene& sc, const typename Scene::Spectrum& expected, std::uint64_t seed) {
+    using S = typename Scene::Spectral;
+    EstimatorOptions opts;
+    opts.max_depth = 64;
+    const PinholeCamera camera(Vec3(0.1f, -0.2f, 0.3f), Vec3(0.5f, 0.f, -1.f), Vec3(0.f, 1.f, 0.f), 70.f, 1.3f);
+    for_each_spectral_bdpt<64>(
+        [&](const auto& est, const char* name) {
+            CAPTURE(std::string(name));
+            check_channels<S>(estimate_channels(est, sc, 6000, seed, [](Pcg32& rng) {
+                                  return Ray{Vec3(0.1f, -0.2f, 0.3f), uniform_sphere(rng.uniform(), rng.uniform())};
+                              }),
+                              expected);
+            check_channels<S>(image_average_channels(est, sc, camera, 6000, seed + 1), expected);
+        },
+        opts);
+}
+
 using Pdfs3 = bdpt::PathPdfs<16, Rgb::Spectrum>;
 
 /// Channel c's pdf of the path under strategy s, as a plain product times its shared factor
@@ -214,21 +235,7 @@ TEST_CASE_TEMPLATE("spectral bdpt: the furnace of six emitting walls around a ch
     // L = 2 in every channel whatever the extinction. Subpaths of up to 64 vertices (the walls
     // halve the throughput about every third vertex). radiance() from inside, and the image with
     // light tracing (its average over (u, v) is 2 too).
-    const Sc<S> sc = chromatic_furnace<S>();
-    const auto expected = S::Spectrum::Constant(2.f);
-    EstimatorOptions opts;
-    opts.max_depth = 64;
-    const PinholeCamera camera(Vec3(0.1f, -0.2f, 0.3f), Vec3(0.5f, 0.f, -1.f), Vec3(0.f, 1.f, 0.f), 70.f, 1.3f);
-    for_each_spectral_bdpt<64>(
-        [&](const auto& est, const char* name) {
-            CAPTURE(std::string(name));
-            check_channels<S>(estimate_channels(est, sc, 6000, 13, [](Pcg32& rng) {
-                                  return Ray{Vec3(0.1f, -0.2f, 0.3f), uniform_sphere(rng.uniform(), rng.uniform())};
-                              }),
-                              expected);
-            check_channels<S>(image_average_channels(est, sc, camera, 6000, 19), expected);
-        },
-        opts);
+    check_furnace(chromatic_furnace<S>(), S::Spectrum::Constant(2.f), 13);
 }
 
 TEST_CASE("spectral bdpt: single scattering from two point lights in a cube over a floor (quadrature)") {
@@ -576,19 +583,7 @@ TEST_CASE("spectral bdpt: an emitting chromatic medium in the furnace: L = L_e i
     const EmittingScene<Rgb> sc(shapes, {emitting_cube(Spectrum(0.6f, 1.2f, 0.3f), Spectrum(1.f, 0.5f, 2.f), le, false, 0.3f)},
                                 Mats<Rgb>({LambertianBsdf<Rgb>(Spectrum::Constant(0.5f))}, {}),
                                 Ls<Rgb>(LightSelection::Uniform, 2.f, walls, {}), 0);
-    const PinholeCamera camera(Vec3(0.1f, -0.2f, 0.3f), Vec3(0.5f, 0.f, -1.f), Vec3(0.f, 1.f, 0.f), 70.f, 1.3f);
-    EstimatorOptions opts;
-    opts.max_depth = 64;
-    for_each_spectral_bdpt<64>(
-        [&](const auto& est, const char* name) {
-            CAPTURE(std::string(name));
-            check_channels<Rgb>(estimate_channels(est, sc, 6000, 17, [](Pcg32& rng) {
-                                    return Ray{Vec3(0.1f, -0.2f, 0.3f), uniform_sphere(rng.uniform(), rng.uniform())};
-                                }),
-                                le);
-            check_channels<Rgb>(image_average_channels(est, sc, camera, 6000, 29), le);
-        },
-        opts);
+    check_furnace(sc, le, 17);
 }
 
 /// The chromatic cube over the floor under the lamp (chromatic_cube(false)), the cube also

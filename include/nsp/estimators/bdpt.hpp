@@ -124,7 +124,7 @@ P majorants(const V& mu) noexcept {
 }
 
 /// A majorant lookup's value in channel c (a grey majorant's in every channel).
-template <class P, class V>
+template <class V>
 float majorant_at(const V& mu, int c) noexcept {
     if constexpr (std::is_same_v<V, float>) return mu;
     else return mu[c];
@@ -1084,7 +1084,7 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
                     const auto c = lookup_untracked(m.medium, m.majorant, Ray{yv.p, w}, 0.f, lambda, counter);
                     if (!c) {
                         status = Status::Rejected;
-                    } else if ((c->k.sigma_a > 0.f).any() && majorant_at<P>(c->mu, channel) > 0.f) {
+                    } else if ((c->k.sigma_a > 0.f).any() && majorant_at(c->mu, channel) > 0.f) {
                         const Spectrum source = c->k.sigma_a * m.medium.emission(yv.p, lambda);
                         if ((source > 0.f).any()) {
                             V& y0 = light[0] = V{};
@@ -1316,7 +1316,7 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
                             const auto c = lookup_untracked(m.medium, m.majorant, sh.last, sh.t_last, lambda, counter);
                             if (!c) {
                                 status = Status::Rejected;
-                            } else if ((c->k.sigma_a > 0.f).any() && majorant_at<P>(c->mu, channel) > 0.f) {
+                            } else if ((c->k.sigma_a > 0.f).any() && majorant_at(c->mu, channel) > 0.f) {
                                 const float p_v = e->select * e->y.pdf;
                                 const Spectrum f = z.beta * fz.value * sh.tr * c->k.sigma_a *
                                                    m.medium.emission(e->y.p, lambda) / (e->dist2 * p_v);
