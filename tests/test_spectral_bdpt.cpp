@@ -497,10 +497,13 @@ TEST_CASE("spectral bdpt: every strategy's shared factors gamma_c are exp(-mu_c 
     // length of the path inside the cube, whichever strategy drew it and however its segments
     // were tracked or connected. The observer's gamma (relative to the largest channel) against
     // that closed form, from the path's vertices, for every strategy of paths of up to 3 interior
-    // vertices, light tracing included. Tolerance 5e-3 relative: shadow rays and connections stop
-    // 1e-4 of their length short of their end (detail::shadow_distance, so that they do not hit
-    // the surface they end on), which leaves out up to 5 x 1e-4 x 6 = 3e-3 of optical depth here;
-    // a segment's factor left out or counted twice is off by exp(-5 x 0.3) or more.
+    // vertices, light tracing included. Shadow rays and connections are tracked up to their end
+    // points, so float rounding alone separates the two: 1e-4 relative for all but 1 in 1000 of
+    // the (path, channel) pairs (2 of 39903 here; with connections that stopped 1e-4 of their
+    // length short, as they once did, 1004 of 39903 were above it). The host geometry ignores hits
+    // within 1e-4 of a ray's origin, so a vertex that close to the cube's face can have its
+    // crossing skipped: at most 5 x 2e-4 of optical depth, hence 5e-3 for the worst pair. A
+    // segment's factor left out or counted twice is off by exp(-5 x 0.3) or more.
     // (Homogeneous media under these majorants make every channel's pdfs proportional across
     // strategies, so the symmetry test above cannot see gamma; this checks it directly.)
     using Spectrum = Rgb::Spectrum;
@@ -516,6 +519,7 @@ TEST_CASE("spectral bdpt: every strategy's shared factors gamma_c are exp(-mu_c 
     LookupCount counter;
     int checked = 0;
     double worst = 0.0;
+    int off = 0;
     auto inside = [&](const Vec3& a, const Vec3& b) {
         const float len = glm::length(b - a);
         if (!(len > 0.f)) return 0.0;
@@ -532,8 +536,11 @@ TEST_CASE("spectral bdpt: every strategy's shared factors gamma_c are exp(-mu_c 
             Spectrum expected;
             for (int c = 0; c < 3; ++c) expected[c] = float(std::exp(-double(sigma_t[c]) * length));
             expected /= expected.maxCoeff();
-            for (int c = 0; c < 3; ++c)
-                worst = std::max(worst, std::abs(double(pdfs.gamma[c]) - expected[c]) / (double(expected[c]) + 1e-30));
+            for (int c = 0; c < 3; ++c) {
+                const double e = std::abs(double(pdfs.gamma[c]) - expected[c]) / (double(expected[c]) + 1e-30);
+                if (e > 1e-4) ++off;
+                worst = std::max(worst, e);
+            }
             ++checked;
         };
         auto splat = [](float, float, const Spectrum&) {};
@@ -543,6 +550,8 @@ TEST_CASE("spectral bdpt: every strategy's shared factors gamma_c are exp(-mu_c 
     }
     CAPTURE(checked);
     CHECK(checked > 10000);
+    CAPTURE(worst);
+    CHECK(off <= checked * 3 / 1000);
     CHECK(worst <= 5e-3);
 }
 

@@ -1230,7 +1230,7 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
         if (!(dist > 0.f)) return Spectrum::Zero();
         const Vec3 w = d / dist;
         const double before = detail::recorder_work(counter);
-        const Shadow sh = shadow(Ray{a.p, w}, detail::shadow_distance(dist), a.medium_toward(w));
+        const Shadow sh = shadow(Ray{a.p, w}, dist, a.medium_toward(w));
         detail::record_light_walk(counter, before);
         if (sh.status != Status::Ok) {
             status = sh.status;
@@ -1259,7 +1259,7 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
                     y0.delta_position = ls.sample.delta;
                     const bool at_infinity = !std::isfinite(ls.sample.distance);
                     y0.p = at_infinity ? z.p : z.p + ls.sample.distance * w;
-                    const Shadow sh = shadow(Ray{z.p, w}, detail::shadow_distance(ls.sample.distance),
+                    const Shadow sh = shadow(Ray{z.p, w}, ls.sample.distance,
                                              z.medium_toward(w));
                     detail::record_shadow_walk(counter, before, true);
                     if (sh.status != Status::Ok) status = sh.status;

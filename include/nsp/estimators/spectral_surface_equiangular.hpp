@@ -21,9 +21,11 @@
 
 namespace nsp::detail {
 
-/// A shadow ray's per-channel factors through a SurfaceScene (see ChannelShadow), the pieces
-/// between null interfaces multiplied; f = 0 where a surface blocks it. `end` Passed, or the
-/// first failed piece's end (Aborted, Rejected, Overflowed), or InvalidInput for a bad hit.
+/// A shadow ray's per-channel factors through a SurfaceScene (see ChannelShadow) to the point at
+/// `distance` (kInf: a light at infinity), the pieces between null interfaces multiplied and the
+/// last one tracked up to the end point; f = 0 where a surface blocks it before shadow_margin of
+/// the end. `end` Passed, or the first failed piece's end (Aborted, Rejected, Overflowed), or
+/// InvalidInput for a bad hit.
 template <ChannelPolicy CP, AbsorptionPolicy A, class Sc, UniformRng R, LookupCounter C>
 ChannelShadow<typename Sc::Spectral> channel_shadow_through(const Sc& sc, Ray r, float distance, int medium,
                                                             const typename Sc::Spectral::Wavelengths& lambda, int c,
@@ -36,8 +38,9 @@ ChannelShadow<typename Sc::Spectral> channel_shadow_through(const Sc& sc, Ray r,
         b.f.setZero();
         return b;
     };
+    const float margin = shadow_margin(distance);
     for (int crossing = 0; crossing <= kMaxInterfaceCrossings; ++crossing) {
-        const SurfaceHit h = sc.geometry.intersect(r, distance);
+        const SurfaceHit h = sc.geometry.intersect(r, distance - margin);
         if (!usable_hit(sc, h)) {
             ChannelShadow<Sp> bad = blocked();
             bad.end = SegmentEnd::InvalidInput;
@@ -97,7 +100,7 @@ Status channel_light_event(const Sc& sc, const SceneVertex& v, const Vec3& x, co
     if (!(fv.value != 0.f).any()) return Status::Ok;
     const bool uni_alternative = St::combines && !ls.sample.delta;
     const double before = recorder_work(counter);
-    const auto sh = channel_shadow_through<CP, A>(sc, Ray{x, fv.wi}, shadow_distance(ls.sample.distance),
+    const auto sh = channel_shadow_through<CP, A>(sc, Ray{x, fv.wi}, ls.sample.distance,
                                                   start_medium(fv.wi), lambda, c, f_x, uni_alternative, rng, counter);
     record_shadow_walk(counter, before, !eq_drawn);
     if (sh.end != SegmentEnd::Passed) return shadow_status(sh.end);

@@ -92,7 +92,7 @@ Status light_event(const K& k, const Sc& sc, const SceneVertex& v, const Vec3& x
     const auto f = eval_vertex(sc, v, wo, ls.sample.wi, lambda);
     if (!(f.value != 0.f).any()) return Status::Ok;
     const double before = recorder_work(counter);
-    const auto sh = shadow_through(k, sc, Ray{x, f.wi}, shadow_distance(ls.sample.distance), start_medium(f.wi), lambda,
+    const auto sh = shadow_through(k, sc, Ray{x, f.wi}, ls.sample.distance, start_medium(f.wi), lambda,
                                    rng, counter);
     record_shadow_walk(counter, before, !eq_drawn);
     if (sh.status != Status::Ok) return sh.status;

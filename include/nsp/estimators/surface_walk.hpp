@@ -99,16 +99,17 @@ VertexDirection<typename Sc::Spectral> sample_vertex(const Sc& sc, const SceneVe
     return out;
 }
 
-/// How far a shadow ray toward a light sample at `light_distance` runs: short of the light's own
-/// surface, which it must not count as a blocker (kInf for lights at infinity).
-inline float shadow_distance(float light_distance) noexcept {
-    return std::isfinite(light_distance) ? light_distance * (1.f - 1e-4f) : kInf;
-}
+/// The part of a shadow ray's length near its end where shadow_through does not look for
+/// blockers: 1e-4 of it, so that the surface or light the ray ends on does not block it (0 for
+/// lights at infinity). The media are tracked over the whole length all the same.
+inline float shadow_margin(float distance) noexcept { return std::isfinite(distance) ? distance * 1e-4f : 0.f; }
 
-/// The transmittance of a shadow ray from r.o, which lies in medium `medium`, over `distance`
-/// through the scene: one VertexKernels::shadow per medium between the null interfaces it
-/// crosses, transmittances and null-pdf products multiplied; 0 where a surface that is not a
-/// null interface blocks it. Status InvalidInput on a hit the estimator cannot use.
+/// The transmittance of a shadow ray from r.o, which lies in medium `medium`, to the point at
+/// `distance` (kInf: a light at infinity) through the scene: one VertexKernels::shadow per medium
+/// between the null interfaces it crosses, transmittances and null-pdf products multiplied, the
+/// last medium tracked up to the end point itself; 0 where a surface that is not a null interface
+/// blocks it before shadow_margin of the end. Status InvalidInput on a hit the estimator cannot
+/// use.
 template <class K, class Sc, UniformRng R, LookupCounter C>
 ShadowTransmittance<typename Sc::Spectral> shadow_through(const K& k, const Sc& sc, Ray r, float distance, int medium,
                                                           const typename Sc::Spectral::Wavelengths& lambda, R& rng,
@@ -117,8 +118,9 @@ ShadowTransmittance<typename Sc::Spectral> shadow_through(const K& k, const Sc& 
     ShadowTransmittance<Sp> out;
     out.transmittance = Sp::Spectrum::Ones();
     const ShadowTransmittance<Sp> blocked;
+    const float margin = shadow_margin(distance);
     for (int crossing = 0; crossing <= kMaxInterfaceCrossings; ++crossing) {
-        const SurfaceHit h = sc.geometry.intersect(r, distance);
+        const SurfaceHit h = sc.geometry.intersect(r, distance - margin);
         if (!usable_hit(sc, h)) return {Sp::Spectrum::Zero(), 1.f, Status::InvalidInput};
         if (sc.has_medium(medium)) {
             const auto& m = sc.media[std::size_t(medium)];
