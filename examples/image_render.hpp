@@ -52,9 +52,11 @@ auto count_ladder(Make make) {
 /// The core of render_image and render_image_learned: `ladder` holds the estimator at every
 /// candidate pair of counts (NEE x emission segment technique, NeeCountLearner's order), or one
 /// estimator; with `pilot` > 0 the first `pilot` samples of each pixel run ladder[0] (counts 1)
-/// with an nsp::NeeCountLearner per 16x16 tile as their counter (tiles handed to threads, so the
-/// counts do not depend on the thread count), the rest the tile's chosen pair (written to
-/// `chosen`, a tile per entry, row-major); every sample is in the statistics. Per-tile counts are
+/// with an nsp::NeeCountLearner per 16x16 tile as their counter (tiles handed to threads in fixed
+/// slots, so the counts do not depend on the thread count), the rest the tile's chosen pair
+/// (written to `chosen`, a tile per entry, row-major): its own where its pilot shows it pays,
+/// else the image's (all tiles' pilots merged) where its pilot predicts that no worse than counts
+/// 1; every sample is in the statistics. Per-tile counts are
 /// sound here: every strategy of radiance() adds to its own sample's pixel alone.
 template <class Sc, class E, class Camera>
 Row render_pixels(const Sc& scene, const std::vector<E>& ladder, const std::string& name, int res, int spp, int threads,
@@ -107,28 +109,43 @@ Row render_pixels(const Sc& scene, const std::vector<E>& ladder, const std::stri
     const auto start = std::chrono::steady_clock::now();
     const int first = std::min(pilot, spp);
     if (first > 0) {
-        std::atomic<int> next_tile{0};
+        // Slot j learns tiles j, j + kSlots, ... in order (threads take whole slots) and merges
+        // their learners into the image's; each tile then keeps its own counts where its pilot
+        // shows they pay, else takes the image's where its pilot predicts them no worse than
+        // counts 1 (NeeCountLearner::Summary).
+        constexpr int kSlots = 16;
+        std::vector<nsp::NeeCountLearner> slots(static_cast<std::size_t>(kSlots));
+        std::vector<nsp::NeeCountLearner::Summary> summaries(static_cast<std::size_t>(n_tiles));
+        std::atomic<int> next_slot{0};
         auto learn = [&](Totals& out) {
             const double cpu0 = thread_cpu_seconds();
-            for (int t; (t = next_tile.fetch_add(1)) < n_tiles;) {
-                nsp::NeeCountLearner learner;
-                const int x0 = (t % tiles_x) * kTile, y0 = (t / tiles_x) * kTile;
-                for (int y = y0; y < std::min(res, y0 + kTile); ++y)
-                    for (int x = x0; x < std::min(res, x0 + kTile); ++x) {
-                        run_samples(out, ladder[0], learner, x, y, first, [&](double v) { learner.end_sample(v); });
-                        learner.end_pixel();
-                    }
-                const nsp::TechniqueCounts c = learner.choose_counts();
-                if (chosen) (*chosen)[std::size_t(t)] = c;
-                if (ladder.size() == std::size_t(kC * kC))
-                    tile_pair[std::size_t(t)] = std::size_t(nsp::NeeCountLearner::candidate_index(c.nee) * kC +
-                                                            nsp::NeeCountLearner::candidate_index(c.emission_segment));
-                out.lookups += learner.count();
-                out.steps += learner.steps();
-            }
+            for (int j; (j = next_slot.fetch_add(1)) < kSlots;)
+                for (int t = j; t < n_tiles; t += kSlots) {
+                    nsp::NeeCountLearner learner;
+                    const int x0 = (t % tiles_x) * kTile, y0 = (t / tiles_x) * kTile;
+                    for (int y = y0; y < std::min(res, y0 + kTile); ++y)
+                        for (int x = x0; x < std::min(res, x0 + kTile); ++x) {
+                            run_samples(out, ladder[0], learner, x, y, first, [&](double v) { learner.end_sample(v); });
+                            learner.end_pixel();
+                        }
+                    summaries[std::size_t(t)] = learner.summary();
+                    slots[std::size_t(j)].merge(learner);
+                    out.lookups += learner.count();
+                    out.steps += learner.steps();
+                }
             out.cpu += thread_cpu_seconds() - cpu0;
         };
         run_pool(learn);
+        nsp::NeeCountLearner image;
+        for (const nsp::NeeCountLearner& l : slots) image.merge(l);
+        const nsp::TechniqueCounts image_counts = image.choose_counts();
+        for (int t = 0; t < n_tiles; ++t) {
+            const nsp::TechniqueCounts c = nsp::NeeCountLearner::choose_counts(summaries[std::size_t(t)], image_counts);
+            if (chosen) (*chosen)[std::size_t(t)] = c;
+            if (ladder.size() == std::size_t(kC * kC))
+                tile_pair[std::size_t(t)] = std::size_t(nsp::NeeCountLearner::candidate_index(c.nee) * kC +
+                                                        nsp::NeeCountLearner::candidate_index(c.emission_segment));
+        }
     }
     std::atomic<int> next{0};
     auto work = [&](Totals& out) {

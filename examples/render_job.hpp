@@ -47,8 +47,9 @@ struct RenderRequest {
     bool pixel_stats = false;  ///< also return every pixel's mean and sample variance (RenderStats)
     /// Learn the NEE count per tile (combinations with learns_nee_count only): the first
     /// pilot_spp(spp) samples of every pixel at count 1 with an nsp::NeeCountLearner per
-    /// tile_size^2 tile, the rest at the tile's chosen count. Every sample, the pilot's too, is in
-    /// the stats.
+    /// tile_size^2 tile, the rest at the tile's chosen count (its own where its pilot shows it
+    /// pays, else the image's where its pilot predicts that no worse than count 1). Every sample,
+    /// the pilot's too, is in the stats.
     bool learn_nee_counts = false;
     int tile_size = 16;
     /// The pilot's samples per pixel: spp / 32, at least 2 (a pixel's sample variance needs two)

@@ -162,9 +162,11 @@ struct PixelState {
 /// the thread count); rows handed out to threads through an atomic counter. Writes the mean
 /// linear RGB into `rgb`. With rq.learn_nee_counts (C::learns_nee_count), a first pass renders
 /// each tile's pilot samples at NEE count 1 with an nsp::NeeCountLearner as their counter, tiles
-/// handed out to threads (a tile's statistics in one fixed order: the chosen counts do not depend
-/// on the thread count); the second pass renders the rest at each tile's counts (NEE's and, on
-/// an emissive medium, the emission segment technique's).
+/// handed out to threads in fixed slots (the chosen counts do not depend on the thread count); a
+/// tile keeps its own counts where its pilot shows they pay, else takes the image's (every tile's
+/// pilot merged) where its pilot predicts them no worse than counts 1; the second pass renders
+/// the rest at each tile's counts (NEE's and, on an emissive medium, the emission segment
+/// technique's).
 template <class C>
 RenderStats render(const typename C::Scene& scene, const RenderRequest& rq, std::vector<float>& rgb) {
     using S = typename C::Spectral;
@@ -249,29 +251,47 @@ RenderStats render(const typename C::Scene& scene, const RenderRequest& rq, std:
             constexpr bool kEmissive = C::MediumKind::emissive;
             st.nee_counts.assign(std::size_t(tiles_x) * std::size_t(tiles_y), 1.f);
             if (kEmissive) st.segment_counts.assign(st.nee_counts.size(), 1.f);
-            std::atomic<int> next_tile{0};
+            // Slot j learns tiles j, j + kSlots, ... in order (threads take whole slots) and merges
+            // their learners, so the image's counts do not depend on the thread count. A tile
+            // keeps its own counts where its pilot shows they pay, else it takes the image's
+            // where its pilot predicts them no worse than counts 1 (NeeCountLearner::Summary).
+            constexpr int kSlots = 16;
+            const int n_tiles = tiles_x * tiles_y;
+            std::vector<nsp::NeeCountLearner> slots(static_cast<std::size_t>(kSlots));
+            std::vector<nsp::NeeCountLearner::Summary> summaries(static_cast<std::size_t>(n_tiles));
+            std::atomic<int> next_slot{0};
             auto pilot_work = [&](ThreadTotals& out) {
                 ThreadTotals t;
                 const double cpu0 = thread_cpu_seconds();
-                for (int tile; (tile = next_tile.fetch_add(1)) < tiles_x * tiles_y;) {
-                    nsp::NeeCountLearner learner;
-                    const int x0 = (tile % tiles_x) * ts, y0 = (tile / tiles_x) * ts;
-                    for (int y = y0; y < std::min(h, y0 + ts); ++y)
-                        for (int x = x0; x < std::min(w, x0 + ts); ++x) {
-                            PixelState& state = px[std::size_t(y) * std::size_t(w) + std::size_t(x)];
-                            for (int k = 0; k < pilot; ++k) learner.end_sample(sample(estimator, learner, state, x, y, t));
-                            learner.end_pixel();
-                        }
-                    const nsp::TechniqueCounts n = learner.choose_counts();
-                    st.nee_counts[std::size_t(tile)] = n.nee;
-                    if (kEmissive) st.segment_counts[std::size_t(tile)] = n.emission_segment;
-                    t.counter.n += learner.count();
-                    t.counter.steps += learner.steps();
-                }
+                for (int j; (j = next_slot.fetch_add(1)) < kSlots;)
+                    for (int tile = j; tile < n_tiles; tile += kSlots) {
+                        nsp::NeeCountLearner learner;
+                        const int x0 = (tile % tiles_x) * ts, y0 = (tile / tiles_x) * ts;
+                        for (int y = y0; y < std::min(h, y0 + ts); ++y)
+                            for (int x = x0; x < std::min(w, x0 + ts); ++x) {
+                                PixelState& state = px[std::size_t(y) * std::size_t(w) + std::size_t(x)];
+                                for (int k = 0; k < pilot; ++k)
+                                    learner.end_sample(sample(estimator, learner, state, x, y, t));
+                                learner.end_pixel();
+                            }
+                        summaries[std::size_t(tile)] = learner.summary();
+                        slots[std::size_t(j)].merge(learner);
+                        t.counter.n += learner.count();
+                        t.counter.steps += learner.steps();
+                    }
                 t.cpu_seconds = thread_cpu_seconds() - cpu0;
                 out = t;
             };
             run_pool(pilot_work, pilot_totals);
+            nsp::NeeCountLearner image;
+            for (const nsp::NeeCountLearner& l : slots) image.merge(l);
+            const nsp::TechniqueCounts image_counts = image.choose_counts();
+            for (int tile = 0; tile < n_tiles; ++tile) {
+                const nsp::TechniqueCounts n =
+                    nsp::NeeCountLearner::choose_counts(summaries[std::size_t(tile)], image_counts);
+                st.nee_counts[std::size_t(tile)] = n.nee;
+                if (kEmissive) st.segment_counts[std::size_t(tile)] = n.emission_segment;
+            }
             // Pass 2: the rest of each pixel's samples at its tile's counts: one estimator per
             // candidate pair (NEE x segment; the segment's at 1 only where nothing emits).
             constexpr int kC = nsp::NeeCountLearner::kCandidates, kS = kEmissive ? kC : 1;

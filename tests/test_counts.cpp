@@ -7,6 +7,7 @@
 // by name.
 #include <array>
 #include <cmath>
+#include <initializer_list>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -648,6 +649,66 @@ TEST_CASE("NeeCountLearner: bookkeeping") {
         CHECK(n.nee < 1.f);
         CHECK(n.emission_segment == 1.f);
         CHECK(l.choose() == n.nee);
+    }
+    SUBCASE("a tile's pilot too small to show a gain takes a fallback's counts where it predicts them no worse") {
+        // Each sample a light contribution u that tracking finds as well as NEE (p_hit = p_nee),
+        // or (`only_nee`) that only NEE finds (a small light); NEE's walk costs 20 of a sample's
+        // 21 lookups. `image`: 100 shared samples, NEE count 1/64 pays by far. `tile`: 4 samples,
+        // one NEE-only: it predicts variance x cost 0.55 of count 1's at NEE count 1/8 but 1.52 at
+        // 1/64, and the noise of 4 samples keeps either from two standard errors.
+        struct Sample {
+            float u;
+            bool only_nee;
+        };
+        auto pilot = [](NeeCountLearner& l, std::initializer_list<Sample> samples) {
+            int i = 0;
+            for (const Sample& smp : samples) {
+                for (int k = 0; k < 21; ++k) l.lookup();
+                if (!smp.only_nee) l.record_light(smp.u, 1.f, 1.f, 0.f, 1.f, LightTechnique::Hit);
+                l.record_light(smp.u, smp.only_nee ? 0.f : 1.f, 1.f, 0.f, 1.f, LightTechnique::Nee);
+                l.record_shadow_walk(20.0, true);
+                l.end_sample(double(smp.u));
+                if (++i % 2 == 0) l.end_pixel();
+            }
+        };
+        NeeCountLearner image;
+        for (int i = 0; i < 50; ++i) pilot(image, {{1.f, false}, {3.f, false}});
+        const TechniqueCounts image_counts = image.choose_counts();
+        REQUIRE(image_counts.nee == NeeCountLearner::candidate(6));
+        CHECK_FALSE(image.summary().open);  // its own choice stands, whatever the fallback
+        CHECK(image.choose_counts(TechniqueCounts{}).nee == image_counts.nee);
+
+        NeeCountLearner tile;
+        pilot(tile, {{1.f, false}, {0.72f, true}, {2.f, false}, {0.5f, false}});
+        const NeeCountLearner::Summary summary = tile.summary();
+        CHECK(tile.choose() == 1.f);
+        REQUIRE(summary.open);
+        constexpr std::size_t kC = NeeCountLearner::kCandidates;
+        CHECK(summary.efficiency[0] == 1.f);
+        CHECK(summary.efficiency[3 * kC] == doctest::Approx(0.554).epsilon(0.01));
+        CHECK(summary.efficiency[6 * kC] == doctest::Approx(1.524).epsilon(0.01));
+        TechniqueCounts eighth;
+        eighth.nee = NeeCountLearner::candidate(3);
+        CHECK(tile.choose_counts(eighth).nee == eighth.nee);
+        CHECK(NeeCountLearner::choose_counts(summary, eighth).nee == eighth.nee);
+        CHECK(tile.choose_counts(eighth).emission_segment == 1.f);
+        CHECK(tile.choose_counts(image_counts).nee == 1.f);  // predicted worse at 1/64: count 1
+        // Counts that are not candidates count as 1: the tile's own choice.
+        for (const float bad : {0.3f, 0.f, -0.125f, 2.f, std::nanf("")}) {
+            CAPTURE(bad);
+            TechniqueCounts f;
+            f.nee = bad;
+            CHECK(tile.choose_counts(f).nee == 1.f);
+        }
+        // No pilot, or an invalid one: counts 1.
+        CHECK_FALSE(NeeCountLearner().summary().open);
+        CHECK(NeeCountLearner().choose_counts(eighth).nee == 1.f);
+        NeeCountLearner invalid;
+        invalid.record_light(1.f, 1.f, 1.f, 0.f, 0.5f, LightTechnique::Hit);
+        invalid.end_sample(1.0);
+        invalid.end_sample(2.0);
+        invalid.end_pixel();
+        CHECK(invalid.choose_counts(eighth).nee == 1.f);
     }
     SUBCASE("BDPT: one light subpath draw for all of its contributions, its splats elsewhere") {
         // Each sample: a fixed-count contribution a (alternating 1 and 3: the estimate a + 2), two

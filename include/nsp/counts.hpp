@@ -410,6 +410,52 @@ public:
         (second_ == Second::LightSubpath ? out.light_subpath : out.emission_segment) = candidate(best_s);
         return out;
     }
+    /// What choose_counts(fallback) needs of a tile once its pilot is done, about 210 bytes (the
+    /// learner itself is about 32 KiB): a host keeps one per tile until every tile's pilot has run
+    /// and their learners are merged into the image's.
+    struct Summary {
+        TechniqueCounts own;        ///< choose_counts()
+        bool open = false;          ///< `own` is counts 1 for want of a significant gain, not of data
+        bool light_subpath = false; ///< the second count is the light subpath probability
+        /// Per pair (NEE candidate x second candidate, row-major): predicted variance x cost
+        /// over that at counts 1.
+        std::array<float, std::size_t(kCandidates) * std::size_t(kCandidates)> efficiency{};
+    };
+    Summary summary() const noexcept {
+        Summary out;
+        out.own = choose_counts();
+        out.light_subpath = second_ == Second::LightSubpath;
+        const float own_second = out.light_subpath ? out.own.light_subpath : out.own.emission_segment;
+        const double e1 = predicted_variance(0, 0) * predicted_cost(0, 0);
+        out.open = out.own.nee == 1.f && own_second == 1.f && !invalid_ && z_dof_ >= 2 && e1 > 0.0;
+        for (int jn = 0; jn < kCandidates; ++jn)
+            for (int js = 0; js < kCandidates; ++js)
+                out.efficiency[pair(jn, js)] =
+                    out.open ? float(predicted_variance(jn, js) * predicted_cost(jn, js) / e1) : 1.f;
+        return out;
+    }
+
+    /// A tile's counts with a fallback for a pilot too small to show a gain on its own: typically
+    /// the image's counts, choose_counts() of every tile's learner merged (merge()), whose pooled
+    /// pilot is many times larger. The tile's own choice where it passes the significance test or
+    /// where it had nothing to learn from; otherwise `fallback` where the tile's predicted variance
+    /// x cost at it is no larger than at counts 1, else counts 1: a tile whose pilot shows that NEE
+    /// pays (a small bright light in it alone) keeps count 1 whatever the image chose. Counts in
+    /// `fallback` that are not candidates (2^-j, j < kCandidates) count as 1.
+    static TechniqueCounts choose_counts(const Summary& tile, const TechniqueCounts& fallback) noexcept {
+        if (!tile.open) return tile.own;
+        const int fn = candidate_or_1(fallback.nee);
+        const int fs = candidate_or_1(tile.light_subpath ? fallback.light_subpath : fallback.emission_segment);
+        if ((fn == 0 && fs == 0) || !(tile.efficiency[pair(fn, fs)] <= 1.f)) return tile.own;
+        TechniqueCounts out;
+        out.nee = candidate(fn);
+        (tile.light_subpath ? out.light_subpath : out.emission_segment) = candidate(fs);
+        return out;
+    }
+    /// choose_counts(summary(), fallback).
+    TechniqueCounts choose_counts(const TechniqueCounts& fallback) const noexcept {
+        return choose_counts(summary(), fallback);
+    }
     /// The NEE count of choose_counts().
     float choose() const noexcept { return choose_counts().nee; }
 
@@ -423,6 +469,12 @@ public:
 
 private:
     static constexpr std::size_t kPairs = std::size_t(kCandidates) * std::size_t(kCandidates);
+    /// The candidate index of `count`, 0 (count 1) where it is not a candidate.
+    static int candidate_or_1(float count) noexcept {
+        if (!(count > 0.f && count <= 1.f)) return 0;
+        const int j = candidate_index(count);
+        return j >= 0 && j < kCandidates && candidate(j) == count ? j : 0;
+    }
     using PerPair = std::array<double, kPairs>;
     static constexpr std::size_t pair(int jn, int js) noexcept { return std::size_t(jn * kCandidates + js); }
 
