@@ -223,7 +223,7 @@ TEST_CASE("lights: emission sampling (light subpaths) matches emission_pdf and e
     for (int i = 0; i < 3; ++i) CHECK(std::abs(picked[i] - 1000) < 5 * std::sqrt(3000 * (1.0 / 3) * (2.0 / 3)));
 }
 
-TEST_CASE("lights: with a BoundingSphere, lights at infinity start light subpaths from a disk outside it") {
+TEST_CASE("lights: with a BoundingSphere, lights at infinity and directional lights start light subpaths from a disk outside it") {
     // The environment's direction uniform (1 / 4 pi, selection 1/2 included in pdf_pos), the ray's
     // origin uniform on a disk of radius R facing the scene: E[L / (pdf_pos pdf_dir)] over all
     // samples (0 for the quad's) is the environment's power in closed form, L 4 pi x pi R^2
@@ -281,6 +281,34 @@ TEST_CASE("lights: with a BoundingSphere, lights at infinity start light subpath
     CHECK_FALSE(plain.emits_from_infinity());
     CHECK(plain.emission_selection_pdf(1) == 0.f);
     CHECK(plain.emission_pdf(1, Vec3(0.f), w).pdf_pos == 0.f);
+    // A directional light, given the sphere, starts them from the same disk: its one direction
+    // (pdf_pos its selection probability, delta_position), E[E cos / (pdf_pos pdf_dir)] its power
+    // through the disk, E pi R^2 (exactly: every sample has the same value); without the sphere none.
+    const DirectionalLight<M> sun{Vec3(0.3f, -2.f, 0.4f), M::Spectrum::Constant(1.5f)};
+    const LightSampler<M, QuadLight<M>, DirectionalLight<M>> sunny(LightSelection::Uniform, sphere, {quad}, {sun});
+    CHECK(sunny.emission_selection_pdf(1) == doctest::Approx(0.5f));
+    int suns = 0;
+    for (int i = 0; i < 1000; ++i) {
+        const EmittedLight<M> e = sunny.sample_emission(rng.uniform(), rng.uniform(), rng.uniform(), rng.uniform(),
+                                                        rng.uniform());
+        if (e.light != 1) continue;
+        ++suns;
+        const LightEmission<M>& x = e.emission;
+        CHECK(x.at_infinity);
+        CHECK(x.delta_position);
+        CHECK(x.pdf_pos == doctest::Approx(0.5f));
+        CHECK(glm::length(x.w - glm::normalize(sun.direction)) < 1e-6f);
+        const Vec3 q = x.p - sphere.center;
+        CHECK(glm::dot(q, -x.w) == doctest::Approx(R).epsilon(1e-4));
+        CHECK(double(x.radiance[0]) * x.cos / (double(x.pdf_pos) * x.pdf_dir) ==
+              doctest::Approx(2.0 * 1.5 * kPi * R * R).epsilon(1e-5));  // power E pi R^2 over selection 1/2
+        const EmissionDensity d = sunny.emission_pdf(1, x.p + 2.f * x.w, x.w);
+        CHECK(d.pdf_pos == doctest::Approx(x.pdf_pos));
+        CHECK(d.pdf_dir == doctest::Approx(x.pdf_dir));
+    }
+    CHECK(suns > 400);
+    const LightSampler<M, QuadLight<M>, DirectionalLight<M>> no_sphere(LightSelection::Uniform, 3.f, {quad}, {sun});
+    CHECK(no_sphere.emission_selection_pdf(1) == 0.f);
     // Bad spheres are rejected with their value.
     CHECK_THROWS_WITH_AS((LightSampler<M, QuadLight<M>>(LightSelection::Uniform, BoundingSphere{Vec3(0.f), -1.f}, {quad})),
                          doctest::Contains("scene_radius = -1"), InvalidArgument);

@@ -47,7 +47,7 @@ struct LightEmission {
     Vec3 p{0.f}, n{0.f, 0.f, 1.f}, w{0.f, 0.f, 1.f};  ///< the point, its unit normal (a point light: w), the direction
     typename S::Spectrum radiance = S::Spectrum::Zero();
     float pdf_pos = 0.f, pdf_dir = 0.f, cos = 0.f;
-    bool delta_position = false;  ///< a point light: no path can hit it
+    bool delta_position = false;  ///< a point light, or a DirectionalLight's one direction: no path can hit it
     bool at_infinity = false;     ///< a light at infinity (see above)
 };
 
@@ -58,9 +58,10 @@ struct EmissionDensity {
 };
 
 /// A light from which light subpaths start (BdptEstimator): `sample_emission(u1, u2, u3, u4,
-/// lambda)` and `emission_pdf(p, w)` as above. Lights at infinity have none of their own:
-/// LightSampler starts their light subpaths when it has a BoundingSphere (else bidirectional
-/// estimators reach them by hitting and NEE alone). DirectionalLight starts none.
+/// lambda)` and `emission_pdf(p, w)` as above. Lights at infinity (`is_infinite`, and
+/// DirectionalLight, `is_distant`) have none of their own: LightSampler starts their light
+/// subpaths when it has a BoundingSphere (else bidirectional estimators reach them by hitting and
+/// NEE alone, a DirectionalLight by NEE alone).
 template <class L, class S>
 concept EmittingLight = SpectralMode<S> && requires(const L& l, const Vec3& v, float u, const typename S::Wavelengths& lambda) {
     { l.sample_emission(u, u, u, u, lambda) } -> std::same_as<LightEmission<S>>;
@@ -279,6 +280,10 @@ struct EnvironmentLight {
 template <SpectralMode S>
 struct DirectionalLight {
     static constexpr bool is_delta = true;
+    /// A delta direction at infinity: with a BoundingSphere, LightSampler starts its light
+    /// subpaths on the sphere's disk facing along `direction`, as it does for the lights at
+    /// infinity (LightEmission::at_infinity and delta_position both set).
+    static constexpr bool is_distant = true;
     Vec3 direction;
     typename S::Coefficient irradiance;
 

@@ -9,8 +9,9 @@
 //
 // Light subpaths (BdptEstimator) start at the lights with a point to emit from (EmittingLight
 // models) and, when the sampler is given a BoundingSphere around the scene, at the lights at
-// infinity too: a direction toward the light by its own sample(), then the ray's origin uniform
-// on a disk of the sphere's radius that faces the scene from outside it (THEORY 5.5).
+// infinity and the directional lights too: a direction toward the light by its own sample(), then
+// the ray's origin uniform on a disk of the sphere's radius that faces the scene from outside it
+// (THEORY 5.5).
 #pragma once
 
 #include <algorithm>
@@ -62,7 +63,8 @@ public:
     /// Throws InvalidArgument on a light with a non-finite position, a radius or area that is not
     /// finite and > 0, a bad radiance, or (Power) when no light has positive power. No lights is
     /// allowed: sample() then returns pdf 0.
-    /// Lights at infinity start no light subpaths (emits_from_infinity() false).
+    /// Lights at infinity and directional lights start no light subpaths (emits_from_infinity()
+    /// false).
     explicit LightSampler(LightSelection selection, float scene_radius, std::vector<Ls>... lights)
         : LightSampler(Checked{}, selection, checked_radius(scene_radius), BoundingSphere{}, std::move(lights)...) {}
 
@@ -155,18 +157,21 @@ public:
     /// The sphere given to the constructor (radius 0: none).
     const BoundingSphere& bounding_sphere() const noexcept { return sphere_; }
 
-    /// The probability with which sample_emission() starts at light `light` (0 for directional
-    /// lights, for lights at infinity without a BoundingSphere, and for indices outside the table).
+    /// The probability with which sample_emission() starts at light `light` (0 for lights at
+    /// infinity and directional lights without a BoundingSphere, and for indices outside the
+    /// table).
     float emission_selection_pdf(int light) const noexcept {
         return light >= 0 && light < count() ? emit_pmf_[std::size_t(light)] : 0.f;
     }
 
-    /// Chooses a light that emits (an EmittingLight, or with a BoundingSphere a light at infinity)
-    /// with u0, and a point on it and a direction leaving it with (u1, u2) and (u3, u4). pdf_pos
-    /// 0 when there is none. From a light at infinity (LightEmission::at_infinity): the direction
-    /// toward it by (u1, u2) and its sample() (pdf_pos, solid angle), the ray's origin p uniform
-    /// by (u3, u4) on the disk of the sphere's radius centred at center + radius x (-w), facing
-    /// along w (pdf_dir = 1 / (pi radius^2), area on the disk), cos = 1.
+    /// Chooses a light that emits (an EmittingLight, or with a BoundingSphere a light at infinity
+    /// or a directional light) with u0, and a point on it and a direction leaving it with (u1, u2)
+    /// and (u3, u4). pdf_pos 0 when there is none. From a light at infinity
+    /// (LightEmission::at_infinity): the direction toward it by (u1, u2) and its sample()
+    /// (pdf_pos, solid angle; a directional light's one direction: pdf_pos 1 and delta_position),
+    /// the ray's origin p uniform by (u3, u4) on the disk of the sphere's radius centred at
+    /// center + radius x (-w), facing along w (pdf_dir = 1 / (pi radius^2), area on the disk),
+    /// cos = 1.
     EmittedLight<S> sample_emission(float u0, float u1, float u2, float u3, float u4,
                                     const typename S::Wavelengths& lambda = {}) const noexcept {
         if (emitters_.empty()) return {};
@@ -177,7 +182,7 @@ public:
         visit(entries_[std::size_t(light)], [&](const auto& l) {
             using L = std::decay_t<decltype(l)>;
             if constexpr (EmittingLight<L, S>) out.emission = l.sample_emission(u1, u2, u3, u4, lambda);
-            else if constexpr (is_infinite<L>()) out.emission = emission_from_infinity(l, u1, u2, u3, u4, lambda);
+            else if constexpr (from_infinity<L>()) out.emission = emission_from_infinity(l, u1, u2, u3, u4, lambda);
         });
         out.emission.pdf_pos *= emit_pmf_[std::size_t(light)];
         return out;
@@ -187,14 +192,15 @@ public:
     /// included in pdf_pos) and leaves along w; all 0 for a light it never starts from. For a
     /// light at infinity p is any point the ray reaches: pdf_pos the density of the direction -w
     /// toward the light, pdf_dir that of a ray through p (0 where no ray from the disk passes
-    /// through p: outside the sphere's cylinder along w, or beyond the disk).
+    /// through p: outside the sphere's cylinder along w, or beyond the disk); for a directional
+    /// light pdf_pos is 1 (its delta), w taken to be its direction.
     EmissionDensity emission_pdf(int light, const Vec3& p, const Vec3& w) const noexcept {
         EmissionDensity d;
         if (!(emission_selection_pdf(light) > 0.f)) return d;
         visit(entries_[std::size_t(light)], [&](const auto& l) {
             using L = std::decay_t<decltype(l)>;
             if constexpr (EmittingLight<L, S>) d = l.emission_pdf(p, w);
-            else if constexpr (is_infinite<L>()) d = emission_pdf_from_infinity(l, p, w);
+            else if constexpr (from_infinity<L>()) d = emission_pdf_from_infinity(l, p, w);
         });
         d.pdf_pos *= emit_pmf_[std::size_t(light)];
         return d;
@@ -275,7 +281,7 @@ private:
         bool r = false;
         visit(e, [&](const auto& l) {
             using L = std::decay_t<decltype(l)>;
-            r = EmittingLight<L, S> || (is_infinite<L>() && emits_from_infinity());
+            r = EmittingLight<L, S> || (from_infinity<L>() && emits_from_infinity());
         });
         return r;
     }
@@ -298,6 +304,7 @@ private:
         e.pdf_dir = 1.f / (kPi * sphere_.radius * sphere_.radius);
         e.cos = 1.f;
         e.at_infinity = true;
+        e.delta_position = s.delta;
         return e;
     }
 
@@ -306,7 +313,8 @@ private:
         EmissionDensity d;
         const Vec3 toward = -w, q = p - sphere_.center;
         const float along = glm::dot(q, toward), r2 = sphere_.radius * sphere_.radius;
-        d.pdf_pos = l.pdf(sphere_.center, toward, 1.f);
+        if constexpr (L::is_delta) d.pdf_pos = 1.f;
+        else d.pdf_pos = l.pdf(sphere_.center, toward, 1.f);
         d.pdf_dir = along < sphere_.radius && glm::dot(q, q) - along * along < r2 ? 1.f / (kPi * r2) : 0.f;
         d.cos = 1.f;
         return d;
@@ -351,6 +359,13 @@ private:
     static constexpr bool is_infinite() noexcept {
         if constexpr (requires { L::is_infinite; }) return bool(L::is_infinite);
         else return false;
+    }
+    /// A light at infinity or a delta direction at infinity (`is_distant`, DirectionalLight): its
+    /// light subpaths start on the BoundingSphere's disk.
+    template <class L>
+    static constexpr bool from_infinity() noexcept {
+        if constexpr (requires { L::is_distant; }) return is_infinite<L>() || bool(L::is_distant);
+        else return is_infinite<L>();
     }
 
     std::tuple<std::vector<Ls>...> lights_;

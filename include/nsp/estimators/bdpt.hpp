@@ -353,7 +353,7 @@ struct Vertex {
     int material = -1, medium = -1, medium_front = -1, medium_back = -1, light = -1;
     VertexKind kind = VertexKind::Camera;
     bool delta = false;           ///< a delta lobe was sampled here: no connection may end at p
-    bool delta_position = false;  ///< a point light: no path hits it
+    bool delta_position = false;  ///< a point light or a directional light's direction: no path hits it
     bool at_infinity = false;     ///< a light at infinity: x_0 is a direction (solid angle), p its ray's origin
 
     /// The medium a ray leaving p along w travels in.
@@ -380,10 +380,11 @@ struct PathVertices {
 
 /// Converts a solid-angle density at `from` toward vertex `to` into `to`'s measure: |n . w| / d^2
 /// on a surface or light, 1 / d^2 in a medium; 0 for a point light and the camera. A light at
-/// infinity is a direction: its measure is the solid angle, pdf_dir unchanged.
+/// infinity is a direction: its measure is the solid angle, pdf_dir unchanged (0 for a directional
+/// light's one direction).
 template <SpectralMode S, class P>
 float to_vertex_measure(float pdf_dir, const Vec3& from, const Vertex<S, P>& to) noexcept {
-    if (to.at_infinity) return pdf_dir;
+    if (to.at_infinity) return to.delta_position ? 0.f : pdf_dir;
     const Vec3 d = to.p - from;
     const float d2 = glm::dot(d, d);
     if (!(d2 > 0.f)) return 0.f;
@@ -1131,8 +1132,8 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
                     const Vec3 d = y0.p - light[1].p;
                     const float d2 = glm::dot(d, d);
                     nee_y0 = nee_count *
-                             (y0.at_infinity      ? sc.lights.pdf(y0.light, light[1].p, -e.emission.w)  // solid angle
-                              : y0.delta_position ? sc.lights.selection_pdf(y0.light)
+                             (y0.delta_position ? sc.lights.selection_pdf(y0.light)  // a point or a direction
+                              : y0.at_infinity  ? sc.lights.pdf(y0.light, light[1].p, -e.emission.w)  // solid angle
                                                   : sc.lights.pdf(y0.light, light[1].p, d / std::sqrt(d2)) *
                                                         std::abs(glm::dot(y0.ng, d)) / (d2 * std::sqrt(d2)));
                 }
@@ -1269,15 +1270,16 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
                         gather(0, t, t);  // camera[0..t-1]; the light point is x_0
                         if constexpr (kPerChannel) pdfs.gamma = path_gamma(z.gamma, sh.gamma);
                         const float d2 = ls.sample.distance * ls.sample.distance;
-                        if (ls.sample.delta) {  // a point or directional light: NEE alone reaches it
+                        if (ls.sample.delta) {  // a point or directional light: no path hits it
                             pdfs.from_camera[0] = broadcast<P>(0.f);
                             pdfs.nee = nee_count * ls.sample.pdf;
-                            pdfs.emit = at_infinity ? 0.f : q_lights * sc.lights.emission_pdf(ls.light, y0.p, -w).pdf_pos;
-                            if (at_infinity)
-                                pdfs.from_light[1] = broadcast<P>(0.f);
-                            else
-                                pdfs.from_light[1] = to_vertex_measure(sc.lights.emission_pdf(ls.light, y0.p, -w).pdf_dir,
-                                                                       y0.p, z) * nulls * z.event;
+                            // Light subpaths from a directional light (given a BoundingSphere) start
+                            // on the sphere's disk: pdf_pos its delta, pdf_dir per area across w.
+                            const EmissionDensity e = sc.lights.emission_pdf(ls.light, at_infinity ? z.p : y0.p, -w);
+                            pdfs.emit = q_lights * e.pdf_pos;
+                            pdfs.from_light[1] = (at_infinity ? from_infinity_measure(e.pdf_dir, -w, z)
+                                                              : to_vertex_measure(e.pdf_dir, y0.p, z)) *
+                                                 nulls * z.event;
                         } else if (at_infinity) {
                             const EmissionDensity e = sc.lights.emission_pdf(ls.light, z.p, -w);
                             pdfs.from_camera[0] = fz.pdf * nulls;
@@ -1296,7 +1298,7 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
                             pdfs.from_light[2] = to_vertex_measure(eval_at(z, w * -1.f, -z.wo).pdf, z.p, z2) *
                                                  z.nulls_in * z2.event;
                         }
-                        add(1, t, f, pdfs, y0.p, at_infinity && !ls.sample.delta);
+                        add(1, t, f, pdfs, y0.p, at_infinity);
                     }
                 }
             }
