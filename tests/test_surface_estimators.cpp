@@ -14,6 +14,7 @@
 
 #include "common.hpp"
 #include "grey_surface_scenes.hpp"
+#include "spectral.hpp"
 
 namespace {
 
@@ -201,50 +202,29 @@ TEST_CASE("surface estimators: single scattering from two point lights in a cube
     //   L = sum_i int_{s_in}^{s_out} sigma_s f_p(d . w_i) T(s - s_in) I_i T(r_i) / r_i^2 ds
     //     + T(s_out - s_in) sum_i (0.6 / pi) I_i cos_i T(c_i) / |l_i - F|^2,
     // r_i = |x - l_i|, c_i the part of F -> l_i inside the cube; the integral by composite Simpson
-    // in double with 20000 intervals. Light selection by power gives the two equiangular targets
-    // probabilities 2/3 and 1/3: equiangular vertices come from a mixture.
-    const double sigma_s = 0.8, sigma_a = 0.2, sigma_t = sigma_s + sigma_a, rho = 0.6, g = 0.3;
+    // in double with 20000 intervals (support/spectral.hpp's TwoPointLights, its channels all
+    // equal). Light selection by power gives the two equiangular targets probabilities 2/3 and
+    // 1/3: equiangular vertices come from a mixture.
     using Ps = LightSampler<S, PointLight<S>>;
     using PSc = SurfaceScene<Shapes, M, GlobalMajorant<M>, HenyeyGreensteinPhase, Mats, Ps>;
-    const Box cube{Vec3(-1.f), Vec3(1.f)};
+    TwoPointLights setup;
+    setup.sigma_s = Rgb::Spectrum::Constant(0.8f);
+    setup.sigma_a = Rgb::Spectrum::Constant(0.2f);
+    setup.rho = Rgb::Spectrum::Constant(0.6f);
+    setup.points[0].intensity = Rgb::Spectrum::Constant(2.f);
+    setup.points[1].intensity = Rgb::Spectrum::Constant(1.f);
+    setup.g = 0.3f;
     Shapes shapes;
-    shapes.boxes.push_back({cube.lo, cube.hi, {-1, -1, 0, -1}});
+    shapes.boxes.push_back({setup.cube.lo, setup.cube.hi, {-1, -1, 0, -1}});
     shapes.quads.push_back({Vec3(-20.f, -1.5f, 20.f), Vec3(40.f, 0.f, 0.f), Vec3(0.f, 0.f, -40.f), {0, -1, -1, -1}});
-    const std::vector<PointLight<S>> points{{Vec3(0.1f, -0.7f, -0.45f), Spectrum::Constant(2.f)},
-                                            {Vec3(-0.5f, -0.3f, 0.6f), Spectrum::Constant(1.f)}};
-    const PSc sc(shapes, {medium(cube, float(sigma_a), float(sigma_s), float(g))}, materials(float(rho)),
+    std::vector<PointLight<S>> points;
+    for (const auto& l : setup.points) points.push_back({l.position, Spectrum::Constant(l.intensity[0])});
+    const PSc sc(shapes, {medium(setup.cube, setup.sigma_a[0], setup.sigma_s[0], setup.g)}, materials(setup.rho[0]),
                  Ps(LightSelection::Power, 4.f, points), -1);
     REQUIRE(sc.lights.equiangular_count() == 2);
     CHECK(sc.lights.equiangular_pmf(0) == doctest::Approx(2.0 / 3.0));
-    const Vec3 eye(0.1f, 0.8f, -4.f), dir = glm::normalize(Vec3(-0.1f, -2.3f, 5.f));
-    const double s_in = (-1.0 - eye.z) / dir.z, s_out = (-1.0 - eye.y) / dir.y, s_floor = (-1.5 - eye.y) / dir.y;
-    const HenyeyGreensteinPhase phase{float(g)};
-    auto single = [&](double s) {
-        const Vec3 x = eye + float(s) * dir;
-        double sum = 0.0;
-        for (const auto& l : points) {
-            const Vec3 to = l.position - x;
-            const double r = glm::length(to);
-            sum += sigma_s * phase.eval(dir, to / float(r)) * std::exp(-sigma_t * (s - s_in)) * l.intensity[0] *
-                   std::exp(-sigma_t * r) / (r * r);
-        }
-        return sum;
-    };
-    const int n = 20000;
-    const double h = (s_out - s_in) / n;
-    double integral = single(s_in) + single(s_out);
-    for (int i = 1; i < n; ++i) integral += (i % 2 ? 4.0 : 2.0) * single(s_in + i * h);
-    integral *= h / 3.0;
-    const Vec3 f = eye + float(s_floor) * dir;
-    double floor_term = 0.0;
-    for (const auto& l : points) {
-        const Vec3 to = l.position - f;
-        const double dist = glm::length(to);
-        const Vec3 w = to / float(dist);
-        floor_term += rho / kPi * l.intensity[0] * w.y * std::exp(-sigma_t * exit_distance(cube, l.position, -w)) /
-                      (dist * dist);
-    }
-    const double expected = integral + std::exp(-sigma_t * (s_out - s_in)) * floor_term;
+    const Vec3 eye = setup.eye, dir = setup.dir;
+    const double expected = setup.expected()[0];
     EstimatorOptions opts;
     opts.max_depth = 1;
     EstimatorOptions fixed = opts;
