@@ -337,6 +337,44 @@ TEST_CASE("spectral bdpt: agrees with SpectralPathEstimator on a strongly chroma
     }
 }
 
+TEST_CASE("spectral bdpt: agrees with SpectralPathEstimator under a lamp and a sun whose light subpaths start on a disk") {
+    // The strongly chromatic cube under its lamp and a sun of chromatic irradiance, the sampler
+    // given a BoundingSphere (radius 4.5: light subpaths from the sun too, x_0 its direction):
+    // per channel, the camera's rays and the image's average with light tracing against spectral
+    // MIS + NEE, 5 combined SE (as the test above).
+    using SunLs = LightSampler<Rgb, QuadLight<Rgb>, DirectionalLight<Rgb>>;
+    using SunSc = SurfaceScene<Shapes, M<Rgb>, ChannelMajorant<M<Rgb>>, HenyeyGreensteinPhase, Mats<Rgb>, SunLs>;
+    const auto base = chromatic_cube(false);
+    const DirectionalLight<Rgb> sun{Vec3(0.4f, -1.f, 0.3f), Rgb::Spectrum(1.5f, 1.f, 0.6f)};
+    const SunSc sc(base.geometry, base.media, base.materials,
+                   SunLs(LightSelection::Power, BoundingSphere{Vec3(0.f), 4.5f}, base.lights.lights<QuadLight<Rgb>>(), {sun}),
+                   -1);
+    REQUIRE(sc.lights.emission_selection_pdf(1) > 0.f);
+    const SpectralPathEstimator<channels::SpectralMis, strategy::NullScatteringMis, mis::Balance> pt(
+        BdptEstimator<>::default_options());
+    const PinholeCamera camera = cube_view();
+    const auto reference = estimate_channels(pt, sc, 60000, 13, cube_ray);
+    const auto reference_image = estimate_channels(pt, sc, 60000, 14, [&](Pcg32& rng) {
+        const float u = rng.uniform(), v = rng.uniform();
+        return camera.ray(u, v);
+    });
+    for_each_spectral_bdpt([&](const auto& est, const char* name) {
+        CAPTURE(std::string(name));
+        const auto a = estimate_channels(est, sc, 30000, 15, cube_ray);
+        const auto b = image_average_channels(est, sc, camera, 30000, 16);
+        for (int c = 0; c < 3; ++c) {
+            CAPTURE(c);
+            CAPTURE(a.ch[c].mean);
+            CAPTURE(reference.ch[c].mean);
+            CAPTURE(b.ch[c].mean);
+            CAPTURE(reference_image.ch[c].mean);
+            CHECK(std::abs(a.ch[c].mean - reference.ch[c].mean) <= kSigmas * std::hypot(a.ch[c].se(), reference.ch[c].se()));
+            CHECK(std::abs(b.ch[c].mean - reference_image.ch[c].mean) <=
+                  kSigmas * std::hypot(b.ch[c].se(), reference_image.ch[c].se()));
+        }
+    });
+}
+
 /// Per channel and strategy (s, t) of paths of 1..3 interior vertices whose consecutive real
 /// vertices lie 0.3 apart: the strategy alone with MIS over channels only (f_lambda gamma_c* p_(s,c*)
 /// / sum_c q_c gamma_c p_(s,c), the one-sample estimate of s alone), and for every other strategy o
@@ -366,7 +404,8 @@ ChannelStrategyRecord record_channel_strategies(const E& est, const Scene& sc, i
         std::vector<Vec3> x{v.x0};
         for (int i = 1; i < v.s; ++i) x.push_back(v.light[i].p);
         for (int j = v.t - 1; j >= 1; --j) x.push_back(v.camera[j].p);
-        for (std::size_t i = 1; i < x.size(); ++i)
+        // x_0 at infinity is a direction: no distance to x_1.
+        for (std::size_t i = v.x0_at_infinity ? 2 : 1; i < x.size(); ++i)
             if (glm::length(x[i] - x[i - 1]) < 0.3f) return false;
         return true;
     };
@@ -424,8 +463,9 @@ ChannelStrategyRecord record_channel_strategies(const E& est, const Scene& sc, i
     return rec;
 }
 
-/// The checks on a record of paths of 1..3 interior vertices (see the test below).
-void check_channel_strategies(ChannelStrategyRecord& rec) {
+/// The checks on a record of paths of 1..3 interior vertices (see the test below). `hittable`:
+/// the lights can be hit (s = 0 draws paths); else s = 0 must contribute exactly nothing.
+void check_channel_strategies(ChannelStrategyRecord& rec, bool hittable = true) {
     for (int n = 1; n <= 3; ++n) {
         const SpecStat<Rgb>& nee = rec.alone[{1, n + 1}];
         for (int s = 0; s <= n + 1; ++s) {
@@ -436,6 +476,10 @@ void check_channel_strategies(ChannelStrategyRecord& rec) {
                 CAPTURE(c);
                 CAPTURE(a.ch[c].mean);
                 CAPTURE(nee.ch[c].mean);
+                if (s == 0 && !hittable) {
+                    CHECK(a.ch[c].mean == 0.0);
+                    continue;
+                }
                 CHECK(a.ch[c].mean > 0.0);
                 CHECK(std::abs(a.ch[c].mean - nee.ch[c].mean) <= kSigmas * std::hypot(a.ch[c].se(), nee.ch[c].se()));
             }
@@ -488,6 +532,17 @@ TEST_CASE("spectral bdpt: each strategy alone is unbiased per channel, every cha
         ChannelStrategyRecord rec = record_channel_strategies(SpectralBdptEstimator<>(opts),
                                                               chromatic_cube<GlobalMajorant<M<Rgb>>>(false), 200000);
         check_channel_strategies(rec);
+    }
+    SUBCASE("a sun alone, light subpaths from its disk") {
+        // x_0 the sun's direction; no path hits it, so s = 0 contributes exactly nothing.
+        using SunLs = LightSampler<Rgb, QuadLight<Rgb>, DirectionalLight<Rgb>>;
+        using SunSc = SurfaceScene<Shapes, M<Rgb>, ChannelMajorant<M<Rgb>>, HenyeyGreensteinPhase, Mats<Rgb>, SunLs>;
+        const auto base = chromatic_cube(false);
+        const DirectionalLight<Rgb> sun{Vec3(0.4f, -1.f, 0.3f), Rgb::Spectrum(1.5f, 1.f, 0.6f)};
+        const SunSc sc(base.geometry, base.media, base.materials,
+                       SunLs(LightSelection::Power, BoundingSphere{Vec3(0.f), 4.5f}, {}, {sun}), -1);
+        ChannelStrategyRecord rec = record_channel_strategies(SpectralBdptEstimator<>(opts), sc, 200000);
+        check_channel_strategies(rec, false);
     }
 }
 
