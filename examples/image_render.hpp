@@ -49,6 +49,44 @@ auto count_ladder(Make make) {
     return ladder;
 }
 
+/// The pilot of render_pixels and render_splatting: an nsp::NeeCountLearner per tile x tile tile
+/// of the res x res image, `pilot_pixel(out, learner, x, y)` running pixel (x, y)'s pilot samples
+/// with it as their counter (and end_sample after each). Slot j learns tiles j, j + kSlots, ...
+/// in order and merges their learners, threads taking whole slots (`run_pool(work)` runs
+/// work(Out&) on each thread's totals), so the result does not depend on the thread count. Each
+/// tile's Summary goes to `summaries` (when given, n_tiles entries); each tile's lookups, steps
+/// and the thread CPU time to the thread's totals. Returns every tile's learner merged.
+template <class Out, class Pool, class PilotPixel>
+nsp::NeeCountLearner learn_tiles(int res, int tile, Pool&& run_pool, PilotPixel&& pilot_pixel,
+                                 std::vector<nsp::NeeCountLearner::Summary>* summaries) {
+    constexpr int kSlots = 16;
+    const int tiles_x = (res + tile - 1) / tile, n_tiles = tiles_x * tiles_x;
+    std::vector<nsp::NeeCountLearner> slots(static_cast<std::size_t>(kSlots));
+    std::atomic<int> next_slot{0};
+    auto learn = [&](Out& out) {
+        const double cpu0 = thread_cpu_seconds();
+        for (int j; (j = next_slot.fetch_add(1)) < kSlots;)
+            for (int t = j; t < n_tiles; t += kSlots) {
+                nsp::NeeCountLearner learner;
+                const int x0 = (t % tiles_x) * tile, y0 = (t / tiles_x) * tile;
+                for (int y = y0; y < std::min(res, y0 + tile); ++y)
+                    for (int x = x0; x < std::min(res, x0 + tile); ++x) {
+                        pilot_pixel(out, learner, x, y);
+                        learner.end_pixel();
+                    }
+                if (summaries) (*summaries)[std::size_t(t)] = learner.summary();
+                slots[std::size_t(j)].merge(learner);
+                out.lookups += learner.count();
+                out.steps += learner.steps();
+            }
+        out.cpu += thread_cpu_seconds() - cpu0;
+    };
+    run_pool(learn);
+    nsp::NeeCountLearner all;
+    for (const nsp::NeeCountLearner& l : slots) all.merge(l);
+    return all;
+}
+
 /// The core of render_image and render_image_learned: `ladder` holds the estimator at every
 /// candidate pair of counts (NEE x emission segment technique, NeeCountLearner's order), or one
 /// estimator; with `pilot` > 0 the first `pilot` samples of each pixel run ladder[0] (counts 1)
@@ -109,35 +147,15 @@ Row render_pixels(const Sc& scene, const std::vector<E>& ladder, const std::stri
     const auto start = std::chrono::steady_clock::now();
     const int first = std::min(pilot, spp);
     if (first > 0) {
-        // Slot j learns tiles j, j + kSlots, ... in order (threads take whole slots) and merges
-        // their learners into the image's; each tile then keeps its own counts where its pilot
-        // shows they pay, else takes the image's where its pilot predicts them no worse than
-        // counts 1 (NeeCountLearner::Summary).
-        constexpr int kSlots = 16;
-        std::vector<nsp::NeeCountLearner> slots(static_cast<std::size_t>(kSlots));
+        // Each tile keeps its own counts where its pilot shows they pay, else takes the image's
+        // where its pilot predicts them no worse than counts 1 (NeeCountLearner::Summary).
         std::vector<nsp::NeeCountLearner::Summary> summaries(static_cast<std::size_t>(n_tiles));
-        std::atomic<int> next_slot{0};
-        auto learn = [&](Totals& out) {
-            const double cpu0 = thread_cpu_seconds();
-            for (int j; (j = next_slot.fetch_add(1)) < kSlots;)
-                for (int t = j; t < n_tiles; t += kSlots) {
-                    nsp::NeeCountLearner learner;
-                    const int x0 = (t % tiles_x) * kTile, y0 = (t / tiles_x) * kTile;
-                    for (int y = y0; y < std::min(res, y0 + kTile); ++y)
-                        for (int x = x0; x < std::min(res, x0 + kTile); ++x) {
-                            run_samples(out, ladder[0], learner, x, y, first, [&](double v) { learner.end_sample(v); });
-                            learner.end_pixel();
-                        }
-                    summaries[std::size_t(t)] = learner.summary();
-                    slots[std::size_t(j)].merge(learner);
-                    out.lookups += learner.count();
-                    out.steps += learner.steps();
-                }
-            out.cpu += thread_cpu_seconds() - cpu0;
-        };
-        run_pool(learn);
-        nsp::NeeCountLearner image;
-        for (const nsp::NeeCountLearner& l : slots) image.merge(l);
+        const nsp::NeeCountLearner image = learn_tiles<Totals>(
+            res, kTile, run_pool,
+            [&](Totals& out, nsp::NeeCountLearner& learner, int x, int y) {
+                run_samples(out, ladder[0], learner, x, y, first, [&](double v) { learner.end_sample(v); });
+            },
+            &summaries);
         const nsp::TechniqueCounts image_counts = image.choose_counts();
         for (int t = 0; t < n_tiles; ++t) {
             const nsp::TechniqueCounts c = nsp::NeeCountLearner::choose_counts(summaries[std::size_t(t)], image_counts);
@@ -211,9 +229,9 @@ namespace detail {
 /// The core of render_image_splatting and render_image_splatting_learned: `ladder` holds the
 /// estimator at every candidate pair of counts (NEE x light subpath, NeeCountLearner's order), or
 /// one estimator; with `pilot` > 0 the first `pilot` samples of each pixel run ladder[0] (counts
-/// 1) with an nsp::NeeCountLearner as their counter, one per 16x16 tile merged in a fixed order
-/// into kSlots learners and those into one (so the counts do not depend on the thread count), and
-/// the rest of every pixel's samples the image's chosen pair (written to `chosen`). One pair for
+/// 1) with an nsp::NeeCountLearner as their counter, one per 16x16 tile, merged by learn_tiles
+/// (so the counts do not depend on the thread count), and the rest of every pixel's samples the
+/// image's chosen pair (written to `chosen`). One pair for
 /// the image, not one per tile: a splat's MIS weight takes the counts of the sample that drew its
 /// light subpath, and they must be those of the pixel it lands in. The pilot's samples and their
 /// splats form an unbiased image at counts 1, the rest one at the chosen counts; every sample is
@@ -243,8 +261,7 @@ Row render_splatting(const Sc& scene, const std::vector<E>& ladder, const Cam& c
     std::vector<nsp::Pcg32> rngs;
     rngs.reserve(n_pix);
     for (std::size_t p = 0; p < n_pix; ++p) rngs.emplace_back(seed, p);
-    constexpr int kTile = 16, kSlots = 16;
-    const int tiles_x = (res + kTile - 1) / kTile, n_tiles = tiles_x * tiles_x;
+    constexpr int kTile = 16;
     std::size_t pair = 0;  // index into ladder
     if (chosen) *chosen = nsp::TechniqueCounts{};
     const auto start = std::chrono::steady_clock::now();
@@ -278,30 +295,12 @@ Row render_splatting(const Sc& scene, const std::vector<E>& ladder, const Cam& c
     };
     const int first = std::min(pilot, spp);
     if (first > 0) {
-        // Slot j learns tiles j, j + kSlots, ... in order; threads take whole slots.
-        std::vector<nsp::NeeCountLearner> slots(static_cast<std::size_t>(kSlots));
-        std::atomic<int> next_slot{0};
-        auto learn = [&](Buffers& out) {
-            const double cpu0 = thread_cpu_seconds();
-            for (int j; (j = next_slot.fetch_add(1)) < kSlots;)
-                for (int t = j; t < n_tiles; t += kSlots) {
-                    nsp::NeeCountLearner learner;
-                    const int x0 = (t % tiles_x) * kTile, y0 = (t / tiles_x) * kTile;
-                    for (int y = y0; y < std::min(res, y0 + kTile); ++y)
-                        for (int x = x0; x < std::min(res, x0 + kTile); ++x) {
-                            run_samples(out, ladder[0], learner, x, y, 0, first,
-                                        [&](double v) { learner.end_sample(v); });
-                            learner.end_pixel();
-                        }
-                    slots[std::size_t(j)].merge(learner);
-                    out.lookups += learner.count();
-                    out.steps += learner.steps();
-                }
-            out.cpu += thread_cpu_seconds() - cpu0;
-        };
-        run_pool(learn);
-        nsp::NeeCountLearner all;
-        for (const nsp::NeeCountLearner& l : slots) all.merge(l);
+        const nsp::NeeCountLearner all = learn_tiles<Buffers>(
+            res, kTile, run_pool,
+            [&](Buffers& out, nsp::NeeCountLearner& learner, int x, int y) {
+                run_samples(out, ladder[0], learner, x, y, 0, first, [&](double v) { learner.end_sample(v); });
+            },
+            nullptr);
         const nsp::TechniqueCounts c = all.choose_counts();
         if (chosen) *chosen = c;
         if (ladder.size() == std::size_t(kC * kC))

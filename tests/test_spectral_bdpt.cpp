@@ -302,66 +302,25 @@ PinholeCamera cube_view() {
                          2.f * std::atan(0.7f) * 180.f / kPi, 1.f);
 }
 
-TEST_CASE("spectral bdpt: agrees with SpectralPathEstimator on a strongly chromatic cube over a floor") {
-    // No closed form: against spectral MIS + NEE (SpectralPathEstimator<SpectralMis,
-    // NullScatteringMis>) per channel, within 5 combined SE of the two independent estimates: the
-    // camera's rays (radiance()), and the image's average with light tracing against the same
-    // average of the path tracer over the same uniform (u, v).
+/// Per channel, every per-channel BDPT variant against spectral MIS + NEE
+/// (SpectralPathEstimator<SpectralMis, NullScatteringMis>) on `sc`, within 5 combined SE of the
+/// two independent estimates: the camera's rays (radiance(), 30000 against 60000 samples), and
+/// the image's average with light tracing against the same average of the path tracer over the
+/// same uniform (u, v). Seeds seed..seed + 3.
+template <class Scene>
+void check_agrees_with_spectral_path(const Scene& sc, std::uint64_t seed) {
     const SpectralPathEstimator<channels::SpectralMis, strategy::NullScatteringMis, mis::Balance> pt(
         BdptEstimator<>::default_options());
     const PinholeCamera camera = cube_view();
-    for (const bool sky : {false, true}) {
-        const auto sc = chromatic_cube(sky);
-        const auto reference = estimate_channels(pt, sc, 60000, 3, cube_ray);
-        const auto reference_image = estimate_channels(pt, sc, 60000, 4, [&](Pcg32& rng) {
-            const float u = rng.uniform(), v = rng.uniform();
-            return camera.ray(u, v);
-        });
-        for_each_spectral_bdpt([&](const auto& est, const char* name) {
-            CAPTURE(std::string(name));
-            CAPTURE(sky);
-            const auto a = estimate_channels(est, sc, 30000, 5, cube_ray);
-            const auto b = image_average_channels(est, sc, camera, 30000, 6);
-            for (int c = 0; c < 3; ++c) {
-                CAPTURE(c);
-                CAPTURE(a.ch[c].mean);
-                CAPTURE(reference.ch[c].mean);
-                CAPTURE(b.ch[c].mean);
-                CAPTURE(reference_image.ch[c].mean);
-                CHECK(std::abs(a.ch[c].mean - reference.ch[c].mean) <=
-                      kSigmas * std::hypot(a.ch[c].se(), reference.ch[c].se()));
-                CHECK(std::abs(b.ch[c].mean - reference_image.ch[c].mean) <=
-                      kSigmas * std::hypot(b.ch[c].se(), reference_image.ch[c].se()));
-            }
-        });
-    }
-}
-
-TEST_CASE("spectral bdpt: agrees with SpectralPathEstimator under a lamp and a sun whose light subpaths start on a disk") {
-    // The strongly chromatic cube under its lamp and a sun of chromatic irradiance, the sampler
-    // given a BoundingSphere (radius 4.5: light subpaths from the sun too, x_0 its direction):
-    // per channel, the camera's rays and the image's average with light tracing against spectral
-    // MIS + NEE, 5 combined SE (as the test above).
-    using SunLs = LightSampler<Rgb, QuadLight<Rgb>, DirectionalLight<Rgb>>;
-    using SunSc = SurfaceScene<Shapes, M<Rgb>, ChannelMajorant<M<Rgb>>, HenyeyGreensteinPhase, Mats<Rgb>, SunLs>;
-    const auto base = chromatic_cube(false);
-    const DirectionalLight<Rgb> sun{Vec3(0.4f, -1.f, 0.3f), Rgb::Spectrum(1.5f, 1.f, 0.6f)};
-    const SunSc sc(base.geometry, base.media, base.materials,
-                   SunLs(LightSelection::Power, BoundingSphere{Vec3(0.f), 4.5f}, base.lights.lights<QuadLight<Rgb>>(), {sun}),
-                   -1);
-    REQUIRE(sc.lights.emission_selection_pdf(1) > 0.f);
-    const SpectralPathEstimator<channels::SpectralMis, strategy::NullScatteringMis, mis::Balance> pt(
-        BdptEstimator<>::default_options());
-    const PinholeCamera camera = cube_view();
-    const auto reference = estimate_channels(pt, sc, 60000, 13, cube_ray);
-    const auto reference_image = estimate_channels(pt, sc, 60000, 14, [&](Pcg32& rng) {
+    const auto reference = estimate_channels(pt, sc, 60000, seed, cube_ray);
+    const auto reference_image = estimate_channels(pt, sc, 60000, seed + 1, [&](Pcg32& rng) {
         const float u = rng.uniform(), v = rng.uniform();
         return camera.ray(u, v);
     });
     for_each_spectral_bdpt([&](const auto& est, const char* name) {
         CAPTURE(std::string(name));
-        const auto a = estimate_channels(est, sc, 30000, 15, cube_ray);
-        const auto b = image_average_channels(est, sc, camera, 30000, 16);
+        const auto a = estimate_channels(est, sc, 30000, seed + 2, cube_ray);
+        const auto b = image_average_channels(est, sc, camera, 30000, seed + 3);
         for (int c = 0; c < 3; ++c) {
             CAPTURE(c);
             CAPTURE(a.ch[c].mean);
@@ -373,6 +332,41 @@ TEST_CASE("spectral bdpt: agrees with SpectralPathEstimator under a lamp and a s
                   kSigmas * std::hypot(b.ch[c].se(), reference_image.ch[c].se()));
         }
     });
+}
+
+using SunLs = LightSampler<Rgb, QuadLight<Rgb>, DirectionalLight<Rgb>>;
+using SunSc = SurfaceScene<Shapes, M<Rgb>, ChannelMajorant<M<Rgb>>, HenyeyGreensteinPhase, Mats<Rgb>, SunLs>;
+
+/// The chromatic cube under a sun of chromatic irradiance and, with `lamp`, its quad lamp; the
+/// sampler has a BoundingSphere (radius 4.5), so light subpaths start from the sun too (x_0 its
+/// direction).
+SunSc chromatic_cube_under_sun(bool lamp) {
+    const auto base = chromatic_cube(false);
+    std::vector<QuadLight<Rgb>> lamps;
+    if (lamp) lamps = base.lights.lights<QuadLight<Rgb>>();
+    const DirectionalLight<Rgb> sun{Vec3(0.4f, -1.f, 0.3f), Rgb::Spectrum(1.5f, 1.f, 0.6f)};
+    return SunSc(base.geometry, base.media, base.materials,
+                 SunLs(LightSelection::Power, BoundingSphere{Vec3(0.f), 4.5f}, lamps, {sun}), -1);
+}
+
+TEST_CASE("spectral bdpt: agrees with SpectralPathEstimator on a strongly chromatic cube over a floor") {
+    // No closed form: against spectral MIS + NEE (SpectralPathEstimator<SpectralMis,
+    // NullScatteringMis>) per channel, within 5 combined SE of the two independent estimates: the
+    // camera's rays (radiance()), and the image's average with light tracing against the same
+    // average of the path tracer over the same uniform (u, v).
+    for (const bool sky : {false, true}) {
+        CAPTURE(sky);
+        check_agrees_with_spectral_path(chromatic_cube(sky), 3);
+    }
+}
+
+TEST_CASE("spectral bdpt: agrees with SpectralPathEstimator under a lamp and a sun whose light subpaths start on a disk") {
+    // The strongly chromatic cube under its lamp and a sun, light subpaths from both: per channel,
+    // the camera's rays and the image's average with light tracing against spectral MIS + NEE,
+    // 5 combined SE (as the test above).
+    const SunSc sc = chromatic_cube_under_sun(true);
+    REQUIRE(sc.lights.emission_selection_pdf(1) > 0.f);
+    check_agrees_with_spectral_path(sc, 13);
 }
 
 /// Per channel and strategy (s, t) of paths of 1..3 interior vertices whose consecutive real
@@ -535,12 +529,7 @@ TEST_CASE("spectral bdpt: each strategy alone is unbiased per channel, every cha
     }
     SUBCASE("a sun alone, light subpaths from its disk") {
         // x_0 the sun's direction; no path hits it, so s = 0 contributes exactly nothing.
-        using SunLs = LightSampler<Rgb, QuadLight<Rgb>, DirectionalLight<Rgb>>;
-        using SunSc = SurfaceScene<Shapes, M<Rgb>, ChannelMajorant<M<Rgb>>, HenyeyGreensteinPhase, Mats<Rgb>, SunLs>;
-        const auto base = chromatic_cube(false);
-        const DirectionalLight<Rgb> sun{Vec3(0.4f, -1.f, 0.3f), Rgb::Spectrum(1.5f, 1.f, 0.6f)};
-        const SunSc sc(base.geometry, base.media, base.materials,
-                       SunLs(LightSelection::Power, BoundingSphere{Vec3(0.f), 4.5f}, {}, {sun}), -1);
+        const SunSc sc = chromatic_cube_under_sun(false);
         ChannelStrategyRecord rec = record_channel_strategies(SpectralBdptEstimator<>(opts), sc, 200000);
         check_channel_strategies(rec, false);
     }
