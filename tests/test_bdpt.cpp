@@ -498,6 +498,55 @@ TEST_CASE("bdpt: the pdf symmetry test sees directional MIS's pdfs are not densi
     CHECK(worst_share_asymmetry(rec, 3) > 4.0 * kSigmas);
 }
 
+TEST_CASE("bdpt: without nulls, null-scattering MIS weighs every path as directional MIS does") {
+    // THEORY 5.5: a strategy's pdf of a path differs from directional MIS's pseudo-pdf by the
+    // nulls' prod P_n of every segment it tracks and the end factor mu_bar P_s at every medium
+    // vertex. Each medium vertex is the end of a tracked segment in every strategy, so its end
+    // factor is common to all of them and cancels; what is left is prod P_n of the one segment a
+    // strategy connects instead of tracking. With the cube's majorant equal to its extinction no
+    // segment has a null: both estimators (the same random draws; the weights draw none) must
+    // return the same value and the same splats for every sample, to float rounding (1e-4
+    // relative). With the majorant twice the extinction the weights must differ (some sample by
+    // more than 1 %): the comparison can fail.
+    const PinholeCamera camera = cube_pinhole();
+    for (const bool tight : {true, false}) {
+        CAPTURE(tight);
+        const Sc sc = cube_over_floor(true, 1.2f, tight);
+        const BdptEstimator<bdpt::NullScattering, mis::Balance> null_mis;
+        const BdptEstimator<bdpt::Directional, mis::Balance> directional;
+        LookupCount counter;
+        double worst = 0.0;
+        int compared = 0;
+        for (int i = 0; i < 20000; ++i) {
+            double a[2] = {0.0, 0.0};
+            int splats[2] = {0, 0};
+            for (int k = 0; k < 2; ++k) {
+                Pcg32 rng(91, std::uint64_t(i));
+                const float u = rng.uniform(), v = rng.uniform();
+                auto splat = [&](float, float, const Spectrum& value) {
+                    a[k] += double(value[0]);
+                    ++splats[k];
+                };
+                const auto r = k == 0 ? null_mis.sample(sc, camera, u, v, {}, rng, counter, splat)
+                                      : directional.sample(sc, camera, u, v, {}, rng, counter, splat);
+                REQUIRE(r.status == Status::Ok);
+                a[k] += double(r.value[0]);
+            }
+            REQUIRE(splats[0] == splats[1]);  // the same paths
+            if (a[0] == 0.0 && a[1] == 0.0) continue;
+            ++compared;
+            worst = std::max(worst, std::abs(a[0] - a[1]) / std::max(std::abs(a[0]), std::abs(a[1])));
+        }
+        CAPTURE(compared);
+        CAPTURE(worst);
+        CHECK(compared > 5000);
+        if (tight)
+            CHECK(worst <= 1e-4);
+        else
+            CHECK(worst > 1e-2);
+    }
+}
+
 TEST_CASE("bdpt: with light tracing, the image agrees with PathEstimator pixel by pixel") {
     // The cube over the floor under the lamp and the sky, 4 x 4 pixels through cube_pinhole(),
     // BdptEstimator::sample with splats: each pixel = (its samples' returns + the splats it

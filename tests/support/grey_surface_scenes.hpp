@@ -31,10 +31,12 @@ inline Mats materials(float albedo = 0.5f) {
 }
 
 /// A homogeneous medium over `box` with a majorant twice its extinction: every segment has
-/// nulls, so their P_n enter the null-scattering MIS.
-inline SceneMedium<M, GlobalMajorant<M>, HenyeyGreensteinPhase> medium(Box box, float sigma_a, float sigma_s, float g = 0.3f) {
+/// nulls, so their P_n enter the null-scattering MIS. `tight`: the majorant equals the
+/// extinction instead, and no segment has a null.
+inline SceneMedium<M, GlobalMajorant<M>, HenyeyGreensteinPhase> medium(Box box, float sigma_a, float sigma_s, float g = 0.3f,
+                                                                      bool tight = false) {
     const M m(box, Spectrum::Constant(sigma_a), Spectrum::Constant(sigma_s));
-    return {m, GlobalMajorant<M>(m, 2.f * (sigma_a + sigma_s) + 0.5f), HenyeyGreensteinPhase(g)};
+    return {m, tight ? GlobalMajorant<M>(m) : GlobalMajorant<M>(m, 2.f * (sigma_a + sigma_s) + 0.5f), HenyeyGreensteinPhase(g)};
 }
 
 /// A homogeneous medium over `box` emitting L_e = `le` everywhere in it, majorant twice its
@@ -71,8 +73,9 @@ inline Sc nested_media() {
 
 /// The scattering cube (albedo 0.8, HG 0.6, behind null interfaces) over a Lambertian floor,
 /// under a quad lamp (`lamp_size` on a side, its power that of 1.2 at radiance 12) and (when
-/// `sky`) a dim sky; the camera in front of it.
-inline Sc cube_over_floor(bool sky, float lamp_size = 1.2f) {
+/// `sky`) a dim sky; the camera in front of it. `tight_majorant`: the cube's majorant is its
+/// extinction (no nulls) instead of twice it.
+inline Sc cube_over_floor(bool sky, float lamp_size = 1.2f, bool tight_majorant = false) {
     Shapes shapes;
     shapes.boxes.push_back({Vec3(-1.f), Vec3(1.f), {-1, -1, 0, -1}});
     shapes.quads.push_back({Vec3(-3.f, -1.05f, 3.f), Vec3(6.f, 0.f, 0.f), Vec3(0.f, 0.f, -6.f), {0, -1, -1, -1}});
@@ -82,7 +85,7 @@ inline Sc cube_over_floor(bool sky, float lamp_size = 1.2f) {
     shapes.quads.push_back({lamp.corner, lamp.edge_u, lamp.edge_v, {-1, 0, -1, -1}});
     std::vector<EnvironmentLight<S>> env;
     if (sky) env.push_back(EnvironmentLight<S>{Spectrum::Constant(0.05f)});
-    return Sc(shapes, {medium(Box{Vec3(-1.f), Vec3(1.f)}, 0.3f, 1.2f, 0.6f)}, materials(0.6f),
+    return Sc(shapes, {medium(Box{Vec3(-1.f), Vec3(1.f)}, 0.3f, 1.2f, 0.6f, tight_majorant)}, materials(0.6f),
               Ls(LightSelection::Power, 4.f, {lamp}, env), -1);
 }
 
