@@ -115,17 +115,6 @@ Eigen::Array3d to_linear_rgb(const typename S::Spectrum& L, const typename S::Wa
     else return Eigen::Array3d::Constant(double(L[0]));
 }
 
-/// The lights of set-up `choice` (the plume has none: the flame is its light).
-template <nsp::SpectralMode S>
-nsp::Lights<S> scene_lights(const SceneChoice& choice) {
-    switch (choice.kind) {
-        case SceneKind::Chromatic: return chromatic_lights<S>(choice.chromatic);
-        case SceneKind::Fog: return fog_lights<S>(choice.fog);
-        case SceneKind::Plume: return {};
-        default: return default_lights<S>(choice.cloud);
-    }
-}
-
 /// The scene of combination C in `choice`, with the lights the flags add or replace and the
 /// majorant built with `settings`.
 template <class C>
@@ -152,7 +141,7 @@ typename C::Scene make_scene(const SceneChoice& choice, const LightOverrides& o,
 struct PixelState {
     nsp::Pcg32 rng;
     std::array<Welford, 3> channel{};
-    Welford channel_mean;
+    Welford channel_mean{};
     Eigen::Array3d sum = Eigen::Array3d::Zero();
     int k = 0;  ///< samples so far
 };

@@ -9,16 +9,20 @@
 // flame in it, an emissive medium; Mono, half the size and spp) with emission and lights in one MIS,
 // then the lantern (the lamp boxed above the cloud, opening into it: the BDPT scene; half the
 // size and spp) with the path tracers against BdptEstimator's directional and null-scattering MIS
-// and BDPT with its expected counts learned (_learned: nsp::NeeCountLearner over the image). The
+// and BDPT with its expected counts learned (_learned: nsp::NeeCountLearner over the image), then
+// the chromatic lantern (the chromatic cloud in it; Rgb) with the spectral path tracers against
+// BDPT with one pdf (directional and null-scattering MIS) and with every channel's pdfs. The
 // grey room's and the plume's tables end with uni + NEE MIS at counts learned per 16x16 tile.
 // On request (--tables cloud) the main job's cloud in empty space, set-ups A and B, as a
-// SurfaceScene (its sphere light a shape the geometry reports), path tracers against BDPT.
+// SurfaceScene (its sphere light a shape the geometry reports), path tracers against BDPT; and
+// (--tables sky) the grey room's BDPT with and without light subpaths from the sky.
 //
 //   nsp_room [--res N] [--spp N] [--threads N] [--out DIR] [--no-png] [--picture-res N]
-//            [--tables grey,rgb,plume,lantern] [--seed N]
+//            [--tables grey,rgb,plume,lantern,lantern-rgb,cloud,sky] [--seed N]
 //
-// Writes DIR/room_sheet.png, DIR/room_rgb_sheet.png, DIR/room_plume_sheet.png and
-// DIR/lantern_sheet.png (each table's rows at one exposure) and
+// Writes DIR/room_sheet.png, DIR/room_rgb_sheet.png, DIR/room_plume_sheet.png,
+// DIR/lantern_sheet.png and DIR/lantern_rgb_sheet.png (each table's rows at one exposure; with
+// --tables sky or cloud also DIR/room_sky_sheet.png, DIR/cloud_bdpt_sheet.png) and
 // DIR/room.png (the grey room, uni-nee-mis balance, 128 spp, --picture-res pixels square) unless
 // --no-png. Exits 1 if any path ended with a status other than Ok.
 #include <algorithm>
@@ -32,6 +36,7 @@
 #include <functional>
 #include <string>
 #include <thread>
+#include <type_traits>
 #include <vector>
 
 #include <CLI/CLI.hpp>
@@ -40,6 +45,7 @@
 #include "png_writer.hpp"
 #include "render_job.hpp"
 #include "room_scene.hpp"
+#include "scene_choice.hpp"
 
 namespace {
 
@@ -108,11 +114,12 @@ int main(int argc, char** argv) {
     app.add_flag("--no-png", no_png, "write no pictures");
     std::uint64_t seed_offset = 0;
     app.add_option("--seed", seed_offset, "added to every row's seed (independent runs)");
-    std::vector<std::string> tables{"grey", "rgb", "plume", "lantern"};  // "cloud" on request
+    std::vector<std::string> tables{"grey", "rgb", "plume", "lantern", "lantern-rgb"};  // "cloud", "sky" on request
     app.add_option("--tables", tables,
-                   "which tables to render (default: grey,rgb,plume,lantern; cloud: the main job's cloud, set-ups A "
-                   "and B, with BDPT; sky: the grey room's BDPT with and without light subpaths from the sky)")
-        ->check(CLI::IsMember({"grey", "rgb", "plume", "lantern", "cloud", "sky"}))
+                   "which tables to render (default: grey,rgb,plume,lantern,lantern-rgb; cloud: the main job's cloud, set-ups A "
+                   "and B, with BDPT; sky: the grey room's BDPT with and without light subpaths from the sky; empty: "
+                   "nsp_render's other scenes, SA, F1-F3, C1, C2, P1, with BDPT)")
+        ->check(CLI::IsMember({"grey", "rgb", "plume", "lantern", "lantern-rgb", "cloud", "sky", "empty"}))
         ->delimiter(',');
     CLI11_PARSE(app, argc, argv);
     auto want = [&](const char* t) { return std::find(tables.begin(), tables.end(), t) != tables.end(); };
@@ -293,10 +300,16 @@ int main(int argc, char** argv) {
         run(lantern, PathEstimator<strategy::Unidirectional>{}, "unidirectional");
         run(lantern, PathEstimator<strategy::NextEvent>{}, "ratio-nee");
         run(lantern, PathEstimator<strategy::NullScatteringMis, mis::Balance>{}, "uni-nee-mis_balance");
+        // Each null-scattering row takes its directional row's seed: the same subpaths (the weights
+        // draw no random numbers), so the pair differs by its weights alone (a paired comparison).
+        const std::uint64_t paired = seed;
         run_splatting(lantern, BdptEstimator<bdpt::Directional, mis::Balance>{}, "bdpt_directional-mis_balance");
+        seed = paired;
         run_splatting(lantern, BdptEstimator<bdpt::NullScattering, mis::Balance>{}, "bdpt_null-mis_balance");
         run_splatting(lantern, BdptEstimator<bdpt::NullScattering, mis::Power>{}, "bdpt_null-mis_power");
+        const std::uint64_t paired_no_t1 = seed;
         run(lantern, BdptEstimator<bdpt::Directional, mis::Balance>{}, "bdpt_directional-mis_balance_no-t1");
+        seed = paired_no_t1;
         run(lantern, BdptEstimator<bdpt::NullScattering, mis::Balance>{}, "bdpt_null-mis_balance_no-t1");
         learned_render(lantern, nsp_examples::room_pinhole(), "bdpt_null-mis_balance_learned", bdpt::Grey{});
         std::vector<Row> lantern_rows(rows.begin() + std::ptrdiff_t(first_lantern), rows.end());
@@ -311,10 +324,41 @@ int main(int argc, char** argv) {
         print_notes();
     }
 
+    // Table 4b: the chromatic lantern (the chromatic cloud of table 2 in the lantern), Rgb: the
+    // spectral path tracers against BDPT with one pdf for all channels (directional and
+    // null-scattering MIS, grey majorant) and with every channel's null-scattering pdfs
+    // (SpectralBdptEstimator, per-channel majorants). Directional MIS has no distance pdfs, so no
+    // per-channel pdfs either: on a chromatic medium it weighs every channel alike.
+    const std::size_t first_lantern_rgb = rows.size();
+    if (want("lantern-rgb")) {
+        using CM = DenseGridMedium<Rgb>;
+        const CM chroma = nsp_examples::make_chromatic_medium<Rgb>();
+        const auto lantern_grey = nsp_examples::make_lantern_scene(chroma, GlobalMajorant<CM>(chroma));
+        const auto lantern_channel = nsp_examples::make_lantern_scene(chroma, ChannelMajorant<CM>(chroma));
+        seed = 31 + seed_offset;
+        run(lantern_channel, SpectralPathEstimator<channels::SpectralMis, strategy::Unidirectional>{},
+            "unidirectional_spectral-mis_per-channel");
+        run(lantern_channel, SpectralPathEstimator<channels::SpectralMis, strategy::NullScatteringMis, mis::Balance>{},
+            "uni-nee-mis_spectral-mis_per-channel");
+        const std::uint64_t paired = seed;  // the grey pair on the same subpaths, as in the lantern's table
+        run_splatting(lantern_grey, BdptEstimator<bdpt::Directional, mis::Balance>{}, "bdpt_directional-mis_grey_balance");
+        seed = paired;
+        run_splatting(lantern_grey, BdptEstimator<bdpt::NullScattering, mis::Balance>{}, "bdpt_null-mis_grey_balance");
+        run_splatting(lantern_channel, SpectralBdptEstimator<mis::Balance>{}, "bdpt_spectral-mis_per-channel");
+        std::vector<Row> lantern_rgb(rows.begin() + std::ptrdiff_t(first_lantern_rgb), rows.end());
+        failed += print_table("Lantern, chromatic cloud (rgb", lantern_rgb, 1, run_res, run_spp, threads,
+                              "the chromatic cloud over a floor, lit only by a lamp in a box that opens downward into it");
+        std::printf("lantern chromatic: bdpt_spectral-mis_per-channel / bdpt_directional-mis_grey_balance in cpu-s*var: "
+                    "%.3g; / best path tracer: %.3g (the grey-pdf rows' variance is practically infinite on this medium: "
+                    "their sample variance understates it; docs/chromatic.md)\n",
+                    cost(lantern_rgb, 4) / cost(lantern_rgb, 2),
+                    cost(lantern_rgb, 4) / std::min(cost(lantern_rgb, 0), cost(lantern_rgb, 1)));
+    }
+
     // Table "sky" (--tables sky only): the grey room, BDPT with the sky reached by hits and NEE
     // alone against BDPT whose light subpaths also start from the sky (a BoundingSphere).
+    const std::size_t first_sky = rows.size();
     if (want("sky")) {
-        const std::size_t first_sky = rows.size();
         const auto sky_room = nsp_examples::make_room_scene(true);
         seed = 29 + seed_offset;
         run_res = res;
@@ -328,6 +372,17 @@ int main(int argc, char** argv) {
                     cost(sky_rows, 2) / cost(sky_rows, 1), cost(sky_rows, 2) / cost(sky_rows, 0));
     }
 
+    // One row over a scene in empty space through the main job's camera: BDPT (an estimator with
+    // kMaxPath) with light tracing, the path tracers along the camera's rays.
+    auto pinhole_render = [&](const auto& scene, const nsp::PinholeCamera& camera, const auto& estimator, const char* name) {
+        if constexpr (requires { estimator.kMaxPath; })
+            rows.push_back(nsp_examples::render_image_splatting(scene, estimator, camera, name, run_res, run_spp, threads, seed++));
+        else
+            rows.push_back(nsp_examples::render_image(scene, estimator, name, run_res, run_spp, threads, seed++,
+                                                      [&](float u, float v) { return camera.ray(u, v); }));
+        std::fprintf(stderr, "  room: %-44s %6.2f s\n", name, rows.back().seconds);
+    };
+
     // Tables 5 and 6 (--tables cloud only): the main job's cloud scene, set-ups A and B, as a
     // SurfaceScene: the path tracers against BDPT with light tracing through the same camera.
     const std::size_t first_cloud = rows.size();
@@ -336,15 +391,8 @@ int main(int argc, char** argv) {
             const auto cloud = nsp_examples::make_cloud_surface_scene(setup);
             const std::size_t first_setup = rows.size();
             seed = (setup == nsp_examples::LightSetup::A ? 17 : 23) + seed_offset;
-            auto cloud_render = [&](const auto& estimator, const char* name) {  // BDPT with light tracing
-                const nsp::PinholeCamera camera = nsp_examples::cloud_pinhole();
-                if constexpr (requires { estimator.kMaxPath; })
-                    rows.push_back(nsp_examples::render_image_splatting(cloud, estimator, camera, name, run_res, run_spp,
-                                                                        threads, seed++));
-                else
-                    rows.push_back(nsp_examples::render_image(cloud, estimator, name, run_res, run_spp, threads, seed++,
-                                                              [&](float u, float v) { return camera.ray(u, v); }));
-                std::fprintf(stderr, "  room: %-44s %6.2f s\n", name, rows.back().seconds);
+            auto cloud_render = [&](const auto& estimator, const char* name) {
+                pinhole_render(cloud, nsp_examples::cloud_pinhole(), estimator, name);
             };
             cloud_render(PathEstimator<strategy::Unidirectional>{}, "unidirectional");
             cloud_render(PathEstimator<strategy::NextEvent>{}, "ratio-nee");
@@ -373,6 +421,90 @@ int main(int argc, char** argv) {
         }
     }
 
+    // Tables "empty" (--tables empty only): the main job's other scenes in empty space (nsp_render's
+    // SA, F1-F3, C1, C2, P1) as SurfaceScenes through its camera: the path tracers against BDPT
+    // with light tracing, plain and with its counts learned over the image.
+    const std::size_t first_empty = rows.size();
+    if (want("empty")) {
+        using nsp_examples::SceneChoice;
+        using nsp_examples::SceneKind;
+        const nsp::PinholeCamera camera = nsp_examples::cloud_pinhole();
+        // The path tracers stop at BDPT's 32 real vertices too, so that every row estimates the same
+        // integral (at the default 1000, C1's image is 0.1% brighter: 4 SE of BDPT's at 512 spp).
+        const EstimatorOptions depth = BdptEstimator<>::default_options();
+        run_res = std::max(1, res / 2);
+        run_spp = std::max(2, spp / 2);
+        // Rows [from, from + n_path) are the path tracers, then BDPT and BDPT learned.
+        auto finish = [&](const SceneChoice& c, const char* mode, std::size_t from, std::size_t n_path) {
+            std::vector<Row> t(rows.begin() + std::ptrdiff_t(from), rows.end());
+            const std::string title = std::string(c.name()) + " in empty space (" + mode;
+            failed += print_table(title.c_str(), t, 2, run_res, run_spp, threads,
+                                  "nsp_render's scene as a SurfaceScene, every row's paths at most 32 real vertices");
+            double best = nsp::kInf;
+            for (std::size_t i = 0; i < n_path; ++i)
+                if (t[i].variance > 0.0) best = std::min(best, cost(t, i));
+            std::printf("%s: bdpt / best path tracer in cpu-s*var: %.3g; bdpt learned: %.3g\n", c.name(),
+                        cost(t, n_path) / best, cost(t, n_path + 1) / best);
+            print_notes();
+        };
+        // The grey pdfs' rows of scene `sc`: the path tracers (with the equiangular one when
+        // `equiangular`), BDPT, BDPT learned.
+        auto grey_rows = [&](const auto& sc, const SceneChoice& c, const char* mode, auto equiangular) {
+            const std::size_t from = rows.size();
+            pinhole_render(sc, camera, PathEstimator<strategy::Unidirectional>(depth), "unidirectional");
+            pinhole_render(sc, camera, PathEstimator<strategy::NextEvent>(depth), "ratio-nee");
+            pinhole_render(sc, camera, PathEstimator<strategy::NullScatteringMis, mis::Balance>(depth), "uni-nee-mis_balance");
+            if constexpr (decltype(equiangular)::value)
+                pinhole_render(sc, camera, PathEstimator<strategy::EquiangularMis, mis::Balance>(depth), "uni-nee-eq-mis_balance");
+            pinhole_render(sc, camera, BdptEstimator<bdpt::NullScattering, mis::Balance>{}, "bdpt_null-mis_balance");
+            learned_render(sc, camera, "bdpt_null-mis_balance_learned", bdpt::Grey{});
+            finish(c, mode, from, decltype(equiangular)::value ? 4 : 3);
+        };
+        // Grey: the sparse medium under set-up A's light, the fog under its lamp; grid majorants (16^3).
+        seed = 37 + seed_offset;
+        for (const SceneChoice c : {SceneChoice{SceneKind::Sparse, nsp_examples::LightSetup::A},
+                                    SceneChoice{SceneKind::Fog, {}, {}, nsp_examples::FogSetup::F1},
+                                    SceneChoice{SceneKind::Fog, {}, {}, nsp_examples::FogSetup::F2},
+                                    SceneChoice{SceneKind::Fog, {}, {}, nsp_examples::FogSetup::F3}}) {
+            using GM = DenseGridMedium<Mono>;
+            GM medium = c.kind == SceneKind::Fog ? nsp_examples::make_fog_medium<Mono>(c.fog)
+                                                 : nsp_examples::make_sparse_medium<Mono>();
+            const GridMajorant<GM> majorant(medium, 16);
+            const auto sc = nsp_examples::make_empty_space_scene(std::move(medium), majorant, nsp_examples::phase_g(c.kind),
+                                                                 nsp_examples::scene_lights<Mono>(c));
+            grey_rows(sc, c, "mono, grid majorant", std::true_type{});
+        }
+        // Chromatic: C1 (a white sky), C2 (set-up A's sphere light); Rgb, per-channel majorants.
+        for (const SceneChoice c : {SceneChoice{SceneKind::Chromatic, {}, nsp_examples::ChromaticSetup::Env},
+                                    SceneChoice{SceneKind::Chromatic, {}, nsp_examples::ChromaticSetup::Small}}) {
+            using CM = DenseGridMedium<Rgb>;
+            CM medium = nsp_examples::make_chromatic_medium<Rgb>();
+            const ChannelMajorant<CM> majorant(medium);
+            const auto sc = nsp_examples::make_empty_space_scene(std::move(medium), majorant, nsp_examples::phase_g(c.kind),
+                                                                 nsp_examples::scene_lights<Rgb>(c));
+            const std::size_t from = rows.size();
+            pinhole_render(sc, camera, SpectralPathEstimator<channels::SpectralMis, strategy::Unidirectional>(depth),
+                           "unidirectional_spectral-mis");
+            pinhole_render(sc, camera, SpectralPathEstimator<channels::SpectralMis, strategy::NextEvent>(depth),
+                           "ratio-nee_spectral-mis");
+            pinhole_render(sc, camera, SpectralPathEstimator<channels::SpectralMis, strategy::NullScatteringMis, mis::Balance>(depth),
+                           "uni-nee-mis_spectral-mis");
+            pinhole_render(sc, camera, SpectralBdptEstimator<mis::Balance>{}, "bdpt_spectral-mis");
+            learned_render(sc, camera, "bdpt_spectral-mis_learned", channels::SpectralMis{});
+            finish(c, "rgb, per-channel majorants", from, 3);
+        }
+        // The plume (an emissive medium, no other light); Rgb (its flame's colour), grid majorant.
+        {
+            using PM = Emissive<DenseGridMedium<Rgb>>;
+            const SceneChoice c{SceneKind::Plume};
+            PM medium = nsp_examples::make_plume_medium<Rgb>();
+            const GridMajorant<PM> majorant(medium, 16);
+            const auto sc = nsp_examples::make_empty_space_scene(std::move(medium), majorant, nsp_examples::phase_g(c.kind),
+                                                                 nsp_examples::scene_lights<Rgb>(c));
+            grey_rows(sc, c, "rgb, grid majorant", std::false_type{});
+        }
+    }
+
     if (!no_png) {
         std::filesystem::create_directories(out);
         // One contact sheet per table, each at one exposure.
@@ -389,8 +521,11 @@ int main(int argc, char** argv) {
         sheet(out + "/room_sheet.png", 0, first);
         sheet(out + "/room_rgb_sheet.png", first, first_plume);
         sheet(out + "/room_plume_sheet.png", first_plume, first_lantern);
-        sheet(out + "/lantern_sheet.png", first_lantern, first_cloud);
-        sheet(out + "/cloud_bdpt_sheet.png", first_cloud, rows.size());
+        sheet(out + "/lantern_sheet.png", first_lantern, first_lantern_rgb);
+        sheet(out + "/lantern_rgb_sheet.png", first_lantern_rgb, first_sky);
+        sheet(out + "/room_sky_sheet.png", first_sky, first_cloud);
+        sheet(out + "/cloud_bdpt_sheet.png", first_cloud, first_empty);
+        sheet(out + "/empty_bdpt_sheet.png", first_empty, rows.size());
         if (want("grey")) {
         const Row picture = render(grey, PathEstimator<strategy::NullScatteringMis, mis::Balance>{}, "picture",
                                    picture_res, 128, threads, 99);

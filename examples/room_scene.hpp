@@ -5,6 +5,8 @@
 #pragma once
 
 #include <cmath>
+#include <utility>
+#include <vector>
 
 #include <nsp/nsp.hpp>
 
@@ -115,24 +117,48 @@ inline nsp::Ray room_camera_ray(float u, float v, float aspect) {
     return {eye, glm::normalize(f + (2.f * u - 1.f) * tan_half * aspect * r + (2.f * v - 1.f) * tan_half * up)};
 }
 
-/// The main job's cloud scene (default_scene.hpp, set-up A or B) as a SurfaceScene, so that the
-/// bidirectional estimator, which needs a geometry that reports the lights it may hit, renders
-/// it: the cloud behind null interfaces (medium 0), the set-up's sphere light as a sphere shape
-/// naming light 0, no other surface. What PathEstimator renders from it equals the nsp::Scene's
-/// image (the same medium, phase function, light and camera).
-using CloudLights = nsp::LightSampler<nsp::Mono, nsp::SphereLight<nsp::Mono>>;
-using CloudSurfaceScene =
-    nsp::SurfaceScene<nsp_host::Shapes, nsp::DenseGridMedium<nsp::Mono>, nsp::GlobalMajorant<nsp::DenseGridMedium<nsp::Mono>>,
-                      nsp::HenyeyGreensteinPhase, RoomMaterials<nsp::Mono>, CloudLights>;
-inline CloudSurfaceScene make_cloud_surface_scene(LightSetup setup) {
+/// The lights of the main job's scenes in empty space as one LightSampler type (a model's list
+/// is empty where a scene has none of it).
+template <nsp::SpectralMode S>
+using EmptySpaceLights = nsp::LightSampler<S, nsp::SphereLight<S>, nsp::PointLight<S>, nsp::EnvironmentLight<S>>;
+template <nsp::Medium M, class Maj>
+using EmptySpaceScene = nsp::SurfaceScene<nsp_host::Shapes, M, Maj, nsp::HenyeyGreensteinPhase,
+                                          RoomMaterials<typename M::Spectral>, EmptySpaceLights<typename M::Spectral>>;
+
+/// A scene of the main job's nsp_render (a medium in empty space under its nsp::Lights; the
+/// phase asymmetry g) as a SurfaceScene, so that the bidirectional estimator, which needs a
+/// geometry that reports the lights it may hit, renders it: the medium's box behind null
+/// interfaces (medium 0), a sphere light as a sphere shape naming light 0, no other surface;
+/// lights selected uniformly, scene radius 4 (nsp_render's). What PathEstimator renders from it
+/// equals the nsp::Scene's image (the same medium, phase function, lights and camera).
+template <nsp::Medium M, class Maj>
+EmptySpaceScene<M, Maj> make_empty_space_scene(M medium, Maj majorant, float g, const nsp::Lights<typename M::Spectral>& lights) {
+    using S = typename M::Spectral;
+    nsp_host::Shapes shapes;
+    const nsp::Box box = medium.bounds();
+    shapes.boxes.push_back({box.lo, box.hi, {-1, -1, 0, -1}});
+    std::vector<nsp::SphereLight<S>> spheres;
+    std::vector<nsp::PointLight<S>> points;
+    std::vector<nsp::EnvironmentLight<S>> environments;
+    if (lights.sphere()) {
+        spheres.push_back(*lights.sphere());
+        shapes.spheres.push_back({spheres[0].center, spheres[0].radius, {-1, 0, -1, -1}});  // light 0: the first model's first
+    }
+    if (lights.point()) points.push_back(*lights.point());
+    if (lights.environment()) environments.push_back(*lights.environment());
+    return EmptySpaceScene<M, Maj>(std::move(shapes), {{std::move(medium), std::move(majorant), nsp::HenyeyGreensteinPhase(g)}},
+                                   RoomMaterials<S>({}),
+                                   EmptySpaceLights<S>(nsp::LightSelection::Uniform, 4.f, std::move(spheres), std::move(points),
+                                                       std::move(environments)),
+                                   -1);
+}
+
+/// The main job's cloud scene (default_scene.hpp, set-up A or B) as a SurfaceScene
+/// (make_empty_space_scene): the grey cloud under its one global majorant.
+inline auto make_cloud_surface_scene(LightSetup setup) {
     auto cloud = make_default_medium<nsp::Mono>();
     nsp::GlobalMajorant<nsp::DenseGridMedium<nsp::Mono>> majorant(cloud);
-    const nsp::SphereLight<nsp::Mono> light = *default_lights<nsp::Mono>(setup).sphere();
-    nsp_host::Shapes shapes;
-    shapes.boxes.push_back({nsp::Vec3(-1.f), nsp::Vec3(1.f), {-1, -1, 0, -1}});
-    shapes.spheres.push_back({light.center, light.radius, {-1, 0, -1, -1}});
-    return CloudSurfaceScene(std::move(shapes), {{std::move(cloud), majorant, nsp::HenyeyGreensteinPhase(kPhaseG)}},
-                             RoomMaterials<nsp::Mono>({}), CloudLights(nsp::LightSelection::Uniform, 4.f, {light}), -1);
+    return make_empty_space_scene(std::move(cloud), majorant, kPhaseG, default_lights<nsp::Mono>(setup));
 }
 
 /// The main job's camera (default_scene.hpp's camera_ray) as an nsp::PinholeCamera, square image.

@@ -44,6 +44,17 @@ inline float phase_g(SceneKind kind) {
     return kind == SceneKind::Fog ? kFogPhaseG : kind == SceneKind::Plume ? kPlumePhaseG : kPhaseG;
 }
 
+/// The lights of set-up `choice` (the plume has none: the flame is its light).
+template <nsp::SpectralMode S>
+nsp::Lights<S> scene_lights(const SceneChoice& choice) {
+    switch (choice.kind) {
+        case SceneKind::Chromatic: return chromatic_lights<S>(choice.chromatic);
+        case SceneKind::Fog: return fog_lights<S>(choice.fog);
+        case SceneKind::Plume: return {};
+        default: return default_lights<S>(choice.cloud);
+    }
+}
+
 /// The run-time values of the majorant policies (flags --grid-res and --majorant-scale).
 struct MajorantSettings {
     int grid_res = 16;   ///< cells per axis of the grid majorants
