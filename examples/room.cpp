@@ -443,13 +443,16 @@ int main(int argc, char** argv) {
             double best = nsp::kInf;
             for (std::size_t i = 0; i < n_path; ++i)
                 if (t[i].variance > 0.0) best = std::min(best, cost(t, i));
-            std::printf("%s: bdpt / best path tracer in cpu-s*var: %.3g; bdpt learned: %.3g\n", c.name(),
+            std::printf("%s: bdpt / best path tracer in cpu-s*var: %.3g; bdpt learned: %.3g", c.name(),
                         cost(t, n_path) / best, cost(t, n_path + 1) / best);
+            for (std::size_t i = n_path + 2; i < t.size(); ++i) std::printf("; %s: %.3g", t[i].name.c_str(), cost(t, i) / best);
+            std::printf("\n");
             print_notes();
         };
         // The grey pdfs' rows of scene `sc`: the path tracers (with the equiangular one when
         // `equiangular`), BDPT, BDPT learned.
-        auto grey_rows = [&](const auto& sc, const SceneChoice& c, const char* mode, auto equiangular) {
+        auto grey_rows = [&](const auto& sc, const SceneChoice& c, const char* mode, auto equiangular,
+                             float fixed_light = 0.f) {
             const std::size_t from = rows.size();
             pinhole_render(sc, camera, PathEstimator<strategy::Unidirectional>(depth), "unidirectional");
             pinhole_render(sc, camera, PathEstimator<strategy::NextEvent>(depth), "ratio-nee");
@@ -458,6 +461,12 @@ int main(int argc, char** argv) {
                 pinhole_render(sc, camera, PathEstimator<strategy::EquiangularMis, mis::Balance>(depth), "uni-nee-eq-mis_balance");
             pinhole_render(sc, camera, BdptEstimator<bdpt::NullScattering, mis::Balance>{}, "bdpt_null-mis_balance");
             learned_render(sc, camera, "bdpt_null-mis_balance_learned", bdpt::Grey{});
+            if (fixed_light > 0.f) {  // a fixed light subpath probability, after the learned row
+                const std::string name = "bdpt_null-mis_balance_light-1/" + std::to_string(int(std::lround(1.f / fixed_light)));
+                pinhole_render(sc, camera,
+                               BdptEstimator<bdpt::NullScattering, mis::Balance>(BdptEstimator<>::default_options(), {}, fixed_light),
+                               name.c_str());
+            }
             finish(c, mode, from, decltype(equiangular)::value ? 4 : 3);
         };
         // Grey: the sparse medium under set-up A's light, the fog under its lamp; grid majorants (16^3).
@@ -501,7 +510,7 @@ int main(int argc, char** argv) {
             const GridMajorant<PM> majorant(medium, 16);
             const auto sc = nsp_examples::make_empty_space_scene(std::move(medium), majorant, nsp_examples::phase_g(c.kind),
                                                                  nsp_examples::scene_lights<Rgb>(c));
-            grey_rows(sc, c, "rgb, grid majorant", std::false_type{});
+            grey_rows(sc, c, "rgb, grid majorant", std::false_type{}, 1.f / 64.f);  // P1: + light subpaths on 1/64
         }
     }
 
@@ -517,6 +526,7 @@ int main(int argc, char** argv) {
                 images.push_back(&rows[i].image);
             }
             nsp_examples::write_contact_sheet(path, tiles, nsp_examples::exposure_for(images));
+            std::fprintf(stderr, "  room: %s\n", path.c_str());
         };
         sheet(out + "/room_sheet.png", 0, first);
         sheet(out + "/room_rgb_sheet.png", first, first_plume);
@@ -530,9 +540,7 @@ int main(int argc, char** argv) {
         const Row picture = render(grey, PathEstimator<strategy::NullScatteringMis, mis::Balance>{}, "picture",
                                    picture_res, 128, threads, 99);
         nsp_examples::write_png(out + "/room.png", picture.image, nsp_examples::exposure_for({&picture.image}));
-        std::fprintf(stderr, "  room: %s/room_sheet.png, %s/room_rgb_sheet.png, %s/room_plume_sheet.png, %s/lantern_sheet.png, "
-                     "%s/room.png (%.1f s)\n",
-                     out.c_str(), out.c_str(), out.c_str(), out.c_str(), out.c_str(), picture.seconds);
+        std::fprintf(stderr, "  room: %s/room.png (%.1f s)\n", out.c_str(), picture.seconds);
         }
     }
     return failed == 0 ? 0 : 1;
