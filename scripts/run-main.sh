@@ -15,9 +15,9 @@
 #  1b. nsp_room: the cloud over a diffuse floor in an open room under a quad light and a dim sky
 #     (the scene with surfaces) with every strategy PathEstimator renders surfaces with, then the
 #     chromatic cloud in the room with the spectral estimators, the glowing plume, and the lantern
-#     (a lamp boxed above the cloud) with the path tracers against BDPT; its four tables and
-#     out/room_sheet.png, out/room_rgb_sheet.png, out/room_plume_sheet.png, out/lantern_sheet.png,
-#     out/room.png;
+#     (a lamp boxed above the cloud), grey and chromatic, with the path tracers against BDPT; its
+#     five tables and out/room_sheet.png, out/room_rgb_sheet.png, out/room_plume_sheet.png,
+#     out/lantern_sheet.png, out/lantern_rgb_sheet.png, out/room.png;
 #  1c. nsp_volume: the smoke plume (512^3, .vdb) and the cloud (.vdb) exported and rendered under
 #     every majorant (global, grid 16^3 and 64^3, tree on the VDB nodes, adaptive tree), their
 #     tables and out/plume_vdb/volume.png, out/cloud_vdb/volume.png; then the plume glowing by its
