@@ -41,6 +41,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "combinations.hpp"
 #include "image_render.hpp"
 #include "png_writer.hpp"
 #include "render_job.hpp"
@@ -464,7 +465,7 @@ int main(int argc, char** argv) {
             if (fixed_light > 0.f) {  // a fixed light subpath probability, after the learned row
                 const std::string name = "bdpt_null-mis_balance_light-1/" + std::to_string(int(std::lround(1.f / fixed_light)));
                 pinhole_render(sc, camera,
-                               BdptEstimator<bdpt::NullScattering, mis::Balance>(BdptEstimator<>::default_options(), {}, fixed_light),
+                               BdptEstimator<bdpt::NullScattering, mis::Balance>(depth, {}, fixed_light),
                                name.c_str());
             }
             finish(c, mode, from, decltype(equiangular)::value ? 4 : 3);
@@ -475,10 +476,8 @@ int main(int argc, char** argv) {
                                     SceneChoice{SceneKind::Fog, {}, {}, nsp_examples::FogSetup::F1},
                                     SceneChoice{SceneKind::Fog, {}, {}, nsp_examples::FogSetup::F2},
                                     SceneChoice{SceneKind::Fog, {}, {}, nsp_examples::FogSetup::F3}}) {
-            using GM = DenseGridMedium<Mono>;
-            GM medium = c.kind == SceneKind::Fog ? nsp_examples::make_fog_medium<Mono>(c.fog)
-                                                 : nsp_examples::make_sparse_medium<Mono>();
-            const GridMajorant<GM> majorant(medium, 16);
+            auto medium = nsp_examples::DenseGridCloud::make<Mono>(c);  // nsp_render's medium and majorant
+            const auto majorant = nsp_examples::GridMajorantPolicy<>::make(medium, nsp_examples::MajorantSettings{});
             const auto sc = nsp_examples::make_empty_space_scene(std::move(medium), majorant, nsp_examples::phase_g(c.kind),
                                                                  nsp_examples::scene_lights<Mono>(c));
             grey_rows(sc, c, "mono, grid majorant", std::true_type{});
@@ -486,9 +485,8 @@ int main(int argc, char** argv) {
         // Chromatic: C1 (a white sky), C2 (set-up A's sphere light); Rgb, per-channel majorants.
         for (const SceneChoice c : {SceneChoice{SceneKind::Chromatic, {}, nsp_examples::ChromaticSetup::Env},
                                     SceneChoice{SceneKind::Chromatic, {}, nsp_examples::ChromaticSetup::Small}}) {
-            using CM = DenseGridMedium<Rgb>;
-            CM medium = nsp_examples::make_chromatic_medium<Rgb>();
-            const ChannelMajorant<CM> majorant(medium);
+            auto medium = nsp_examples::DenseGridCloud::make<Rgb>(c);
+            const auto majorant = nsp_examples::ChannelMajorantPolicy::make(medium, nsp_examples::MajorantSettings{});
             const auto sc = nsp_examples::make_empty_space_scene(std::move(medium), majorant, nsp_examples::phase_g(c.kind),
                                                                  nsp_examples::scene_lights<Rgb>(c));
             const std::size_t from = rows.size();
@@ -504,10 +502,9 @@ int main(int argc, char** argv) {
         }
         // The plume (an emissive medium, no other light); Rgb (its flame's colour), grid majorant.
         {
-            using PM = Emissive<DenseGridMedium<Rgb>>;
             const SceneChoice c{SceneKind::Plume};
-            PM medium = nsp_examples::make_plume_medium<Rgb>();
-            const GridMajorant<PM> majorant(medium, 16);
+            auto medium = nsp_examples::EmissivePlume::make<Rgb>(c);
+            const auto majorant = nsp_examples::GridMajorantPolicy<>::make(medium, nsp_examples::MajorantSettings{});
             const auto sc = nsp_examples::make_empty_space_scene(std::move(medium), majorant, nsp_examples::phase_g(c.kind),
                                                                  nsp_examples::scene_lights<Rgb>(c));
             grey_rows(sc, c, "rgb, grid majorant", std::false_type{}, 1.f / 64.f);  // P1: + light subpaths on 1/64
