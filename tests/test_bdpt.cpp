@@ -58,6 +58,12 @@ using Pdfs = bdpt::PathPdfs<16>;
 /// (x_0 by NEE when s = 1, by emission when s >= 2), x_s..x_{k-1} from the camera; 0 where a
 /// connection would end at a delta vertex.
 double brute_pdf(const Pdfs& p, int s) {
+    if (s == Pdfs::kEquiangular) {  // x_0 by NEE from x_1, x_1 by equiangular sampling from x_2
+        if (p.k < 2 || !p.connectible[1]) return 0.0;
+        double v = double(p.eq_nee) * double(p.eq);
+        for (int i = 2; i < p.k; ++i) v *= p.from_camera[i];
+        return v;
+    }
     if (s == p.k) {  // t = 1: x_0..x_{k-1} from the light, x_{k-1} connected to the camera
         if (!p.light_tracing || p.k < 2 || !p.connectible[p.k - 1]) return 0.0;
     } else {
@@ -73,7 +79,7 @@ double brute_pdf(const Pdfs& p, int s) {
 TEST_CASE("bdpt: the strategy weights of a path are the heuristics of its strategies' pdfs and sum to 1") {
     // Random densities over 12 orders of magnitude, delta vertices and zero densities (a point
     // light: from_camera[0] = 0; a light at infinity: emit = 0), paths of 2 to 15 vertices, with
-    // and without light tracing (t = 1).
+    // and without light tracing (t = 1), with and without the equiangular strategy.
     Pcg32 rng(17, 3);
     const mis::Balance balance;
     const mis::Power power(2.f);
@@ -92,15 +98,20 @@ TEST_CASE("bdpt: the strategy weights of a path are the heuristics of its strate
         p.nee = density();
         p.emit = rng.uniform() < 0.2f ? 0.f : density();
         if (rng.uniform() < 0.2f) p.from_camera[0] = 0.f;
+        p.eq = rng.uniform() < 0.3f ? 0.f : density();
+        p.eq_nee = rng.uniform() < 0.2f ? 0.f : density();
         const int count = p.light_tracing && p.k >= 2 ? p.k + 1 : p.k;
         CHECK(bdpt::strategy_count(p) == count);
+        std::vector<int> strategies;
+        for (int s = 0; s < count; ++s) strategies.push_back(s);
+        strategies.push_back(Pdfs::kEquiangular);
         double total = 0.0, total2 = 0.0;
-        for (int s = 0; s < count; ++s) {
+        for (const int s : strategies) {
             total += brute_pdf(p, s);
             total2 += brute_pdf(p, s) * brute_pdf(p, s);
         }
         float sum_b = 0.f, sum_p = 0.f;
-        for (int s = 0; s < count; ++s) {
+        for (const int s : strategies) {
             const float wb = bdpt::strategy_weight(balance, p, s), wp = bdpt::strategy_weight(power, p, s);
             CAPTURE(trial);
             CAPTURE(s);
@@ -222,23 +233,37 @@ TEST_CASE("bdpt: agrees with PathEstimator on a scattering cube over a floor, a 
 }
 
 /// What one run of the estimator on the cube over the floor measured per strategy, over the paths
-/// whose consecutive real vertices lie at least 0.3 apart (see below): for each (s, t), the
-/// unweighted contribution of every sample (0 where the strategy drew no such path), and for each
-/// other strategy o of the same path length, p_o / sum_r p_r of the path s drew (0 likewise).
+/// whose consecutive real vertices lie at least 0.3 apart (see below): for each strategy (s, t),
+/// the unweighted contribution of every sample (0 where the strategy drew no such path), the same
+/// over the paths whose x_1 is a medium vertex and x_0 a light's (outside the cube [-1, 1]^3 the
+/// tests' media fill), and for each other strategy o of the same path
+/// length, p_o / sum_r p_r of the path s drew (0 likewise). The equiangular strategy is (eq, t),
+/// t its camera-side vertices as s = 1's.
 struct StrategyRecord {
+    int eq = 0;  ///< the equiangular strategy's index (PathPdfs::kEquiangular)
     std::map<std::pair<int, int>, Stat> alone;
+    std::map<std::pair<int, int>, Stat> alone_medium;
     std::map<std::pair<int, int>, std::map<int, Stat>> share;
+
+    /// The strategies of the paths of n interior vertices: (s, n + 2 - s), s = 0..n+1, and (eq, n + 1).
+    std::vector<std::pair<int, int>> strategies(int n) const {
+        std::vector<std::pair<int, int>> out;
+        for (int s = 0; s <= n + 1; ++s) out.emplace_back(s, n + 2 - s);
+        out.emplace_back(eq, n + 1);
+        return out;
+    }
 };
 
 /// Samples of the cube's image at uniform (u, v) over the whole image, light tracing included.
 template <class E, class Scene>
 StrategyRecord record_strategies(const E& est, const Scene& sc, int n_samples, int longest) {
     StrategyRecord rec;
+    rec.eq = E::Pdfs::kEquiangular;
     Pcg32 rng(41, 7);
     LookupCount counter;
     const PinholeCamera camera = cube_pinhole();
-    std::map<std::pair<int, int>, double> value;
-    std::map<std::pair<int, int>, std::vector<double>> shares;
+    std::map<std::pair<int, int>, double> value, value_medium;
+    std::map<std::pair<int, int>, std::map<int, double>> shares;
     auto far_apart = [](const auto& v) {
         std::vector<Vec3> x{v.x0};
         for (int i = 1; i < v.s; ++i) x.push_back(v.light[i].p);
@@ -250,36 +275,42 @@ StrategyRecord record_strategies(const E& est, const Scene& sc, int n_samples, i
     };
     for (int i = 0; i < n_samples; ++i) {
         value.clear();
+        value_medium.clear();
         shares.clear();
         auto observe = [&](int s, int t, const Spectrum& f, float, const auto& pdfs, const auto& vertices) {
             if (!far_apart(vertices)) return;
             value[{s, t}] += double(f[0]);
+            const auto& x1 = vertices.s >= 2 ? vertices.light[1] : vertices.camera[vertices.t - 1];
+            const bool x0_on_light = vertices.x0_at_infinity || !Box{Vec3(-1.f), Vec3(1.f)}.contains(vertices.x0);
+            if (x1.kind == bdpt::VertexKind::Medium && x0_on_light) value_medium[{s, t}] += double(f[0]);
             double q[E::kMaxPath + 1];
             REQUIRE(bdpt::strategy_pdfs(pdfs, q));
-            const int count = bdpt::strategy_count(pdfs);
+            std::vector<int> all;
+            for (int o = 0; o < bdpt::strategy_count(pdfs); ++o) all.push_back(o);
+            all.push_back(rec.eq);
             double sum = 0.0;
-            for (int o = 0; o < count; ++o) sum += q[o];
+            for (const int o : all) sum += q[o];
             // Summed: a strategy may draw several paths in one sample (the collision estimator's
             // every tentative collision; NEE toward the lights and toward the volume), each a sample
             // of its density, so E_s[sum of the shares] is still the integral of p_s p_o / sum p.
-            auto& sh = shares[{s, t}];
-            sh.resize(std::max(sh.size(), std::size_t(count)), 0.0);
-            for (int o = 0; o < count; ++o) sh[std::size_t(o)] += q[o] / sum;
+            for (const int o : all) shares[{s, t}][o] += q[o] / sum;
         };
         auto splat = [](float, float, const Spectrum&) {};
         const float u = rng.uniform(), v = rng.uniform();
         const auto r = est.sample_observed(sc, camera, u, v, {}, rng, counter, splat, observe);
         REQUIRE(r.status == Status::Ok);
-        for (int n = 1; n <= longest; ++n)
-            for (int s = 0; s <= n + 1; ++s) {
-                const auto key = std::make_pair(s, n + 2 - s);
+        for (int n = 1; n <= longest; ++n) {
+            const auto keys = rec.strategies(n);
+            for (const auto& key : keys) {
                 rec.alone[key].add(value.count(key) ? value[key] : 0.0);
+                rec.alone_medium[key].add(value_medium.count(key) ? value_medium[key] : 0.0);
                 const auto it = shares.find(key);
-                for (int o = 0; o <= n + 1; ++o)
-                    rec.share[key][o].add(it == shares.end() || std::size_t(o) >= it->second.size()
-                                              ? 0.0
-                                              : it->second[std::size_t(o)]);
+                for (const auto& other : keys) {
+                    const int o = other.first;
+                    rec.share[key][o].add(it == shares.end() || !it->second.count(o) ? 0.0 : it->second.at(o));
+                }
             }
+        }
     }
     return rec;
 }
@@ -288,17 +319,23 @@ StrategyRecord record_strategies(const E& est, const Scene& sc, int n_samples, i
 /// in combined standard errors.
 double worst_share_asymmetry(StrategyRecord& rec, int longest) {
     double worst = 0.0;
-    for (int n = 1; n <= longest; ++n)
-        for (int s = 0; s <= n + 1; ++s)
-            for (int o = s + 1; o <= n + 1; ++o) {
-                const Stat& a = rec.share[{s, n + 2 - s}][o];
-                const Stat& b = rec.share[{o, n + 2 - o}][s];
+    for (int n = 1; n <= longest; ++n) {
+        const auto keys = rec.strategies(n);
+        for (std::size_t i = 0; i < keys.size(); ++i)
+            for (std::size_t j = i + 1; j < keys.size(); ++j) {
+                const Stat& a = rec.share[keys[i]][keys[j].first];
+                const Stat& b = rec.share[keys[j]][keys[i].first];
                 const double se = std::sqrt(a.se() * a.se() + b.se() * b.se());
+                if (!(se > 0.0)) {  // neither draws the other's paths: both shares are 0
+                    CHECK(a.mean == b.mean);
+                    continue;
+                }
                 if (getenv("BDPT_DEBUG"))
-                    printf("n=%d s=%d o=%d  E_s[p_o/sum] %.5f  E_o[p_s/sum] %.5f  (%.1f SE)\n", n, s, o, a.mean, b.mean,
-                           std::abs(a.mean - b.mean) / se);
+                    printf("n=%d s=%d o=%d  E_s[p_o/sum] %.5f  E_o[p_s/sum] %.5f  (%.1f SE)\n", n, keys[i].first,
+                           keys[j].first, a.mean, b.mean, std::abs(a.mean - b.mean) / se);
                 worst = std::max(worst, std::abs(a.mean - b.mean) / se);
             }
+    }
     return worst;
 }
 
@@ -315,7 +352,7 @@ EstimatorOptions strategy_test_options() {
 /// (s, t) alone against NEE's estimate of the same path length, and the pdf symmetry over every
 /// pair of strategies, both within 5 combined SE. `hittable`: the lights can be hit (s = 0 draws
 /// paths); else s = 0 must contribute exactly nothing.
-void check_strategies_alone_and_symmetric(StrategyRecord& rec, bool hittable = true) {
+void check_strategies_alone_and_symmetric(StrategyRecord& rec, bool hittable = true, bool equiangular = false) {
     for (int n = 1; n <= 3; ++n) {
         const Stat& nee = rec.alone[{1, n + 1}];
         for (int s = 0; s <= n + 1; ++s) {
@@ -331,6 +368,21 @@ void check_strategies_alone_and_symmetric(StrategyRecord& rec, bool hittable = t
             CHECK(a.mean > 0.0);
             CHECK(std::abs(a.mean - nee.mean) <= kSigmas * std::sqrt(a.se() * a.se() + nee.se() * nee.se()));
         }
+        // The equiangular strategy draws the paths whose x_1 is a medium vertex and x_0 a light's,
+        // all of them: its estimate alone against NEE's over those paths (5 combined SE); where it
+        // is off (no light with a target), nothing.
+        const Stat& eq = rec.alone[{rec.eq, n + 1}];
+        const Stat& nee_medium = rec.alone_medium[{1, n + 1}];
+        CAPTURE(n);
+        CAPTURE(eq.mean);
+        CAPTURE(nee_medium.mean);
+        if (!equiangular) {
+            CHECK(eq.mean == 0.0);
+            continue;
+        }
+        CHECK(eq.mean > 0.0);
+        CHECK(rec.alone_medium[{rec.eq, n + 1}].mean == eq.mean);
+        CHECK(std::abs(eq.mean - nee_medium.mean) <= kSigmas * std::sqrt(eq.se() * eq.se() + nee_medium.se() * nee_medium.se()));
     }
     CHECK(worst_share_asymmetry(rec, 3) <= kSigmas);
 }
@@ -351,7 +403,7 @@ TEST_CASE("bdpt: each strategy alone is unbiased, and the strategies' pdfs are t
     const Sc sc = cube_over_floor(false);
     const EstimatorOptions opts = strategy_test_options();
     StrategyRecord rec = record_strategies(BdptEstimator<bdpt::NullScattering, mis::Balance>(opts), sc, 200000, 3);
-    check_strategies_alone_and_symmetric(rec);
+    check_strategies_alone_and_symmetric(rec, true, true);
 }
 
 /// The cube over the floor under a sky alone (no lamp), whose light sampler has a BoundingSphere of
@@ -507,12 +559,15 @@ TEST_CASE("bdpt: without nulls, null-scattering MIS weighs every path as directi
     // segment has a null: both estimators (the same random draws; the weights draw none) must
     // return the same value and the same splats for every sample, to float rounding (1e-4
     // relative). With the majorant twice the extinction the weights must differ (some sample by
-    // more than 1 %): the comparison can fail.
+    // more than 1 %): the comparison can fail. The equiangular strategy, which directional MIS
+    // does not have, is off.
     const PinholeCamera camera = cube_pinhole();
+    EstimatorOptions no_eq = BdptEstimator<>::default_options();
+    no_eq.bdpt_equiangular = false;
     for (const bool tight : {true, false}) {
         CAPTURE(tight);
         const Sc sc = cube_over_floor(true, 1.2f, tight);
-        const BdptEstimator<bdpt::NullScattering, mis::Balance> null_mis;
+        const BdptEstimator<bdpt::NullScattering, mis::Balance> null_mis(no_eq);
         const BdptEstimator<bdpt::Directional, mis::Balance> directional;
         LookupCount counter;
         double worst = 0.0;
@@ -713,7 +768,7 @@ TEST_CASE("bdpt: an emitting cube: each strategy alone unbiased, the pdfs true d
     const ESc sc = emitting_cube_over_floor();
     const EstimatorOptions opts = strategy_test_options();
     StrategyRecord rec = record_strategies(BdptEstimator<bdpt::NullScattering, mis::Balance>(opts), sc, 200000, 3);
-    check_strategies_alone_and_symmetric(rec);
+    check_strategies_alone_and_symmetric(rec, true, true);
 }
 
 TEST_CASE("bdpt: agrees with PathEstimator on an emitting cube over a floor under a lamp") {
@@ -765,7 +820,7 @@ TEST_CASE("bdpt: light subpaths and NEE on a fraction of the samples (expected c
     opts.nee_count = 0.5f;
     StrategyRecord rec =
         record_strategies(BdptEstimator<bdpt::NullScattering, mis::Balance>(opts, {}, 0.4f), cube_over_floor(false), 200000, 3);
-    check_strategies_alone_and_symmetric(rec);
+    check_strategies_alone_and_symmetric(rec, true, true);
     CHECK_THROWS_WITH_AS((BdptEstimator<>(BdptEstimator<>::default_options(), {}, 0.f)),
                          doctest::Contains("light_subpath_probability = 0 is not allowed"), InvalidArgument);
     CHECK_THROWS_WITH_AS((BdptEstimator<>(BdptEstimator<>::default_options(), {}, 1.5f)),

@@ -132,6 +132,12 @@ using Pdfs3 = bdpt::PathPdfs<16, Rgb::Spectrum>;
 /// Channel c's pdf of the path under strategy s, as a plain product times its shared factor
 /// gamma_c (THEORY 5.5 per channel, 5.3); 0 where a connection would end at a delta vertex.
 double brute_channel_pdf(const Pdfs3& p, int c, int s) {
+    if (s == Pdfs3::kEquiangular) {  // x_0 by NEE from x_1, x_1 by equiangular sampling from x_2
+        if (p.k < 2 || !p.connectible[1]) return 0.0;
+        double v = double(p.eq_nee) * double(p.eq[c]);
+        for (int i = 2; i < p.k; ++i) v *= p.from_camera[i][c];
+        return v * p.gamma[c];
+    }
     if (s == p.k) {
         if (!p.light_tracing || p.k < 2 || !p.connectible[p.k - 1]) return 0.0;
     } else {
@@ -146,7 +152,8 @@ double brute_channel_pdf(const Pdfs3& p, int c, int s) {
 
 TEST_CASE("spectral bdpt: the weights over channels x strategies are the heuristics of their pdfs and sum to 1") {
     // Random per-channel densities over 12 decades, shared factors gamma_c over 6, delta vertices,
-    // paths of 2 to 15 vertices, with and without light tracing; uniform selection q_c = 1/3. The
+    // paths of 2 to 15 vertices, with and without light tracing and the equiangular strategy;
+    // uniform selection q_c = 1/3. The
     // sampling channel c*'s weight w_(s,c*) = power(q p_(s,c*)) / sum_(c,s') power(q p_(s',c)) is
     // returned divided by q (the factor of the throughput f / p_(s,c*)), so sum_(c*,s) q W = 1.
     // Then under the power heuristic of exponent 100 the weights still sum to 1: q_c x the
@@ -173,10 +180,15 @@ TEST_CASE("spectral bdpt: the weights over channels x strategies are the heurist
         if (rng.uniform() < 0.2f) p.from_camera[0] = Rgb::Spectrum::Zero();
         for (int c = 0; c < 3; ++c) p.gamma[c] = std::pow(10.f, -6.f * rng.uniform());
         p.gamma /= p.gamma.maxCoeff();
+        p.eq = rng.uniform() < 0.3f ? Rgb::Spectrum(Rgb::Spectrum::Zero()) : channels();
+        p.eq_nee = rng.uniform() < 0.2f ? 0.f : density();
         const int count = bdpt::strategy_count(p);
+        std::vector<int> strategies;
+        for (int s = 0; s < count; ++s) strategies.push_back(s);
+        strategies.push_back(Pdfs3::kEquiangular);
         double total = 0.0, total2 = 0.0;
         for (int c = 0; c < 3; ++c)
-            for (int s = 0; s < count; ++s) {
+            for (const int s : strategies) {
                 const double x = q * brute_channel_pdf(p, c, s);
                 total += x;
                 total2 += x * x;
@@ -184,7 +196,7 @@ TEST_CASE("spectral bdpt: the weights over channels x strategies are the heurist
         double sum_b = 0.0, sum_p = 0.0;
         for (int c = 0; c < 3; ++c) {
             p.channel = c;
-            for (int s = 0; s < count; ++s) {
+            for (const int s : strategies) {
                 const double x = q * brute_channel_pdf(p, c, s);
                 const float wb = bdpt::channel_strategy_weight(balance, p, s);
                 const float wp = bdpt::channel_strategy_weight(power, p, s);
@@ -203,7 +215,7 @@ TEST_CASE("spectral bdpt: the weights over channels x strategies are the heurist
             double sum_steep = 0.0;
             for (int c = 0; c < 3; ++c) {
                 p.channel = c;
-                for (int s = 0; s < count; ++s) sum_steep += q * bdpt::channel_strategy_weight(steep, p, s);
+                for (const int s : strategies) sum_steep += q * bdpt::channel_strategy_weight(steep, p, s);
             }
             CAPTURE(trial);
             CHECK(sum_steep == doctest::Approx(1.0).epsilon(1e-5));
@@ -388,15 +400,26 @@ TEST_CASE("spectral bdpt: agrees with SpectralPathEstimator under a lamp and a s
 
 /// Per channel and strategy (s, t) of paths of 1..3 interior vertices whose consecutive real
 /// vertices lie 0.3 apart: the strategy alone with MIS over channels only (f_lambda gamma_c* p_(s,c*)
-/// / sum_c q_c gamma_c p_(s,c), the one-sample estimate of s alone), and for every other strategy o
-/// the share pbar_o / sum_r pbar_r of the path s drew, pbar_s = sum_c q_c p_(s,c) the density of
-/// strategy s over the channel selection.
+/// / sum_c q_c gamma_c p_(s,c), the one-sample estimate of s alone), the same over the paths whose
+/// x_1 is a medium vertex and x_0 a light's (outside the cube [-1, 1]^3), and for every other
+/// strategy o the share pbar_o / sum_r pbar_r of the path s drew, pbar_s = sum_c q_c p_(s,c) the
+/// density of strategy s over the channel selection. The equiangular strategy is (eq, t).
 struct ChannelStrategyRecord {
+    int eq = 0;  ///< the equiangular strategy's index (PathPdfs::kEquiangular)
     std::map<std::pair<int, int>, SpecStat<Rgb>> alone;
+    std::map<std::pair<int, int>, SpecStat<Rgb>> alone_medium;
     std::map<std::pair<int, int>, std::map<int, Stat>> share;
     /// Per sampling channel c: p_(o,c) / sum_r p_(r,c) of the paths that s drew with c (0 on the
     /// samples of the other channels).
     std::array<std::map<std::pair<int, int>, std::map<int, Stat>>, 3> channel_share;
+
+    /// The strategies of the paths of n interior vertices: (s, n + 2 - s), s = 0..n+1, and (eq, n + 1).
+    std::vector<std::pair<int, int>> strategies(int n) const {
+        std::vector<std::pair<int, int>> out;
+        for (int s = 0; s <= n + 1; ++s) out.emplace_back(s, n + 2 - s);
+        out.emplace_back(eq, n + 1);
+        return out;
+    }
 };
 
 template <class E, class Scene>
@@ -404,12 +427,12 @@ ChannelStrategyRecord record_channel_strategies(const E& est, const Scene& sc, i
     constexpr int N = E::kMaxPath;
     using Spectrum = Rgb::Spectrum;
     ChannelStrategyRecord rec;
+    rec.eq = N;
     Pcg32 rng(43, 7);
     LookupCount counter;
     const PinholeCamera camera = cube_view();
-    std::map<std::pair<int, int>, Spectrum> value;
-    std::map<std::pair<int, int>, std::vector<double>> shares;
-    std::map<std::pair<int, int>, std::vector<double>> own_shares;
+    std::map<std::pair<int, int>, Spectrum> value, value_medium;
+    std::map<std::pair<int, int>, std::map<int, double>> shares, own_shares;
     int channel = 0;
     auto far_apart = [](const auto& v) {
         std::vector<Vec3> x{v.x0};
@@ -422,61 +445,68 @@ ChannelStrategyRecord record_channel_strategies(const E& est, const Scene& sc, i
     };
     for (int i = 0; i < n_samples; ++i) {
         value.clear();
+        value_medium.clear();
         shares.clear();
         own_shares.clear();
         auto observe = [&](int s, int t, const Spectrum& f, float, const auto& pdfs, const auto& vertices) {
             if (!far_apart(vertices)) return;
             double q[3 * (N + 1)];
             REQUIRE(bdpt::channel_strategy_pdfs(pdfs, q));
-            const int count = bdpt::strategy_count(pdfs);
+            std::vector<int> all;
+            for (int o = 0; o < bdpt::strategy_count(pdfs); ++o) all.push_back(o);
+            all.push_back(N);
             double own_sum = 0.0, total = 0.0;
-            std::vector<double> mixture(std::size_t(count), 0.0);
+            std::map<int, double> mixture;
             for (int c = 0; c < 3; ++c) {
                 own_sum += q[c * (N + 1) + s] / 3.0;
-                for (int o = 0; o < count; ++o) mixture[std::size_t(o)] += q[c * (N + 1) + o] / 3.0;
+                for (const int o : all) mixture[o] += q[c * (N + 1) + o] / 3.0;
             }
-            for (const double x : mixture) total += x;
+            for (const auto& [o, x] : mixture) total += x;
             REQUIRE(own_sum > 0.0);
+            const Spectrum alone = f * float(q[pdfs.channel * (N + 1) + s] / own_sum);
             value.try_emplace({s, t}, Spectrum::Zero());
-            value[{s, t}] += f * float(q[pdfs.channel * (N + 1) + s] / own_sum);
-            auto& sh = shares[{s, t}];
-            sh.resize(std::max(sh.size(), std::size_t(count)), 0.0);
-            for (int o = 0; o < count; ++o) sh[std::size_t(o)] += mixture[std::size_t(o)] / total;
+            value[{s, t}] += alone;
+            const auto& x1 = vertices.s >= 2 ? vertices.light[1] : vertices.camera[vertices.t - 1];
+            const bool x0_on_light = vertices.x0_at_infinity || !Box{Vec3(-1.f), Vec3(1.f)}.contains(vertices.x0);
+            if (x1.kind == bdpt::VertexKind::Medium && x0_on_light) {
+                value_medium.try_emplace({s, t}, Spectrum::Zero());
+                value_medium[{s, t}] += alone;
+            }
+            for (const int o : all) shares[{s, t}][o] += mixture[o] / total;
             channel = pdfs.channel;
             double own_total = 0.0;
-            for (int o = 0; o < count; ++o) own_total += q[channel * (N + 1) + o];
-            auto& osh = own_shares[{s, t}];
-            osh.resize(std::max(osh.size(), std::size_t(count)), 0.0);
-            for (int o = 0; o < count; ++o) osh[std::size_t(o)] += q[channel * (N + 1) + o] / own_total;
+            for (const int o : all) own_total += q[channel * (N + 1) + o];
+            for (const int o : all) own_shares[{s, t}][o] += q[channel * (N + 1) + o] / own_total;
         };
         auto splat = [](float, float, const Spectrum&) {};
         const float u = rng.uniform(), v = rng.uniform();
         const auto r = est.sample_observed(sc, camera, u, v, Rgb::Wavelengths{}, rng, counter, splat, observe);
         REQUIRE(r.status == Status::Ok);
-        for (int n = 1; n <= 3; ++n)
-            for (int s = 0; s <= n + 1; ++s) {
-                const auto key = std::make_pair(s, n + 2 - s);
+        for (int n = 1; n <= 3; ++n) {
+            const auto keys = rec.strategies(n);
+            for (const auto& key : keys) {
                 rec.alone[key].add(value.count(key) ? value[key] : Spectrum(Spectrum::Zero()));
+                rec.alone_medium[key].add(value_medium.count(key) ? value_medium[key] : Spectrum(Spectrum::Zero()));
                 const auto it = shares.find(key);
                 const auto own = own_shares.find(key);
-                for (int o = 0; o <= n + 1; ++o) {
-                    rec.share[key][o].add(it == shares.end() || std::size_t(o) >= it->second.size()
-                                              ? 0.0
-                                              : it->second[std::size_t(o)]);
+                for (const auto& other : keys) {
+                    const int o = other.first;
+                    rec.share[key][o].add(it == shares.end() || !it->second.count(o) ? 0.0 : it->second.at(o));
                     for (int c = 0; c < 3; ++c)
                         rec.channel_share[std::size_t(c)][key][o].add(
-                            c != channel || own == own_shares.end() || std::size_t(o) >= own->second.size()
-                                ? 0.0
-                                : own->second[std::size_t(o)]);
+                            c != channel || own == own_shares.end() || !own->second.count(o) ? 0.0 : own->second.at(o));
                 }
             }
+        }
     }
     return rec;
 }
 
 /// The checks on a record of paths of 1..3 interior vertices (see the test below). `hittable`:
 /// the lights can be hit (s = 0 draws paths); else s = 0 must contribute exactly nothing.
-void check_channel_strategies(ChannelStrategyRecord& rec, bool hittable = true) {
+/// `equiangular`: the equiangular strategy draws every path whose x_1 is a medium vertex and x_0
+/// a light's (against NEE over those, 5 combined SE per channel); else it draws none.
+void check_channel_strategies(ChannelStrategyRecord& rec, bool hittable = true, bool equiangular = false) {
     for (int n = 1; n <= 3; ++n) {
         const SpecStat<Rgb>& nee = rec.alone[{1, n + 1}];
         for (int s = 0; s <= n + 1; ++s) {
@@ -495,16 +525,38 @@ void check_channel_strategies(ChannelStrategyRecord& rec, bool hittable = true) 
                 CHECK(std::abs(a.ch[c].mean - nee.ch[c].mean) <= kSigmas * std::hypot(a.ch[c].se(), nee.ch[c].se()));
             }
         }
+        const SpecStat<Rgb>& eq = rec.alone[{rec.eq, n + 1}];
+        const SpecStat<Rgb>& nee_medium = rec.alone_medium[{1, n + 1}];
+        for (int c = 0; c < 3; ++c) {
+            CAPTURE(n);
+            CAPTURE(c);
+            CAPTURE(eq.ch[c].mean);
+            CAPTURE(nee_medium.ch[c].mean);
+            if (!equiangular) {
+                CHECK(eq.ch[c].mean == 0.0);
+                continue;
+            }
+            CHECK(eq.ch[c].mean > 0.0);
+            CHECK(std::abs(eq.ch[c].mean - nee_medium.ch[c].mean) <=
+                  kSigmas * std::hypot(eq.ch[c].se(), nee_medium.ch[c].se()));
+        }
     }
-    auto worst_asymmetry = [](std::map<std::pair<int, int>, std::map<int, Stat>>& share) {
+    auto worst_asymmetry = [&rec](std::map<std::pair<int, int>, std::map<int, Stat>>& share) {
         double worst = 0.0;
-        for (int n = 1; n <= 3; ++n)
-            for (int s = 0; s <= n + 1; ++s)
-                for (int o = s + 1; o <= n + 1; ++o) {
-                    const Stat& a = share[{s, n + 2 - s}][o];
-                    const Stat& b = share[{o, n + 2 - o}][s];
-                    worst = std::max(worst, std::abs(a.mean - b.mean) / std::hypot(a.se(), b.se()));
+        for (int n = 1; n <= 3; ++n) {
+            const auto keys = rec.strategies(n);
+            for (std::size_t i = 0; i < keys.size(); ++i)
+                for (std::size_t j = i + 1; j < keys.size(); ++j) {
+                    const Stat& a = share[keys[i]][keys[j].first];
+                    const Stat& b = share[keys[j]][keys[i].first];
+                    const double se = std::hypot(a.se(), b.se());
+                    if (!(se > 0.0)) {  // neither draws the other's paths: both shares are 0
+                        CHECK(a.mean == b.mean);
+                        continue;
+                    }
+                    worst = std::max(worst, std::abs(a.mean - b.mean) / se);
                 }
+        }
         return worst;
     };
     const double mixture = worst_asymmetry(rec.share);
@@ -537,12 +589,12 @@ TEST_CASE("spectral bdpt: each strategy alone is unbiased per channel, every cha
     opts.max_depth = 3;
     SUBCASE("per-channel majorant") {
         ChannelStrategyRecord rec = record_channel_strategies(SpectralBdptEstimator<>(opts), chromatic_cube(false), 200000);
-        check_channel_strategies(rec);
+        check_channel_strategies(rec, true, true);
     }
     SUBCASE("grey majorant") {
         ChannelStrategyRecord rec = record_channel_strategies(SpectralBdptEstimator<>(opts),
                                                               chromatic_cube<GlobalMajorant<M<Rgb>>>(false), 200000);
-        check_channel_strategies(rec);
+        check_channel_strategies(rec, true, true);
     }
     SUBCASE("a sun alone, light subpaths from its disk") {
         // x_0 the sun's direction; no path hits it, so s = 0 contributes exactly nothing.
@@ -680,7 +732,7 @@ TEST_CASE("spectral bdpt: an emitting chromatic cube: each strategy alone, every
     opts.russian_roulette = false;
     opts.max_depth = 3;
     ChannelStrategyRecord rec = record_channel_strategies(SpectralBdptEstimator<>(opts), emitting_chromatic_cube(), 200000);
-    check_channel_strategies(rec);
+    check_channel_strategies(rec, true, true);
 }
 
 TEST_CASE("spectral bdpt: agrees with SpectralPathEstimator on an emitting chromatic cube") {

@@ -139,6 +139,22 @@ bool no_nan(const Spec& s) {
 // ---------------------------------------------------------------------------------------------
 // MIS weights
 
+/// A grey BDPT path's densities from the input: its length, light tracing, each vertex's two
+/// densities in [0, inf] and connectibility, NEE's and the light subpaths' densities of x_0.
+bdpt::PathPdfs<12> read_path_pdfs(Input& in) {
+    bdpt::PathPdfs<12> p;
+    p.k = 1 + int(in.pick(11));
+    p.light_tracing = in.pick(2) == 1;
+    for (int i = 0; i < p.k; ++i) {
+        p.from_light[i] = ratio(in);
+        p.from_camera[i] = ratio(in);
+        p.connectible[i] = in.pick(4) != 0;
+    }
+    p.nee = ratio(in);
+    p.emit = ratio(in);
+    return p;
+}
+
 template <class H>
 void check_heuristic(Input& in, const H& h) {
     g_context = "mis heuristic";
@@ -178,24 +194,16 @@ void check_heuristic(Input& in, const H& h) {
     for (const float x : {ec, es, en}) NSP_FUZZ_CHECK(x >= 0.f && x <= 1.f);
     if (ep.collision > 0.f || ep.segment > 0.f || ep.nee > 0.f) NSP_FUZZ_CHECK(std::abs(ec + es + en - 1.f) <= kWeightTol);
 
-    // BDPT (THEORY 5.5): the (s, t) strategies of one path, densities in [0, inf] per vertex, delta
-    // vertices, with and without light tracing: every weight in [0, 1], and they sum to 1 where any
+    // BDPT (THEORY 5.5): the (s, t) strategies of one path (the equiangular one off: weight 0),
+    // densities in [0, inf] per vertex, delta vertices, with and without light tracing: every
+    // weight in [0, 1], and they sum to 1 where any
     // strategy can draw the path (strategy_pdfs true), to 0 where none can.
-    bdpt::PathPdfs<12> p;
-    p.k = 1 + int(in.pick(11));
-    p.light_tracing = in.pick(2) == 1;
-    for (int i = 0; i < p.k; ++i) {
-        p.from_light[i] = ratio(in);
-        p.from_camera[i] = ratio(in);
-        p.connectible[i] = in.pick(4) != 0;
-    }
-    p.nee = ratio(in);
-    p.emit = ratio(in);
-    double q[12];
+    bdpt::PathPdfs<12> p = read_path_pdfs(in);
+    double q[13];
     const bool drawable = bdpt::strategy_pdfs(p, q);
     float sum = 0.f;
-    for (int s = 0; s < bdpt::strategy_count(p); ++s) {
-        const float w = bdpt::strategy_weight(h, p, s);
+    for (int s = 0; s <= bdpt::strategy_count(p); ++s) {  // the last: the equiangular strategy
+        const float w = bdpt::strategy_weight(h, p, s == bdpt::strategy_count(p) ? p.kEquiangular : s);
         NSP_FUZZ_CHECK(w >= 0.f && w <= 1.f);
         sum += w;
     }
@@ -234,16 +242,41 @@ void check_channel_bdpt(Input& in, const H& h) {
     p.emit = ratio(in);
     const float gammas[] = {0.f, 1e-30f, 0.5f, 1.f};
     p.gamma = Rgb::Spectrum(gammas[in.pick(4)], gammas[in.pick(4)], 1.f);
+    p.eq = Rgb::Spectrum(ratio(in), ratio(in), ratio(in));  // the equiangular strategy
+    p.eq_nee = ratio(in);
     double q[3 * 13];
     const bool drawable = bdpt::channel_strategy_pdfs(p, q);
     float sum = 0.f;
     for (int c = 0; c < 3; ++c) {
         p.channel = c;
-        for (int s = 0; s < bdpt::strategy_count(p); ++s) {
-            const float w = bdpt::channel_strategy_weight(h, p, s) / 3.f;
+        for (int s = 0; s <= bdpt::strategy_count(p); ++s) {  // the last: the equiangular strategy
+            const float w =
+                bdpt::channel_strategy_weight(h, p, s == bdpt::strategy_count(p) ? p.kEquiangular : s) / 3.f;
             NSP_FUZZ_CHECK(w >= 0.f && w <= 1.f + kWeightTol);
             sum += w;
         }
+    }
+    NSP_FUZZ_CHECK(drawable ? std::abs(sum - 1.f) <= kWeightTol : sum == 0.f);
+}
+
+/// BDPT's grey weights with the equiangular strategy (THEORY 5.4 in 5.5), as check_heuristic's:
+/// every weight in [0, 1], summing to 1 where any strategy can draw the path, to 0 where none can.
+/// Reads its bytes last.
+void check_bdpt_equiangular(Input& in) {
+    bdpt::PathPdfs<12> p = read_path_pdfs(in);
+    p.eq = ratio(in);
+    p.eq_nee = ratio(in);
+    const float betas[] = {1.f, 2.f, 10.f, 100.f};
+    const bool balance = in.pick(2) == 0;
+    const mis::Power power(betas[in.pick(4)]);
+    double q[13];
+    const bool drawable = bdpt::strategy_pdfs(p, q);
+    float sum = 0.f;
+    for (int s = 0; s <= bdpt::strategy_count(p); ++s) {
+        const int strategy = s == bdpt::strategy_count(p) ? p.kEquiangular : s;
+        const float w = balance ? bdpt::strategy_weight(mis::Balance{}, p, strategy) : bdpt::strategy_weight(power, p, strategy);
+        NSP_FUZZ_CHECK(w >= 0.f && w <= 1.f);
+        sum += w;
     }
     NSP_FUZZ_CHECK(drawable ? std::abs(sum - 1.f) <= kWeightTol : sum == 0.f);
 }
@@ -1048,5 +1081,6 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         default: run<nsp::Hero<4>>(in); break;
     }
     check_channel_bdpt(in);
+    check_bdpt_equiangular(in);
     return 0;
 }

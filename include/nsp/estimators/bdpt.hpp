@@ -152,17 +152,28 @@ P broadcast(float v) noexcept {
 ///   value > 0 (it is the same in every strategy and cancels).
 /// Strategy s draws x_0..x_{s-1} from the light and x_s..x_k from the camera.
 ///
+/// - eq, eq_nee: the equiangular strategy (BdptEstimator with EstimatorOptions::bdpt_equiangular),
+///   s = 1 with x_1 drawn from x_2 by equiangular sampling toward the lights' targets instead of
+///   by tracking: eq the density of x_1 so drawn (volume measure, the segment's nulls ratio-tracked,
+///   so its only tracking factor is the equiangular density per unit length; 0 where x_1 is no
+///   medium vertex or the technique is off), eq_nee the density of x_0 under NEE from it (NEE
+///   from an equiangular vertex always runs: no count; 0 where NEE does not draw x_0 there). Its
+///   index among the strategies is kEquiangular (k >= 2 only).
+///
 /// Per channel (P a Spectrum, THEORY 5.3 with 5.5), from_light and from_camera hold every
 /// channel's density (its own majorant and event probabilities in the null and event factors),
 /// `gamma` every channel's factor that all strategies of the path share (its Tbar_c and the
 /// nulls' mu_bar_c), relative to the largest, and `channel` the sample's sampling channel.
 template <int N, class P = float>
 struct PathPdfs {
+    /// The equiangular strategy's index (above every (s, t) strategy's, s <= k <= N - 1).
+    static constexpr int kEquiangular = N;
     int k = 0;
     bool light_tracing = false;
-    float emit = 0.f, nee = 0.f;
+    float emit = 0.f, nee = 0.f, eq_nee = 0.f;
     P from_light[N] = {};
     P from_camera[N] = {};
+    P eq = broadcast<P>(0.f);
     bool connectible[N] = {};
     [[no_unique_address]] GammaOf<P> gamma = unit_gamma<P>();
     [[no_unique_address]] std::conditional_t<std::is_same_v<P, float>, NoGamma, int> channel{};
@@ -175,8 +186,15 @@ int strategy_count(const PathPdfs<N, P>& p) noexcept {
     return p.light_tracing && p.k >= 2 ? p.k + 1 : p.k;
 }
 
+/// Whether strategy s is one of the path's: s < strategy_count(p), or the equiangular strategy.
+template <int N, class P>
+bool is_strategy(const PathPdfs<N, P>& p, int s) noexcept {
+    return (s >= 0 && s < strategy_count(p)) || s == PathPdfs<N, P>::kEquiangular;
+}
+
 /// Strategy s's pdf of the path relative to the largest of all strategies' (each in [0, 1]; 0
-/// where s cannot draw it), written into q[0..k-1] (q[0..k] with light tracing). Each vertex's
+/// where s cannot draw it), written into q[0..k-1] (q[0..k] with light tracing) and the
+/// equiangular strategy's into q[N] (q has N + 1 entries). Each vertex's
 /// two densities are scaled by their larger one (an infinite one, an overflowed density, wins)
 /// and the products taken in double, so long paths neither overflow nor underflow. Returns false
 /// when no strategy can draw the path. NaN densities give NaN.
@@ -199,21 +217,29 @@ bool strategy_pdfs(const PathPdfs<N>& p, double* q) noexcept {
             v[i] = nan ? v[i] * 0.0 + std::numeric_limits<double>::quiet_NaN()
                        : inf ? (std::isinf(v[i]) ? 1.0 : 0.0) : (m > 0.0 ? v[i] / m : 0.0);
     };
-    double l[N], c[N];
+    double l[N], c[N], eq1 = 0.0;
     for (int i = 1; i < k; ++i) {
-        double v[2] = {double(p.from_light[i]), double(p.from_camera[i])};
-        scale(v, 2);
+        double v[3] = {double(p.from_light[i]), double(p.from_camera[i]), i == 1 ? double(p.eq) : 0.0};
+        scale(v, 3);
         l[i] = v[0];
         c[i] = v[1];
+        if (i == 1) eq1 = v[2];
     }
     // suffix[j] = prod_{i=j}^{k-1} c_i
     double suffix[N + 1];
     suffix[k] = 1.0;
     for (int i = k - 1; i >= 1; --i) suffix[i] = suffix[i + 1] * c[i];
-    double x0[3] = {double(p.from_camera[0]), double(p.nee), double(p.emit)};  // x_0 under s = 0, 1, >= 2
-    scale(x0, 3);
+    // x_0 under s = 0, 1, >= 2 and the equiangular strategy
+    double x0[4] = {double(p.from_camera[0]), double(p.nee), double(p.emit), double(p.eq_nee)};
+    scale(x0, 4);
     const int last = strategy_count(p);
     double prefix = 1.0, largest = 0.0;  // prefix = prod_{i=1}^{s-1} l_i
+    q[N] = k >= 2 && p.connectible[1] ? x0[3] * eq1 * suffix[2] : 0.0;
+    if (std::isnan(q[N])) {
+        for (int r = 0; r <= N; ++r) q[r] = q[N];
+        return true;
+    }
+    largest = q[N];
     for (int s = 0; s < last; ++s) {
         if (s >= 2) prefix *= l[s - 1];
         double v = 0.0;
@@ -223,13 +249,14 @@ bool strategy_pdfs(const PathPdfs<N>& p, double* q) noexcept {
         else if (p.connectible[s - 1] && p.connectible[s]) v = x0[2] * prefix * suffix[s];
         q[s] = v;
         if (std::isnan(v)) {  // a NaN density: every strategy's pdf is NaN
-            for (int r = 0; r < last; ++r) q[r] = v;
+            for (int r = 0; r <= N; ++r) q[r] = v;
             return true;
         }
         largest = std::max(largest, v);
     }
     if (!(largest > 0.0)) return false;
     for (int s = 0; s < last; ++s) q[s] /= largest;
+    q[N] /= largest;
     return true;
 }
 
@@ -239,17 +266,18 @@ bool strategy_pdfs(const PathPdfs<N>& p, double* q) noexcept {
 template <mis::CombiningHeuristic H, int N>
 float strategy_weight(const H& h, const PathPdfs<N>& p, int s) noexcept {
     const int n = strategy_count(p);
-    if (s < 0 || s >= n) return 0.f;
+    if (!is_strategy(p, s)) return 0.f;
     double q[N + 1];
     if (!strategy_pdfs(p, q)) return 0.f;
     if (!(q[s] > 0.0)) return std::isnan(q[s]) ? q[s] : 0.f;
-    double sum = 0.0;
+    double sum = q[N] > 0.0 ? double(h.power(float(q[N]))) : 0.0;
     for (int i = 0; i < n; ++i) sum += double(h.power(float(q[i])));
     return float(double(h.power(float(q[s]))) / sum);
 }
 
 /// Per channel (THEORY 5.3 with 5.5): every channel's pdf of the path under every strategy,
-/// gamma_c x the strategy's product of densities, written into q[c * (N + 1) + s], all relative
+/// gamma_c x the strategy's product of densities, written into q[c * (N + 1) + s] (the equiangular
+/// strategy's into q[c * (N + 1) + N]), all relative
 /// to one scale (each vertex's densities scaled by the largest over both directions and every
 /// channel, the products in double, the whole divided by the largest), as strategy_pdfs does for
 /// one channel. Returns false when no strategy of any channel can draw the path. NaN gives NaN.
@@ -268,12 +296,17 @@ bool channel_strategy_pdfs(const PathPdfs<N, P>& p, double* q) noexcept {
     double inv[N];  // 1 / the scale of vertex i (0 where all its densities are 0)
     bool inf[N];
     for (int i = 1; i < k; ++i) {
-        const double m = scale_of(p.from_light[i], p.from_camera[i], nan);
+        double m = scale_of(p.from_light[i], p.from_camera[i], nan);
+        if (i == 1) {
+            nan = nan || p.eq.isNaN().any();
+            m = std::max(m, double(p.eq.maxCoeff()));
+        }
         inf[i] = std::isinf(m);
         inv[i] = m > 0.0 && !inf[i] ? 1.0 / m : 0.0;
     }
-    const double m0 = std::max({double(p.from_camera[0].maxCoeff()), double(p.nee), double(p.emit)});
-    nan = nan || p.from_camera[0].isNaN().any() || std::isnan(p.nee) || std::isnan(p.emit) || p.gamma.isNaN().any();
+    const double m0 = std::max({double(p.from_camera[0].maxCoeff()), double(p.nee), double(p.emit), double(p.eq_nee)});
+    nan = nan || p.from_camera[0].isNaN().any() || std::isnan(p.nee) || std::isnan(p.emit) || std::isnan(p.eq_nee) ||
+          p.gamma.isNaN().any();
     if (nan) {
         for (int i = 0; i < C * (N + 1); ++i) q[i] = std::numeric_limits<double>::quiet_NaN();
         return true;
@@ -288,9 +321,11 @@ bool channel_strategy_pdfs(const PathPdfs<N, P>& p, double* q) noexcept {
         double suffix[N + 1];
         suffix[k] = 1.0;
         for (int i = k - 1; i >= 1; --i) suffix[i] = suffix[i + 1] * rel(double(p.from_camera[i][ch]), inv[i], inf[i]);
-        const double x0[3] = {rel(double(p.from_camera[0][ch]), inv0, inf0), rel(double(p.nee), inv0, inf0),
-                              rel(double(p.emit), inv0, inf0)};
+        const double x0[4] = {rel(double(p.from_camera[0][ch]), inv0, inf0), rel(double(p.nee), inv0, inf0),
+                              rel(double(p.emit), inv0, inf0), rel(double(p.eq_nee), inv0, inf0)};
         const double g = double(p.gamma[ch]);
+        qc[N] = k >= 2 && p.connectible[1] ? g * x0[3] * rel(double(p.eq[ch]), inv[1], inf[1]) * suffix[2] : 0.0;
+        largest = std::max(largest, qc[N]);
         double prefix = 1.0;
         for (int s = 0; s < last; ++s) {
             if (s >= 2) prefix *= rel(double(p.from_light[s - 1][ch]), inv[s - 1], inf[s - 1]);
@@ -304,8 +339,10 @@ bool channel_strategy_pdfs(const PathPdfs<N, P>& p, double* q) noexcept {
         }
     }
     if (!(largest > 0.0)) return false;
-    for (int ch = 0; ch < C; ++ch)
+    for (int ch = 0; ch < C; ++ch) {
         for (int s = 0; s < last; ++s) q[ch * (N + 1) + s] /= largest;
+        q[ch * (N + 1) + N] /= largest;
+    }
     return true;
 }
 
@@ -319,7 +356,7 @@ template <mis::CombiningHeuristic H, int N, class P>
 float channel_strategy_weight(const H& h, const PathPdfs<N, P>& p, int s) noexcept {
     constexpr int C = int(P::SizeAtCompileTime);
     const int n = strategy_count(p);
-    if (s < 0 || s >= n || p.channel < 0 || p.channel >= C) return 0.f;
+    if (!is_strategy(p, s) || p.channel < 0 || p.channel >= C) return 0.f;
     double q[C * (N + 1)];
     if (!channel_strategy_pdfs(p, q)) return 0.f;
     const double own = q[p.channel * (N + 1) + s];
@@ -328,8 +365,10 @@ float channel_strategy_weight(const H& h, const PathPdfs<N, P>& p, int s) noexce
     // and power are homogeneous): the pdfs enter as they are, the largest 1, so the sum is at
     // least 1 (q_c x the largest under a power of 100 would underflow to 0).
     double sum = 0.0;
-    for (int ch = 0; ch < C; ++ch)
+    for (int ch = 0; ch < C; ++ch) {
         for (int r = 0; r < n; ++r) sum += double(h.power(float(q[ch * (N + 1) + r])));
+        if (q[ch * (N + 1) + N] > 0.0) sum += double(h.power(float(q[ch * (N + 1) + N])));
+    }
     return float(double(h.power(float(own))) / sum * double(C));
 }
 
@@ -347,6 +386,10 @@ struct Vertex {
     P pdf_rev = broadcast<P>(0.f);   ///< density of p drawn from the other side, from the next vertex of its subpath
     P nulls_in = broadcast<P>(1.f);  ///< N: prod P_n of the segment arriving at p (1 under Directional)
     P event = broadcast<P>(1.f);     ///< E: mu_bar P_s at a medium vertex (1 on surfaces and under Directional)
+    /// The equiangular strategy's density of p (a medium vertex; 0 elsewhere and when it is off),
+    /// drawn from the camera side's vertex before it: a camera subpath's previous vertex, a light
+    /// subpath's next one (kept for y_1 alone, the only light vertex that can be x_1).
+    P eq = broadcast<P>(0.f);
     /// Per channel: every channel's factor that all strategies share (Tbar_c, the nulls' mu_bar_c)
     /// over the subpath up to p, relative to the largest.
     [[no_unique_address]] GammaOf<P> gamma = unit_gamma<P>();
@@ -649,10 +692,33 @@ private:
         return m > 0.f && std::isfinite(m) ? Spec(g / m) : Spec(Spec::Zero());
     }
 
-    template <class Sc, UniformRng R, LookupCounter C, class OnHit, class OnEmission = NoEmission>
+    /// Where the equiangular strategy draws its vertices (THEORY 5.4 in 5.5): on the part of a
+    /// camera segment's ray inside the box around every medium, aimed at the light sampler's
+    /// targets (LightSampler::equiangular_point, by their selection probabilities).
+    struct EqRegion {
+        Box box;
+        /// The technique's density per unit length at distance d along the ray from o along w.
+        template <class Sc>
+        float density(const Sc& sc, const Vec3& o, const Vec3& w, float d) const noexcept {
+            const Ray r{o, w};
+            const Interval in = box.clip(r, 0.f, kInf);
+            return detail::PieceEquiangular<Sc>(sc, r, in.t0, in.t1).density(d);
+        }
+    };
+
+    /// A walk's segment callback that does nothing (light subpaths, the equiangular strategy off).
+    struct NoSegment {};
+
+    /// Tracks a subpath from path[count - 1] (see trace). With `eq` (the equiangular strategy on),
+    /// stores its densities: a camera subpath's (`camera_side`) at each medium vertex, a light
+    /// subpath's at y_1; `on_segment(path, count, ray, medium, pdf_dir, beta)` runs at the start of
+    /// every segment, before it is tracked.
+    template <class Sc, UniformRng R, LookupCounter C, class OnHit, class OnEmission = NoEmission,
+              class OnSegment = NoSegment>
     int walk(const Sc& sc, VertexT<Sc>* path, int count, int max_vertices, Ray ray, int medium, float pdf_dir,
              typename Sc::Spectrum beta, const typename Sc::Spectral::Wavelengths& lambda, int channel, R& rng,
-             C& counter, OnHit on_hit, Status& status, OnEmission on_emission = {}) const;
+             C& counter, OnHit on_hit, Status& status, const EqRegion* eq, bool camera_side,
+             OnEmission on_emission = {}, OnSegment on_segment = {}) const;
 
     Kernels kernels_;
     float light_probability_ = 1.f;
@@ -661,12 +727,13 @@ private:
 // ---------------------------------------------------------------------------------------------
 
 template <bdpt::MisPolicy Mis, mis::CombiningHeuristic H, AbsorptionPolicy A, int MaxDepth, bdpt::ChannelAxis Ch>
-template <class Sc, UniformRng R, LookupCounter C, class OnHit, class OnEmission>
+template <class Sc, UniformRng R, LookupCounter C, class OnHit, class OnEmission, class OnSegment>
 int BdptEstimator<Mis, H, A, MaxDepth, Ch>::walk(const Sc& sc, VertexT<Sc>* path, int count, int max_vertices,
                                                  Ray ray, int medium, float pdf_dir, typename Sc::Spectrum beta,
                                                  const typename Sc::Spectral::Wavelengths& lambda, int channel, R& rng,
-                                                 C& counter, OnHit on_hit, Status& status,
-                                                 OnEmission on_emission) const {
+                                                 C& counter, OnHit on_hit, Status& status, const EqRegion* eq,
+                                                 bool camera_side, OnEmission on_emission,
+                                                 OnSegment on_segment) const {
     using namespace bdpt;
     using V = VertexT<Sc>;
     using S = typename Sc::Spectral;
@@ -687,7 +754,12 @@ int BdptEstimator<Mis, H, A, MaxDepth, Ch>::walk(const Sc& sc, VertexT<Sc>* path
         if constexpr (kPerChannel) return relative_to_largest<Spectrum>(path[count - 1].gamma * st.eq.vertex);
         else return NoGamma{};
     };
+    bool segment_start = true;
     while (count < max_vertices) {
+        if constexpr (!std::is_same_v<OnSegment, NoSegment>) {
+            if (segment_start) on_segment(path, count, ray, medium, pdf_dir, beta);
+        }
+        segment_start = false;
         const SurfaceHit hit = sc.geometry.intersect(ray, kInf);
         if (!detail::usable_hit(sc, hit)) {
             status = Status::InvalidInput;
@@ -778,11 +850,17 @@ int BdptEstimator<Mis, H, A, MaxDepth, Ch>::walk(const Sc& sc, VertexT<Sc>* path
         v.wo = ray.d;
         v.beta = beta;
         v.nulls_in = nulls;
-        // From the camera: its own density of the ray converted (light tracing), or 1, which every
-        // strategy with t >= 2 shares.
-        if (prev.kind == VertexKind::Camera && !(pdf_dir > 0.f)) v.pdf_fwd = broadcast<P>(1.f);
-        else if (prev.at_infinity) v.pdf_fwd = from_infinity_measure(pdf_dir, ray.d, v) * nulls * v.event;
-        else v.pdf_fwd = to_vertex_measure(pdf_dir, prev.p, v) * nulls * v.event;
+        // From the camera: its own density of the ray (light tracing), or a stand-in of 1 for it,
+        // a factor of every strategy with t >= 2 (the equiangular one too), so it cancels.
+        const float pd = prev.kind == VertexKind::Camera && !(pdf_dir > 0.f) ? 1.f : pdf_dir;
+        if (prev.at_infinity) {
+            v.pdf_fwd = from_infinity_measure(pd, ray.d, v) * nulls * v.event;
+        } else {
+            const float g = to_vertex_measure(pd, prev.p, v);
+            v.pdf_fwd = g * nulls * v.event;
+            if (camera_side && eq && v.kind == VertexKind::Medium)
+                v.eq = broadcast<P>(g * eq->density(sc, prev.p, ray.d, glm::length(v.p - prev.p)));
+        }
         if constexpr (kPerChannel) v.gamma = gamma_here();
         path[count] = v;
         V& cur = path[count++];
@@ -801,7 +879,13 @@ int BdptEstimator<Mis, H, A, MaxDepth, Ch>::walk(const Sc& sc, VertexT<Sc>* path
         cur.delta = next.delta;
         // The density with which the other side, arriving along -next.wi, draws prev from cur.
         const float rev = next.delta ? next.pdf : detail::eval_vertex(sc, sv, -next.wi, -ray.d, lambda).pdf;
-        prev.pdf_rev = to_vertex_measure(rev, cur.p, prev) * nulls * prev.event;
+        const float g_rev = to_vertex_measure(rev, cur.p, prev);
+        prev.pdf_rev = g_rev * nulls * prev.event;
+        if (!camera_side && eq && count == 3 && prev.kind == VertexKind::Medium) {  // y_1, drawn from y_2
+            const Vec3 d = prev.p - cur.p;
+            const float len = glm::length(d);
+            prev.eq = broadcast<P>(len > 0.f ? g_rev * eq->density(sc, cur.p, d / len, len) : 0.f);
+        }
         beta *= next.value / next.pdf;
         if (!(beta != 0.f).any()) return count;
         if (cur.kind == VertexKind::Surface) medium = cur.medium_toward(next.wi);
@@ -814,6 +898,7 @@ int BdptEstimator<Mis, H, A, MaxDepth, Ch>::walk(const Sc& sc, VertexT<Sc>* path
         }
         crossings = 0;
         ray = Ray{cur.p, next.wi};
+        segment_start = true;
     }
     return count;
 }
@@ -843,6 +928,31 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
     V* const light = std::launder(reinterpret_cast<V*>(light_storage));    // y_0 .. y_{depth-1}, y_depth (light tracing)
     PathPdfsT pdfs;
     pdfs.light_tracing = kLightTracing;
+    constexpr int kEq = PathPdfsT::kEquiangular;
+    // The equiangular strategy: with null-scattering MIS (directional MIS has no distance pdfs to
+    // weigh it against tracking by), the option on, a light with a target and a medium.
+    EqRegion eq_region;
+    const EqRegion* eq = nullptr;
+    if constexpr (Mis::null_pdfs) {
+        if (kernels_.options().bdpt_equiangular && sc.lights.equiangular_count() > 0 && !sc.media.empty()) {
+            eq_region.box = sc.media[0].medium.bounds();
+            for (const auto& m : sc.media) {
+                const Box b = m.medium.bounds();
+                eq_region.box.lo = glm::min(eq_region.box.lo, b.lo);
+                eq_region.box.hi = glm::max(eq_region.box.hi, b.hi);
+            }
+            eq = &eq_region;
+        }
+    }
+    // The equiangular strategy's density of `to` drawn from `from` with direction pdf pdf_dir
+    // there (0 off, and where `to` is no medium vertex).
+    auto eq_from = [&](const Vec3& from, float pdf_dir, const V& to) -> P {
+        if (!eq || to.kind != VertexKind::Medium) return broadcast<P>(0.f);
+        const Vec3 d = to.p - from;
+        const float len = glm::length(d);
+        if (!(len > 0.f)) return broadcast<P>(0.f);
+        return broadcast<P>(to_vertex_measure(pdf_dir, from, to) * eq->density(sc, from, d / len, len));
+    };
     // Per channel: the sample's sampling channel, chosen uniformly (THEORY 5.3). Its light
     // subpath, connections and splats use the same channel, so the one-sample weights of every
     // pixel's strategies share one denominator.
@@ -879,7 +989,7 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
             const int n = strategy_count(p);
             double p_fixed = 0.0, p_nee = 0.0, p_light = 0.0, own = 0.0;
             auto add_group = [&](const double* q, double selection) {
-                p_fixed += selection * q[0];
+                p_fixed += selection * (q[0] + q[kMaxPath]);  // the equiangular strategy: count 1
                 if (n > 1) (volume_x0 ? p_fixed : p_nee) += selection * q[1];
                 for (int r = 2; r < n; ++r) p_light += selection * q[r];
             };
@@ -895,7 +1005,7 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
                 add_group(q, 1.0);
                 own = q[s];
             }
-            const BdptTechnique group = s == 0 ? BdptTechnique::Fixed
+            const BdptTechnique group = s == 0 || s == kEq ? BdptTechnique::Fixed
                                         : s == 1 ? (volume_x0 ? BdptTechnique::Fixed : BdptTechnique::Nee)
                                                  : BdptTechnique::Light;
             detail::record_bdpt(counter, float(double(f.mean()) * own), float(p_fixed),
@@ -910,8 +1020,9 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
                    bool volume_x0 = false) {
         const float w = weight_of(p, s);
         record(s, f, p, volume_x0, false);
+        const int sv = s == kEq ? 1 : s;  // the equiangular strategy's vertices are s = 1's
         observe(s, t, f, w, p,
-                PathVertices<typename Sc::Spectral, P>{light, s, camera, s == 0 ? t - 1 : t, x0, x0_at_infinity});
+                PathVertices<typename Sc::Spectral, P>{light, sv, camera, sv == 0 ? t - 1 : t, x0, x0_at_infinity});
         L += f * w;
     };
     auto eval_at = [&](const V& v, const Vec3& wo, const Vec3& wi) {
@@ -923,6 +1034,8 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
     // x_0's and the densities that its connection changes.
     auto gather = [&](int s, int nz, int k) {
         pdfs.k = k;
+        pdfs.eq = broadcast<P>(0.f);
+        pdfs.eq_nee = 0.f;
         for (int i = 0; i < s; ++i) {
             pdfs.from_light[i] = light[i].pdf_fwd;
             pdfs.from_camera[i] = light[i].pdf_rev;
@@ -967,15 +1080,18 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
                 const float cos0 = std::abs(glm::dot(hit.ng, w));
                 pdfs.from_camera[0] = (z.delta ? 1.f : pdf_dir_z) * cos0 / d2 * nulls;
                 pdfs.emit = q_lights * e.pdf_pos;
-                pdfs.nee = nee_count * sc.lights.pdf(light_index, z.p, w) * cos0 / d2;
+                pdfs.eq_nee = sc.lights.pdf(light_index, z.p, w) * cos0 / d2;
+                pdfs.nee = nee_count * pdfs.eq_nee;
                 pdfs.from_light[1] = to_vertex_measure(e.pdf_dir, hit.p, z) * nulls * z.event;
             } else {  // x_0 is the direction w; light subpaths (if any) reach z along -w
                 const EmissionDensity e = sc.lights.emission_pdf(light_index, z.p, -w);
                 pdfs.from_camera[0] = (z.delta ? 1.f : pdf_dir_z) * nulls;
                 pdfs.emit = q_lights * e.pdf_pos;
-                pdfs.nee = nee_count * sc.lights.pdf(light_index, z.p, w);
+                pdfs.eq_nee = sc.lights.pdf(light_index, z.p, w);
+                pdfs.nee = nee_count * pdfs.eq_nee;
                 pdfs.from_light[1] = from_infinity_measure(e.pdf_dir, -w, z) * nulls * z.event;
             }
+            pdfs.eq = z.eq;
             // z's own density from the light side: from x_1 toward x_2, arriving along -w.
             if (t >= 4) {
                 const V& z2 = camera[t - 3];  // x_2
@@ -1023,6 +1139,7 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
             gather(0, t - 1, t - 1);
             const Vec3 d = y - z.p;
             const float d2 = glm::dot(d, d);
+            if (!(d2 > 0.f)) return;  // a collision at the segment's origin (a flight of length 0): no direction
             const float p_v = sc.emission_selection_pdf(medium) * m.emission_pdf(y);
             pdfs.from_camera[0] = pdf_dir / d2 * nulls * mu_bar;
             pdfs.nee = p_v;
@@ -1040,6 +1157,152 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
         }
     };
 
+    // A shadow ray's (a connection's) transmittance through the scene, ratio-tracked: its
+    // throughput (per channel f_lambda / p_c*), its nulls' P_n product and, per channel, the
+    // factor every strategy of the path shares over it (prod mu_bar_c(n_j) Tbar_c).
+    using GammaT = GammaOf<P>;
+    struct Shadow {
+        Status status = Status::Ok;
+        Spectrum tr = Spectrum::Zero();
+        P nulls = broadcast<P>(1.f);
+        GammaT gamma = unit_gamma<P>();
+    };
+    // `end_medium`, if given, receives the medium the ray ends in.
+    auto shadow = [&](const Ray& r, float distance, int start, int* end_medium = nullptr) {
+        Shadow out;
+        if constexpr (kPerChannel) {
+            const auto sh = detail::channel_shadow_through<Ch, A>(sc, r, distance, start, lambda, channel,
+                                                                  Spectrum::Ones(), true, rng, counter, end_medium);
+            if (sh.end != SegmentEnd::Passed) {
+                out.status = detail::shadow_status(sh.end);
+                return out;
+            }
+            // A sampling channel's density below float's range beside another's: its weight is 0.
+            if (!(sh.f != 0.f).any() || !(sh.nee[channel] > 0.f)) return out;
+            out.tr = sh.f / sh.nee[channel];
+            out.nulls = (sh.nee > 0.f).select(sh.uni / sh.nee, 0.f);
+            out.gamma = relative_to_largest<Spectrum>(sh.nee);
+        } else {
+            const auto sh = detail::shadow_through(kernels_, sc, r, distance, start, lambda, rng, counter, end_medium);
+            out.status = sh.status;
+            if (sh.status != Status::Ok) return out;
+            out.tr = sh.transmittance;
+            out.nulls = Mis::null_pdfs ? sh.null_pdf_product : 1.f;
+        }
+        return out;
+    };
+    // The shared factors of a path made of pieces (per channel), relative to the largest.
+    auto path_gamma = [&](const auto&... g) {
+        if constexpr (kPerChannel) return relative_to_largest<Spectrum>((... * g));
+        else return NoGamma{};
+    };
+
+    // s = 1 from camera vertex z = camera[t - 1] toward the lights (or, `from_eq`, the equiangular
+    // strategy's NEE from its vertex there, which always runs: no count).
+    auto next_event = [&](int t, bool from_eq) {
+        const V& z = camera[t - 1];
+        const float count = from_eq ? 1.f : nee_count;
+        const double before = detail::recorder_work(counter);
+        const float u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
+        const SampledLight<typename Sc::Spectral> ls = sc.lights.sample(z.p, u0, u1, u2, lambda);
+        if (!(ls.sample.pdf > 0.f)) return;
+        const Vec3 w = ls.sample.wi;
+        const auto fz = eval_at(z, z.wo, w);
+        if (!(fz.value != 0.f).any()) return;
+        V y0;
+        y0.kind = VertexKind::Light;
+        y0.delta_position = ls.sample.delta;
+        const bool at_infinity = !std::isfinite(ls.sample.distance);
+        y0.p = at_infinity ? z.p : z.p + ls.sample.distance * w;
+        const Shadow sh = shadow(Ray{z.p, w}, ls.sample.distance, z.medium_toward(w));
+        detail::record_shadow_walk(counter, before, !from_eq);
+        if (sh.status != Status::Ok) status = sh.status;
+        if (sh.status != Status::Ok || !(sh.tr != 0.f).any()) return;
+        const P& nulls = sh.nulls;
+        const Spectrum f = z.beta * fz.value * sh.tr * ls.sample.radiance / (count * ls.sample.pdf);
+        gather(0, t, t);  // camera[0..t-1]; the light point is x_0
+        if constexpr (kPerChannel) pdfs.gamma = path_gamma(z.gamma, sh.gamma);
+        const float d2 = ls.sample.distance * ls.sample.distance;
+        if (ls.sample.delta) {  // a point or directional light: no path hits it
+            pdfs.from_camera[0] = broadcast<P>(0.f);
+            pdfs.eq_nee = ls.sample.pdf;
+            // Light subpaths from a directional light (given a BoundingSphere) start on the
+            // sphere's disk: pdf_pos its delta, pdf_dir per area across w.
+            const EmissionDensity e = sc.lights.emission_pdf(ls.light, at_infinity ? z.p : y0.p, -w);
+            pdfs.emit = q_lights * e.pdf_pos;
+            pdfs.from_light[1] = (at_infinity ? from_infinity_measure(e.pdf_dir, -w, z)
+                                              : to_vertex_measure(e.pdf_dir, y0.p, z)) *
+                                 nulls * z.event;
+        } else if (at_infinity) {
+            const EmissionDensity e = sc.lights.emission_pdf(ls.light, z.p, -w);
+            pdfs.from_camera[0] = fz.pdf * nulls;
+            pdfs.eq_nee = ls.sample.pdf;
+            pdfs.emit = q_lights * e.pdf_pos;
+            pdfs.from_light[1] = from_infinity_measure(e.pdf_dir, -w, z) * nulls * z.event;
+        } else {
+            const EmissionDensity e = sc.lights.emission_pdf(ls.light, y0.p, -w);
+            pdfs.from_camera[0] = fz.pdf * e.cos / d2 * nulls;
+            pdfs.eq_nee = ls.sample.pdf * e.cos / d2;
+            pdfs.emit = q_lights * e.pdf_pos;
+            pdfs.from_light[1] = to_vertex_measure(e.pdf_dir, y0.p, z) * nulls * z.event;
+        }
+        pdfs.nee = nee_count * pdfs.eq_nee;
+        pdfs.eq = z.eq;
+        if (t >= 3) {
+            const V& z2 = camera[t - 2];
+            pdfs.from_light[2] = to_vertex_measure(eval_at(z, w * -1.f, -z.wo).pdf, z.p, z2) * z.nulls_in * z2.event;
+        }
+        add(from_eq ? kEq : 1, t, f, pdfs, y0.p, at_infinity);
+    };
+
+    // The equiangular strategy on the camera segment from z = path[count - 1] along `ray` (in
+    // `medium`, throughput `beta` past z's direction sample): x drawn on the ray's part in the
+    // media's box by equiangular sampling toward the lights' targets, the nulls before it
+    // ratio-tracked, stored as z_t-1 = path[count] (the walk writes its own next vertex there
+    // afterwards) and connected to the lights by NEE.
+    auto on_camera_segment = [&](V* path, int count, const Ray& ray, int medium, float pdf_dir, const Spectrum& beta) {
+        const int t = count + 1;
+        if (!eq || t - 1 > depth) return;
+        const V& z = path[count - 1];
+        const Interval in = eq->box.clip(ray, 0.f, kInf);
+        const detail::PieceEquiangular<Sc> piece(sc, ray, in.t0, in.t1);
+        if (!piece.valid()) return;
+        const float u_pick = rng.uniform(), u = rng.uniform();
+        const DistanceSample ds = piece.sample(u_pick, u);
+        if (!(ds.pdf > 0.f && ds.t > 0.f)) return;
+        const double before = detail::recorder_work(counter);
+        int at = -1;
+        const Shadow sh = shadow(ray, ds.t, medium, &at);
+        detail::record_shadow_walk(counter, before, false);
+        if (sh.status != Status::Ok) status = sh.status;
+        if (sh.status != Status::Ok || !(sh.tr != 0.f).any() || !sc.has_medium(at)) return;
+        const auto& m = sc.media[std::size_t(at)];
+        const auto c = lookup_untracked(m.medium, m.majorant, ray, ds.t, lambda, counter);
+        if (!c) {
+            status = Status::Rejected;
+            return;
+        }
+        if (!(c->k.sigma_s > 0.f).any()) return;
+        V& x = path[count];
+        x = V{};
+        x.kind = VertexKind::Medium;
+        x.p = ray.at(ds.t);
+        x.medium = at;
+        x.wo = ray.d;
+        x.beta = beta * sh.tr * c->k.sigma_s / ds.pdf;
+        x.nulls_in = sh.nulls;
+        // Tracking's event density mu_bar P_s at x (per channel, every channel's).
+        if constexpr (kPerChannel)
+            x.event = channel_event_densities<A, typename Sc::Spectral>(c->k, majorants<P>(c->mu)).scatter;
+        else
+            x.event = c->mu * event_probabilities<A>(c->k, c->mu).scatter;
+        const float pd = z.kind == VertexKind::Camera && !(pdf_dir > 0.f) ? 1.f : pdf_dir;  // as the walk's
+        const float g = to_vertex_measure(pd, z.p, x);
+        x.pdf_fwd = g * sh.nulls * x.event;
+        x.eq = broadcast<P>(g * ds.pdf);
+        if constexpr (kPerChannel) x.gamma = path_gamma(z.gamma, sh.gamma);
+        if ((x.beta != 0.f).any()) next_event(t, true);
+    };
     // The camera subpath.
     camera[0] = V{};
     camera[0].kind = VertexKind::Camera;
@@ -1052,14 +1315,15 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
     int nc = 0;
     if constexpr (kEmissive)
         nc = walk(sc, camera, 1, depth + 2, camera_ray, sc.camera_medium, camera_pdf, Spectrum::Ones(), lambda, channel,
-                  rng, counter, on_camera_hit, status, on_camera_emission);
+                  rng, counter, on_camera_hit, status, eq, true, on_camera_emission, on_camera_segment);
     else
         nc = walk(sc, camera, 1, depth + 2, camera_ray, sc.camera_medium, camera_pdf, Spectrum::Ones(), lambda, channel,
-                  rng, counter, on_camera_hit, status);
+                  rng, counter, on_camera_hit, status, eq, true, NoEmission{}, on_camera_segment);
 
     // The light subpath: from a light, or from the emitting volume.
     int nl = 0;
     float nee_y0 = 0.f;         // NEE's density of y_0 from y_1 (with its count at a light)
+    float eq_nee_y0 = 0.f;      // the same without the count (the equiangular strategy's; 0 in the volume)
     float emit_y0 = 0.f;        // the light subpath's density of y_0
     bool volume_start = true;  // y_0 lies in the emitting volume (else on a light)
     const int light_vertices = kLightTracing ? depth + 1 : depth;
@@ -1099,7 +1363,7 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
                             y0.beta = source / emit_y0;
                             nl = walk(sc, light, 1, light_vertices, Ray{yv.p, w}, i, kInv4Pi,
                                       Spectrum(y0.beta * (4.f * kPi)), lambda, channel, rng, counter,
-                                      [](auto&&...) {}, status);
+                                      [](auto&&...) {}, status, eq, false);
                             nee_y0 = select * yv.pdf;
                         }
                     }
@@ -1127,54 +1391,21 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
                 else
                     nl = walk(sc, light, 1, light_vertices, Ray{e.emission.p, e.emission.w}, start, e.emission.pdf_dir,
                               Spectrum(y0.beta * (e.emission.cos / e.emission.pdf_dir)), lambda, channel, rng, counter,
-                              [](auto&&...) {}, status);
+                              [](auto&&...) {}, status, eq, false);
                 if (nl >= 2) {
                     const Vec3 d = y0.p - light[1].p;
                     const float d2 = glm::dot(d, d);
-                    nee_y0 = nee_count *
-                             (y0.delta_position ? sc.lights.selection_pdf(y0.light)  // a point or a direction
-                              : y0.at_infinity  ? sc.lights.pdf(y0.light, light[1].p, -e.emission.w)  // solid angle
-                                                  : sc.lights.pdf(y0.light, light[1].p, d / std::sqrt(d2)) *
-                                                        std::abs(glm::dot(y0.ng, d)) / (d2 * std::sqrt(d2)));
+                    eq_nee_y0 = y0.delta_position ? sc.lights.selection_pdf(y0.light)  // a point or a direction
+                                : y0.at_infinity  ? sc.lights.pdf(y0.light, light[1].p, -e.emission.w)  // solid angle
+                                                    : sc.lights.pdf(y0.light, light[1].p, d / std::sqrt(d2)) *
+                                                          std::abs(glm::dot(y0.ng, d)) / (d2 * std::sqrt(d2));
+                    nee_y0 = nee_count * eq_nee_y0;
                 }
             }
         }
     }
     if (traced) detail::record_light_walk(counter, light_work_before);
 
-    // A shadow ray's (a connection's) transmittance through the scene, ratio-tracked: its
-    // throughput (per channel f_lambda / p_c*), its nulls' P_n product and, per channel, the
-    // factor every strategy of the path shares over it (prod mu_bar_c(n_j) Tbar_c).
-    using GammaT = GammaOf<P>;
-    struct Shadow {
-        Status status = Status::Ok;
-        Spectrum tr = Spectrum::Zero();
-        P nulls = broadcast<P>(1.f);
-        GammaT gamma = unit_gamma<P>();
-    };
-    auto shadow = [&](const Ray& r, float distance, int start) {
-        Shadow out;
-        if constexpr (kPerChannel) {
-            const auto sh = detail::channel_shadow_through<Ch, A>(sc, r, distance, start, lambda, channel,
-                                                                  Spectrum::Ones(), true, rng, counter);
-            if (sh.end != SegmentEnd::Passed) {
-                out.status = detail::shadow_status(sh.end);
-                return out;
-            }
-            // A sampling channel's density below float's range beside another's: its weight is 0.
-            if (!(sh.f != 0.f).any() || !(sh.nee[channel] > 0.f)) return out;
-            out.tr = sh.f / sh.nee[channel];
-            out.nulls = (sh.nee > 0.f).select(sh.uni / sh.nee, 0.f);
-            out.gamma = relative_to_largest<Spectrum>(sh.nee);
-        } else {
-            const auto sh = detail::shadow_through(kernels_, sc, r, distance, start, lambda, rng, counter);
-            out.status = sh.status;
-            if (sh.status != Status::Ok) return out;
-            out.tr = sh.transmittance;
-            out.nulls = Mis::null_pdfs ? sh.null_pdf_product : 1.f;
-        }
-        return out;
-    };
     // A shadow ray toward a point drawn in emitting medium `target` (NEE toward the volume): its
     // throughput, nulls and shared factors as `shadow`'s, whether it reached the point inside
     // `target`, and the point's piece (the point is last.at(t_last)).
@@ -1217,12 +1448,6 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
         }
         return out;
     };
-    // The shared factors of a path made of pieces (per channel), relative to the largest.
-    auto path_gamma = [&](const auto&... g) {
-        if constexpr (kPerChannel) return relative_to_largest<Spectrum>((... * g));
-        else return NoGamma{};
-    };
-
     // Transmittance of a connection a -> b through the scene, with its nulls' P_n product and
     // shared factors (its work the light subpath's).
     auto transmit = [&](const V& a, const V& b, P& nulls, GammaT& gamma) -> Spectrum {
@@ -1247,62 +1472,7 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
         if (z.delta) continue;
         // s = 1: next-event estimation from z toward the lights, drawn with the NEE count
         // (THEORY 5.9: its estimate divides by it, every path's NEE density carries it).
-        if (draw_technique(nee_count, rng)) {
-            const double before = detail::recorder_work(counter);
-            const float u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
-            const SampledLight<typename Sc::Spectral> ls = sc.lights.sample(z.p, u0, u1, u2, lambda);
-            if (ls.sample.pdf > 0.f) {
-                const Vec3 w = ls.sample.wi;
-                const auto fz = eval_at(z, z.wo, w);
-                if ((fz.value != 0.f).any()) {
-                    V y0;
-                    y0.kind = VertexKind::Light;
-                    y0.delta_position = ls.sample.delta;
-                    const bool at_infinity = !std::isfinite(ls.sample.distance);
-                    y0.p = at_infinity ? z.p : z.p + ls.sample.distance * w;
-                    const Shadow sh = shadow(Ray{z.p, w}, ls.sample.distance,
-                                             z.medium_toward(w));
-                    detail::record_shadow_walk(counter, before, true);
-                    if (sh.status != Status::Ok) status = sh.status;
-                    if (sh.status == Status::Ok && (sh.tr != 0.f).any()) {
-                        const P& nulls = sh.nulls;
-                        const Spectrum f = z.beta * fz.value * sh.tr * ls.sample.radiance / (nee_count * ls.sample.pdf);
-                        gather(0, t, t);  // camera[0..t-1]; the light point is x_0
-                        if constexpr (kPerChannel) pdfs.gamma = path_gamma(z.gamma, sh.gamma);
-                        const float d2 = ls.sample.distance * ls.sample.distance;
-                        if (ls.sample.delta) {  // a point or directional light: no path hits it
-                            pdfs.from_camera[0] = broadcast<P>(0.f);
-                            pdfs.nee = nee_count * ls.sample.pdf;
-                            // Light subpaths from a directional light (given a BoundingSphere) start
-                            // on the sphere's disk: pdf_pos its delta, pdf_dir per area across w.
-                            const EmissionDensity e = sc.lights.emission_pdf(ls.light, at_infinity ? z.p : y0.p, -w);
-                            pdfs.emit = q_lights * e.pdf_pos;
-                            pdfs.from_light[1] = (at_infinity ? from_infinity_measure(e.pdf_dir, -w, z)
-                                                              : to_vertex_measure(e.pdf_dir, y0.p, z)) *
-                                                 nulls * z.event;
-                        } else if (at_infinity) {
-                            const EmissionDensity e = sc.lights.emission_pdf(ls.light, z.p, -w);
-                            pdfs.from_camera[0] = fz.pdf * nulls;
-                            pdfs.nee = nee_count * ls.sample.pdf;
-                            pdfs.emit = q_lights * e.pdf_pos;
-                            pdfs.from_light[1] = from_infinity_measure(e.pdf_dir, -w, z) * nulls * z.event;
-                        } else {
-                            const EmissionDensity e = sc.lights.emission_pdf(ls.light, y0.p, -w);
-                            pdfs.from_camera[0] = fz.pdf * e.cos / d2 * nulls;
-                            pdfs.nee = nee_count * ls.sample.pdf * e.cos / d2;
-                            pdfs.emit = q_lights * e.pdf_pos;
-                            pdfs.from_light[1] = to_vertex_measure(e.pdf_dir, y0.p, z) * nulls * z.event;
-                        }
-                        if (t >= 3) {
-                            const V& z2 = camera[t - 2];
-                            pdfs.from_light[2] = to_vertex_measure(eval_at(z, w * -1.f, -z.wo).pdf, z.p, z2) *
-                                                 z.nulls_in * z2.event;
-                        }
-                        add(1, t, f, pdfs, y0.p, at_infinity);
-                    }
-                }
-            }
-        }
+        if (draw_technique(nee_count, rng)) next_event(t, false);
         // s = 1 toward the emitting volume: a point drawn by the power grids, the shadow walk
         // through every medium up to it (THEORY 5.7).
         if constexpr (kEmissive) {
@@ -1369,10 +1539,13 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
                 const V& z2 = camera[t - 2];
                 pdfs.from_light[s + 1] = to_vertex_measure(eval_at(z, w, -z.wo).pdf, z.p, z2) * z.nulls_in * z2.event;
             }
-            {
-                const V& y2 = light[s - 2];
-                pdfs.from_camera[s - 2] = to_vertex_measure(eval_at(y, -w, -y.wo).pdf, y.p, y2) * y.nulls_in * y2.event;
-            }
+            const V& y2 = light[s - 2];
+            const float pd_y2 = eval_at(y, -w, -y.wo).pdf;
+            pdfs.from_camera[s - 2] = to_vertex_measure(pd_y2, y.p, y2) * y.nulls_in * y2.event;
+            // x_1 = y_1 as the equiangular strategy draws it, from x_2 (z, y_2 toward the connection,
+            // or y_2 as its light subpath stored).
+            pdfs.eq_nee = eq_nee_y0;
+            pdfs.eq = s == 2 ? eq_from(z.p, fz.pdf, y) : s == 3 ? eq_from(y.p, pd_y2, y2) : light[1].eq;
             add(s, t, f, pdfs, light[0].p, light[0].at_infinity, volume_start);
         }
     }
@@ -1404,7 +1577,10 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
             pdfs.nee = nee_y0;
             pdfs.from_camera[s - 1] = to_vertex_measure(pc, eye, y) * nulls * y.event;
             const V& y2 = light[s - 2];
-            pdfs.from_camera[s - 2] = to_vertex_measure(eval_at(y, -w, -y.wo).pdf, y.p, y2) * y.nulls_in * y2.event;
+            const float pd_y2 = eval_at(y, -w, -y.wo).pdf;
+            pdfs.from_camera[s - 2] = to_vertex_measure(pd_y2, y.p, y2) * y.nulls_in * y2.event;
+            pdfs.eq_nee = eq_nee_y0;
+            pdfs.eq = s == 2 ? eq_from(eye, pc, y) : s == 3 ? eq_from(y.p, pd_y2, y2) : light[1].eq;
             const float wt = weight_of(pdfs, s);
             record(s, f, pdfs, volume_start, true);
             observe(s, 1, f, wt, pdfs,

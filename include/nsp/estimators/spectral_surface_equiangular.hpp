@@ -25,12 +25,13 @@ namespace nsp::detail {
 /// `distance` (kInf: a light at infinity), the pieces between null interfaces multiplied and the
 /// last one tracked up to the end point; f = 0 where a surface blocks it before shadow_margin of
 /// the end. `end` Passed, or the first failed piece's end (Aborted, Rejected, Overflowed), or
-/// InvalidInput for a bad hit.
+/// InvalidInput for a bad hit. `end_medium`, if given, receives the medium the ray ends in
+/// (where it passes).
 template <ChannelPolicy CP, AbsorptionPolicy A, class Sc, UniformRng R, LookupCounter C>
 ChannelShadow<typename Sc::Spectral> channel_shadow_through(const Sc& sc, Ray r, float distance, int medium,
                                                             const typename Sc::Spectral::Wavelengths& lambda, int c,
                                                             const typename Sc::Spectrum& weights, bool uni_alternative,
-                                                            R& rng, C& counter) {
+                                                            R& rng, C& counter, int* end_medium = nullptr) {
     using Sp = typename Sc::Spectral;
     ChannelShadow<Sp> out;
     auto blocked = [] {
@@ -68,7 +69,10 @@ ChannelShadow<typename Sc::Spectral> channel_shadow_through(const Sc& sc, Ray r,
                 out.uni /= k;
             }
         }
-        if (!h.found()) return out;
+        if (!h.found()) {
+            if (end_medium) *end_medium = medium;
+            return out;
+        }
         if (!crosses(sc, h)) return blocked();
         medium = h.medium_entered(r.d);
         r.o = h.p;

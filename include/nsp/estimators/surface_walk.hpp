@@ -109,11 +109,11 @@ inline float shadow_margin(float distance) noexcept { return std::isfinite(dista
 /// between the null interfaces it crosses, transmittances and null-pdf products multiplied, the
 /// last medium tracked up to the end point itself; 0 where a surface that is not a null interface
 /// blocks it before shadow_margin of the end. Status InvalidInput on a hit the estimator cannot
-/// use.
+/// use. `end_medium`, if given, receives the medium the ray ends in (where it passes).
 template <class K, class Sc, UniformRng R, LookupCounter C>
 ShadowTransmittance<typename Sc::Spectral> shadow_through(const K& k, const Sc& sc, Ray r, float distance, int medium,
                                                           const typename Sc::Spectral::Wavelengths& lambda, R& rng,
-                                                          C& counter) {
+                                                          C& counter, int* end_medium = nullptr) {
     using Sp = typename Sc::Spectral;
     ShadowTransmittance<Sp> out;
     out.transmittance = Sp::Spectrum::Ones();
@@ -130,7 +130,10 @@ ShadowTransmittance<typename Sc::Spectral> shadow_through(const K& k, const Sc& 
             out.null_pdf_product *= s.null_pdf_product;
             if (!(out.transmittance != 0.f).any()) return blocked;
         }
-        if (!h.found()) return out;
+        if (!h.found()) {
+            if (end_medium) *end_medium = medium;
+            return out;
+        }
         if (!crosses(sc, h)) return blocked;
         medium = h.medium_entered(r.d);
         r.o = h.p;
