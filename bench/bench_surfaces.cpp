@@ -12,6 +12,10 @@
 //   strategy families' counts per sample (hits s = 0, NEE s = 1, connections s >= 2, each one
 //   evaluated path; splats t = 1 with light tracing) and the stack its subpaths take (bytes,
 //   MaxDepth = 32).
+// - BM_FogLamp/<estimator>: one sample of nsp_render's F2 (a point lamp beside thin fog) as a
+//   SurfaceScene through its camera: uni + NEE + equiangular MIS against BDPT with light tracing,
+//   with its equiangular strategy and without; for BDPT the equiangular strategy's contributions
+//   per sample.
 // - BM_ChromaticRoom/<estimator>: one sample of the room around the chromatic cloud (Rgb,
 //   extinction 5, 20 and 80 per unit density: nsp_room's second table), spectral MIS + NEE and
 //   per-channel BDPT under per-channel majorants, grey BDPT under the grey one; the BDPT rows with
@@ -19,11 +23,14 @@
 #include <array>
 #include <string>
 #include <type_traits>
+#include <vector>
 
 #include <benchmark/benchmark.h>
 
 #include "fixtures.hpp"
+#include "combinations.hpp"
 #include "room_scene.hpp"
+#include "scene_choice.hpp"
 
 namespace {
 
@@ -90,6 +97,17 @@ void BM_CloudUnderSky_NoSurfaces(benchmark::State& state) {
     run<E>(state, scene, camera_rays());
 }
 
+/// Uniform image points, kSetSize of them (fixed seed).
+const std::vector<std::array<float, 2>>& image_points() {
+    static const std::vector<std::array<float, 2>> uv = [] {
+        nsp::Pcg32 g(8, 88);
+        std::vector<std::array<float, 2>> p(kSetSize);
+        for (auto& x : p) x = {g.uniform(), g.uniform()};
+        return p;
+    }();
+    return uv;
+}
+
 /// With light tracing: BdptEstimator::sample through the room's pinhole camera at the same image
 /// points, the splats summed into a sink.
 template <class E, bool kLightTracing = false>
@@ -108,12 +126,7 @@ void BM_Lantern(benchmark::State& state) {
     for (auto _ : state) {
         if constexpr (kLightTracing) {
             static const nsp::PinholeCamera camera = nsp_examples::room_pinhole();
-            static const std::vector<std::array<float, 2>> uv = [] {
-                nsp::Pcg32 g(8, 88);
-                std::vector<std::array<float, 2>> p(kSetSize);
-                for (auto& x : p) x = {g.uniform(), g.uniform()};
-                return p;
-            }();
+            const auto& uv = image_points();
             double sink = 0.0;
             auto splat = [&](float, float, const auto& value) { sink += double(value[0]); };
             auto r = estimator.sample_observed(scene, camera, uv[i][0], uv[i][1], {}, rng, counter, splat, count);
@@ -200,6 +213,59 @@ BENCHMARK_TEMPLATE(BM_Lantern, nsp::BdptEstimator<nsp::bdpt::Directional>)->Name
 BENCHMARK_TEMPLATE(BM_Lantern, nsp::BdptEstimator<nsp::bdpt::NullScattering>)->Name("BM_Lantern/bdpt-null-mis:balance");
 BENCHMARK_TEMPLATE(BM_Lantern, nsp::BdptEstimator<nsp::bdpt::NullScattering>, true)
     ->Name("BM_Lantern/bdpt-null-mis:balance+light-tracing");
+
+/// nsp_render's F2 as a SurfaceScene (see the header); BDPT with its equiangular strategy when
+/// kEquiangular.
+template <class E, bool kEquiangular = true>
+void BM_FogLamp(benchmark::State& state) {
+    static const auto scene = [] {
+        const nsp_examples::SceneChoice c{nsp_examples::SceneKind::Fog, {}, {}, nsp_examples::FogSetup::F2};
+        auto medium = nsp_examples::DenseGridCloud::make<nsp::Mono>(c);
+        const auto majorant = nsp_examples::GridMajorantPolicy<>::make(medium, nsp_examples::MajorantSettings{});
+        return nsp_examples::make_empty_space_scene(std::move(medium), majorant, nsp_examples::phase_g(c.kind),
+                                                    nsp_examples::scene_lights<nsp::Mono>(c));
+    }();
+    static const nsp::PinholeCamera camera = nsp_examples::cloud_pinhole();
+    const E estimator = [] {
+        nsp::EstimatorOptions o = E::default_options();
+        if constexpr (requires { E::kMaxPath; }) o.bdpt_equiangular = kEquiangular;
+        return E(o);
+    }();
+    nsp::Pcg32 rng(6, 66);
+    nsp::LookupCount counter;
+    double equiangular = 0;
+    std::size_t i = 0;
+    const auto& uv = image_points();
+    for (auto _ : state) {
+        if constexpr (requires { E::kMaxPath; }) {
+            auto count = [&](int s, int, const auto&, float, const auto& pdfs, const auto&) {
+                if (s == std::remove_cvref_t<decltype(pdfs)>::kEquiangular) equiangular += 1.0;
+            };
+            double sink = 0.0;
+            auto splat = [&](float, float, const auto& value) { sink += double(value[0]); };
+            auto r = estimator.sample_observed(scene, camera, uv[i][0], uv[i][1], {}, rng, counter, splat, count);
+            benchmark::DoNotOptimize(r);
+            benchmark::DoNotOptimize(sink);
+        } else {
+            auto r = estimator.radiance(scene, camera.ray(uv[i][0], uv[i][1]), {}, rng, counter);
+            benchmark::DoNotOptimize(r);
+        }
+        i = (i + 1) & kSetMask;
+    }
+    report_lookups(state, counter, "lookups/sample");
+    if constexpr (requires { E::kMaxPath; }) state.counters["equiangular/sample"] = equiangular / double(state.iterations());
+}
+
+struct EqMisDepth : nsp::PathEstimator<nsp::strategy::EquiangularMis, nsp::mis::Balance> {
+    using nsp::PathEstimator<nsp::strategy::EquiangularMis, nsp::mis::Balance>::PathEstimator;
+    /// nsp_room's empty tables stop every row at BDPT's 32 vertices.
+    static nsp::EstimatorOptions default_options() { return nsp::BdptEstimator<>::default_options(); }
+};
+BENCHMARK_TEMPLATE(BM_FogLamp, EqMisDepth)->Name("BM_FogLamp/uni-nee-eq-mis:balance");
+BENCHMARK_TEMPLATE(BM_FogLamp, nsp::BdptEstimator<nsp::bdpt::NullScattering>, false)
+    ->Name("BM_FogLamp/bdpt-null-mis:balance+light-tracing");
+BENCHMARK_TEMPLATE(BM_FogLamp, nsp::BdptEstimator<nsp::bdpt::NullScattering>, true)
+    ->Name("BM_FogLamp/bdpt-null-mis:balance+light-tracing+equiangular");
 BENCHMARK_TEMPLATE(BM_CloudUnderSky_Scene, Uni)->Name("BM_CloudUnderSky/Scene/unidirectional");
 BENCHMARK_TEMPLATE(BM_CloudUnderSky_NoSurfaces, Uni)->Name("BM_CloudUnderSky/NoSurfaces/unidirectional");
 BENCHMARK_TEMPLATE(BM_CloudUnderSky_Scene, Nsmis)->Name("BM_CloudUnderSky/Scene/uni-nee-mis:balance");

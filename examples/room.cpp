@@ -148,13 +148,11 @@ int main(int argc, char** argv) {
     // probability learned for the image from a pilot of spp / 32 samples per pixel (2-16) at
     // counts 1 (THEORY 5.9, nsp::NeeCountLearner); the choice printed under the table.
     // `channels`: bdpt::Grey{}, or channels::SpectralMis{} (per-channel pdfs, SpectralBdptEstimator).
-    // `base`: the options the learned counts go into.
-    auto learned_render = [&](const auto& scene, const nsp::PinholeCamera& camera, const char* name, auto channels,
-                              const nsp::EstimatorOptions& base = BdptEstimator<>::default_options()) {
+    auto learned_render = [&](const auto& scene, const nsp::PinholeCamera& camera, const char* name, auto channels) {
         using Channels = decltype(channels);
         nsp::TechniqueCounts chosen;
-        auto make = [base](float nee, float light) {
-            nsp::EstimatorOptions o = base;
+        auto make = [](float nee, float light) {
+            nsp::EstimatorOptions o = BdptEstimator<>::default_options();
             o.nee_count = nee;
             return BdptEstimator<bdpt::NullScattering, mis::Balance, absorption::Weight, 32, Channels>(o, {}, light);
         };
@@ -305,21 +303,16 @@ int main(int argc, char** argv) {
         run(lantern, PathEstimator<strategy::NullScatteringMis, mis::Balance>{}, "uni-nee-mis_balance");
         // Each null-scattering row takes its directional row's seed: the same subpaths (the weights
         // draw no random numbers), so the pair differs by its weights alone (a paired comparison).
-        // Directional MIS has no equiangular strategy, so these rows leave it out; the last row
-        // adds it.
-        EstimatorOptions no_eq = BdptEstimator<>::default_options();
-        no_eq.bdpt_equiangular = false;
         const std::uint64_t paired = seed;
         run_splatting(lantern, BdptEstimator<bdpt::Directional, mis::Balance>{}, "bdpt_directional-mis_balance");
         seed = paired;
-        run_splatting(lantern, BdptEstimator<bdpt::NullScattering, mis::Balance>(no_eq), "bdpt_null-mis_balance");
-        run_splatting(lantern, BdptEstimator<bdpt::NullScattering, mis::Power>(no_eq), "bdpt_null-mis_power");
+        run_splatting(lantern, BdptEstimator<bdpt::NullScattering, mis::Balance>{}, "bdpt_null-mis_balance");
+        run_splatting(lantern, BdptEstimator<bdpt::NullScattering, mis::Power>{}, "bdpt_null-mis_power");
         const std::uint64_t paired_no_t1 = seed;
         run(lantern, BdptEstimator<bdpt::Directional, mis::Balance>{}, "bdpt_directional-mis_balance_no-t1");
         seed = paired_no_t1;
-        run(lantern, BdptEstimator<bdpt::NullScattering, mis::Balance>(no_eq), "bdpt_null-mis_balance_no-t1");
-        learned_render(lantern, nsp_examples::room_pinhole(), "bdpt_null-mis_balance_learned", bdpt::Grey{}, no_eq);
-        run_splatting(lantern, BdptEstimator<bdpt::NullScattering, mis::Balance>{}, "bdpt_null-mis_balance_eq");
+        run(lantern, BdptEstimator<bdpt::NullScattering, mis::Balance>{}, "bdpt_null-mis_balance_no-t1");
+        learned_render(lantern, nsp_examples::room_pinhole(), "bdpt_null-mis_balance_learned", bdpt::Grey{});
         std::vector<Row> lantern_rows(rows.begin() + std::ptrdiff_t(first_lantern), rows.end());
         failed += print_table("Lantern (mono", lantern_rows, 4, run_res, run_spp, threads,
                         "the cloud over a floor, lit only by a lamp in a box that opens downward into it");
@@ -327,9 +320,8 @@ int main(int argc, char** argv) {
                     "tracing: %.3g); / best path tracer: %.3g\n",
                     cost(lantern_rows, 4) / cost(lantern_rows, 3), cost(lantern_rows, 7) / cost(lantern_rows, 6),
                     cost(lantern_rows, 4) / std::min({cost(lantern_rows, 0), cost(lantern_rows, 1), cost(lantern_rows, 2)}));
-        std::printf("lantern: bdpt_null-mis_balance_learned / bdpt_null-mis_balance in cpu-s*var: %.3g; "
-                    "bdpt_null-mis_balance_eq (the equiangular strategy added) / bdpt_null-mis_balance: %.3g\n",
-                    cost(lantern_rows, 8) / cost(lantern_rows, 4), cost(lantern_rows, 9) / cost(lantern_rows, 4));
+        std::printf("lantern: bdpt_null-mis_balance_learned / bdpt_null-mis_balance in cpu-s*var: %.3g\n",
+                    cost(lantern_rows, 8) / cost(lantern_rows, 4));
         print_notes();
     }
 
@@ -459,8 +451,8 @@ int main(int argc, char** argv) {
             print_notes();
         };
         // The grey pdfs' rows of scene `sc`: the path tracers (with the equiangular one when
-        // `equiangular`), BDPT, BDPT learned (and then, when `equiangular`, BDPT without its
-        // equiangular strategy).
+        // `equiangular`), BDPT, BDPT learned (and then, where a point light gives BDPT its
+        // equiangular strategy, BDPT without it).
         auto grey_rows = [&](const auto& sc, const SceneChoice& c, const char* mode, auto equiangular,
                              float fixed_light = 0.f) {
             const std::size_t from = rows.size();
@@ -471,11 +463,17 @@ int main(int argc, char** argv) {
                 pinhole_render(sc, camera, PathEstimator<strategy::EquiangularMis, mis::Balance>(depth), "uni-nee-eq-mis_balance");
             pinhole_render(sc, camera, BdptEstimator<bdpt::NullScattering, mis::Balance>{}, "bdpt_null-mis_balance");
             learned_render(sc, camera, "bdpt_null-mis_balance_learned", bdpt::Grey{});
-            if constexpr (decltype(equiangular)::value) {  // BDPT without its equiangular strategy
+            // BDPT without its equiangular strategy, where it has one (a point light).
+            bool point_light = false;
+            for (int k = 0; k < sc.lights.equiangular_count(); ++k) point_light = point_light || sc.lights.equiangular_is_delta(k);
+            // (On the seed the next row takes too: the rows after it keep the seeds they had before it.)
+            if (point_light) {
                 EstimatorOptions no_eq = depth;
                 no_eq.bdpt_equiangular = false;
+                const std::uint64_t next = seed;
                 pinhole_render(sc, camera, BdptEstimator<bdpt::NullScattering, mis::Balance>(no_eq),
                                "bdpt_null-mis_balance_no-eq");
+                seed = next;
             }
             if (fixed_light > 0.f) {  // a fixed light subpath probability, after the learned row
                 const std::string name = "bdpt_null-mis_balance_light-1/" + std::to_string(int(std::lround(1.f / fixed_light)));

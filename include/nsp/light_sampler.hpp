@@ -114,7 +114,10 @@ private:
         std::size_t entry = 0;
         for_each_light([&](const auto& l, int, int) {
             if (const auto p = aim_point(l)) {
-                targets_.push_back({*p, entries_[entry].pmf, 0.f});
+                using L = std::decay_t<decltype(l)>;
+                bool delta = false;
+                if constexpr (requires { L::is_delta; }) delta = bool(L::is_delta);
+                targets_.push_back({*p, entries_[entry].pmf, 0.f, delta});
                 aim_total += double(entries_[entry].pmf);
             }
             ++entry;
@@ -215,6 +218,8 @@ public:
     /// The probability with which an equiangular vertex aims at target k: its light's selection
     /// probability, renormalised over the targets.
     float equiangular_pmf(int k) const noexcept { return targets_[std::size_t(k)].pmf; }
+    /// Whether target k's light is a delta light (a point light): no path hits it.
+    bool equiangular_is_delta(int k) const noexcept { return targets_[std::size_t(k)].delta; }
     /// The target for a uniform u in [0, 1) (-1: there is none).
     int pick_equiangular(float u) const noexcept {
         if (targets_.empty()) return -1;
@@ -374,6 +379,7 @@ private:
     struct Target {
         Vec3 point;
         float pmf, cdf;
+        bool delta;
     };
     std::vector<Target> targets_;
     struct Emitter {

@@ -55,6 +55,7 @@
 #include "../camera.hpp"
 #include "../media/emissive.hpp"
 #include "../channel_tracking.hpp"
+#include "../equiangular.hpp"
 #include "../mis.hpp"
 #include "../path_pdf.hpp"
 #include "../surface_scene.hpp"
@@ -693,16 +694,48 @@ private:
     }
 
     /// Where the equiangular strategy draws its vertices (THEORY 5.4 in 5.5): on the part of a
-    /// camera segment's ray inside the box around every medium, aimed at the light sampler's
-    /// targets (LightSampler::equiangular_point, by their selection probabilities).
+    /// camera segment's ray inside the box around every medium, aimed at the point lights (the
+    /// light sampler's targets whose lights are delta: LightSampler::equiangular_point, by their
+    /// selection probabilities renormalised over them). Lights a path can hit have tracking's
+    /// hits and the light subpaths besides NEE; a point light has NEE and the light subpaths alone.
     struct EqRegion {
         Box box;
-        /// The technique's density per unit length at distance d along the ray from o along w.
+        float total = 0.f;  ///< the point lights' equiangular_pmf summed
+
+        /// The technique's density per unit length at distance t along `r` (0 outside the box).
+        template <class Sc>
+        float density(const Sc& sc, const Ray& r, float t) const noexcept {
+            const Interval in = box.clip(r, 0.f, kInf);
+            if (in.empty()) return 0.f;
+            float p = 0.f;
+            for (int k = 0; k < sc.lights.equiangular_count(); ++k)
+                if (sc.lights.equiangular_is_delta(k))
+                    p += sc.lights.equiangular_pmf(k) * EquiangularSampler(r, sc.lights.equiangular_point(k), in.t0, in.t1).pdf(t);
+            return p / total;
+        }
+        /// The same at distance d from o toward direction w.
         template <class Sc>
         float density(const Sc& sc, const Vec3& o, const Vec3& w, float d) const noexcept {
-            const Ray r{o, w};
+            return density(sc, Ray{o, w}, d);
+        }
+        /// A distance along `r` (a point light by u_pick, then its equiangular distance by u) with
+        /// the mixture's density there; pdf 0 where the ray misses the box.
+        template <class Sc>
+        DistanceSample sample(const Sc& sc, const Ray& r, float u_pick, float u) const noexcept {
             const Interval in = box.clip(r, 0.f, kInf);
-            return detail::PieceEquiangular<Sc>(sc, r, in.t0, in.t1).density(d);
+            if (in.empty()) return {};
+            int pick = -1;
+            float cdf = 0.f;
+            for (int k = 0; k < sc.lights.equiangular_count(); ++k) {
+                if (!sc.lights.equiangular_is_delta(k)) continue;
+                pick = k;  // the last point light takes what rounding leaves
+                cdf += sc.lights.equiangular_pmf(k) / total;
+                if (u_pick < cdf) break;
+            }
+            if (pick < 0) return {};
+            DistanceSample ds = EquiangularSampler(r, sc.lights.equiangular_point(pick), in.t0, in.t1).sample(u);
+            if (ds.pdf > 0.f) ds.pdf = density(sc, r, ds.t);
+            return ds;
         }
     };
 
@@ -934,7 +967,9 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
     EqRegion eq_region;
     const EqRegion* eq = nullptr;
     if constexpr (Mis::null_pdfs) {
-        if (kernels_.options().bdpt_equiangular && sc.lights.equiangular_count() > 0 && !sc.media.empty()) {
+        for (int k = 0; k < sc.lights.equiangular_count(); ++k)
+            if (sc.lights.equiangular_is_delta(k)) eq_region.total += sc.lights.equiangular_pmf(k);
+        if (kernels_.options().bdpt_equiangular && eq_region.total > 0.f && !sc.media.empty()) {
             eq_region.box = sc.media[0].medium.bounds();
             for (const auto& m : sc.media) {
                 const Box b = m.medium.bounds();
@@ -1264,11 +1299,9 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
         const int t = count + 1;
         if (!eq || t - 1 > depth) return;
         const V& z = path[count - 1];
-        const Interval in = eq->box.clip(ray, 0.f, kInf);
-        const detail::PieceEquiangular<Sc> piece(sc, ray, in.t0, in.t1);
-        if (!piece.valid()) return;
+        if (eq->box.clip(ray, 0.f, kInf).empty()) return;
         const float u_pick = rng.uniform(), u = rng.uniform();
-        const DistanceSample ds = piece.sample(u_pick, u);
+        const DistanceSample ds = eq->sample(sc, ray, u_pick, u);
         if (!(ds.pdf > 0.f && ds.t > 0.f)) return;
         const double before = detail::recorder_work(counter);
         int at = -1;

@@ -109,12 +109,13 @@ struct EstimatorOptions {
     /// camera vertex; NEE toward an emitting volume keeps count 1).
     float nee_count = 1.f;
     /// nsp::BdptEstimator<bdpt::NullScattering> (grey and per channel): on every camera segment
-    /// also draw one vertex by equiangular sampling toward the light sampler's targets on the part
-    /// of the ray inside the media's bounding box, the nulls before it ratio-tracked, and connect
-    /// it to the lights by NEE: one more strategy among the (s, t) ones, weighed with its analytic
-    /// pdf (THEORY 5.4 in 5.5). Only where a light has a target (a point or sphere light) and a
-    /// medium is there. Directional MIS has no distance pdfs to weigh it by and leaves it out. The
-    /// path estimators choose equiangular sampling by their strategy instead.
+    /// also draw one vertex by equiangular sampling toward the point lights on the part of the ray
+    /// inside the media's bounding box, the nulls before it ratio-tracked, and connect it to the
+    /// lights by NEE: one more strategy among the (s, t) ones, weighed with its analytic pdf
+    /// (THEORY 5.4 in 5.5). Only where the scene has a point light (delta lights with a target;
+    /// lights a path can hit have tracking's hits besides) and a medium. Directional MIS has no
+    /// distance pdfs to weigh it by and leaves it out. The path estimators choose equiangular
+    /// sampling by their strategy instead.
     bool bdpt_equiangular = true;
 };
 
