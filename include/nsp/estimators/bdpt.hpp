@@ -718,12 +718,10 @@ private:
         float density(const Sc& sc, const Vec3& o, const Vec3& w, float d) const noexcept {
             return density(sc, Ray{o, w}, d);
         }
-        /// A distance along `r` (a point light by u_pick, then its equiangular distance by u) with
-        /// the mixture's density there; pdf 0 where the ray misses the box.
+        /// A distance along `r` in `in`, the ray's part in the box (a point light by u_pick, then
+        /// its equiangular distance by u), with the mixture's density there.
         template <class Sc>
-        DistanceSample sample(const Sc& sc, const Ray& r, float u_pick, float u) const noexcept {
-            const Interval in = box.clip(r, 0.f, kInf);
-            if (in.empty()) return {};
+        DistanceSample sample(const Sc& sc, const Ray& r, const Interval& in, float u_pick, float u) const noexcept {
             int pick = -1;
             float cdf = 0.f;
             for (int k = 0; k < sc.lights.equiangular_count(); ++k) {
@@ -1299,9 +1297,10 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
         const int t = count + 1;
         if (!eq || t - 1 > depth) return;
         const V& z = path[count - 1];
-        if (eq->box.clip(ray, 0.f, kInf).empty()) return;
+        const Interval in = eq->box.clip(ray, 0.f, kInf);
+        if (in.empty()) return;
         const float u_pick = rng.uniform(), u = rng.uniform();
-        const DistanceSample ds = eq->sample(sc, ray, u_pick, u);
+        const DistanceSample ds = eq->sample(sc, ray, in, u_pick, u);
         if (!(ds.pdf > 0.f && ds.t > 0.f)) return;
         const double before = detail::recorder_work(counter);
         int at = -1;
