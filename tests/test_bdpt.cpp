@@ -64,6 +64,11 @@ double brute_pdf(const Pdfs& p, int s) {
         for (int i = 2; i < p.k; ++i) v *= p.from_camera[i];
         return v;
     }
+    if (s == Pdfs::kSegment) {  // x_0 by the segment technique from x_1, x_1.. from the camera
+        double v = double(p.seg);
+        for (int i = 1; i < p.k; ++i) v *= p.from_camera[i];
+        return v;
+    }
     if (s == p.k) {  // t = 1: x_0..x_{k-1} from the light, x_{k-1} connected to the camera
         if (!p.light_tracing || p.k < 2 || !p.connectible[p.k - 1]) return 0.0;
     } else {
@@ -100,11 +105,13 @@ TEST_CASE("bdpt: the strategy weights of a path are the heuristics of its strate
         if (rng.uniform() < 0.2f) p.from_camera[0] = 0.f;
         p.eq = rng.uniform() < 0.3f ? 0.f : density();
         p.eq_nee = rng.uniform() < 0.2f ? 0.f : density();
+        p.seg = rng.uniform() < 0.3f ? 0.f : density();
         const int count = p.light_tracing && p.k >= 2 ? p.k + 1 : p.k;
         CHECK(bdpt::strategy_count(p) == count);
         std::vector<int> strategies;
         for (int s = 0; s < count; ++s) strategies.push_back(s);
         strategies.push_back(Pdfs::kEquiangular);
+        strategies.push_back(Pdfs::kSegment);
         double total = 0.0, total2 = 0.0;
         for (const int s : strategies) {
             total += brute_pdf(p, s);
@@ -237,19 +244,25 @@ TEST_CASE("bdpt: agrees with PathEstimator on a scattering cube over a floor, a 
 /// the unweighted contribution of every sample (0 where the strategy drew no such path), the same
 /// over the paths whose x_1 is a medium vertex and x_0 a light's (outside the cube [-1, 1]^3 the
 /// tests' media fill), and for each other strategy o of the same path
-/// length, p_o / sum_r p_r of the path s drew (0 likewise). The equiangular strategy is (eq, t),
-/// t its camera-side vertices as s = 1's.
+/// length, p_o / sum_r p_r of the path s drew (0 likewise), and the unweighted contributions of
+/// the paths whose x_0 lies inside the cube (an emitting cube's volume sources). The equiangular
+/// strategy is (eq, t), t its camera-side vertices as s = 1's; the segment technique (seg, t),
+/// as s = 0's.
 struct StrategyRecord {
-    int eq = 0;  ///< the equiangular strategy's index (PathPdfs::kEquiangular)
+    int eq = 0;   ///< the equiangular strategy's index (PathPdfs::kEquiangular)
+    int seg = 0;  ///< the segment technique's (PathPdfs::kSegment)
     std::map<std::pair<int, int>, Stat> alone;
     std::map<std::pair<int, int>, Stat> alone_medium;
+    std::map<std::pair<int, int>, Stat> alone_volume;
     std::map<std::pair<int, int>, std::map<int, Stat>> share;
 
-    /// The strategies of the paths of n interior vertices: (s, n + 2 - s), s = 0..n+1, and (eq, n + 1).
+    /// The strategies of the paths of n interior vertices: (s, n + 2 - s), s = 0..n+1, (eq, n + 1)
+    /// and (seg, n + 2).
     std::vector<std::pair<int, int>> strategies(int n) const {
         std::vector<std::pair<int, int>> out;
         for (int s = 0; s <= n + 1; ++s) out.emplace_back(s, n + 2 - s);
         out.emplace_back(eq, n + 1);
+        out.emplace_back(seg, n + 2);
         return out;
     }
 };
@@ -259,10 +272,11 @@ template <class E, class Scene>
 StrategyRecord record_strategies(const E& est, const Scene& sc, int n_samples, int longest) {
     StrategyRecord rec;
     rec.eq = E::Pdfs::kEquiangular;
+    rec.seg = E::Pdfs::kSegment;
     Pcg32 rng(41, 7);
     LookupCount counter;
     const PinholeCamera camera = cube_pinhole();
-    std::map<std::pair<int, int>, double> value, value_medium;
+    std::map<std::pair<int, int>, double> value, value_medium, value_volume;
     std::map<std::pair<int, int>, std::map<int, double>> shares;
     auto far_apart = [](const auto& v) {
         std::vector<Vec3> x{v.x0};
@@ -276,6 +290,7 @@ StrategyRecord record_strategies(const E& est, const Scene& sc, int n_samples, i
     for (int i = 0; i < n_samples; ++i) {
         value.clear();
         value_medium.clear();
+        value_volume.clear();
         shares.clear();
         auto observe = [&](int s, int t, const Spectrum& f, float, const auto& pdfs, const auto& vertices) {
             if (!far_apart(vertices)) return;
@@ -283,11 +298,13 @@ StrategyRecord record_strategies(const E& est, const Scene& sc, int n_samples, i
             const auto& x1 = vertices.s >= 2 ? vertices.light[1] : vertices.camera[vertices.t - 1];
             const bool x0_on_light = vertices.x0_at_infinity || !Box{Vec3(-1.f), Vec3(1.f)}.contains(vertices.x0);
             if (x1.kind == bdpt::VertexKind::Medium && x0_on_light) value_medium[{s, t}] += double(f[0]);
-            double q[E::kMaxPath + 1];
+            if (!x0_on_light) value_volume[{s, t}] += double(f[0]);
+            double q[E::Pdfs::kSlots];
             REQUIRE(bdpt::strategy_pdfs(pdfs, q));
             std::vector<int> all;
             for (int o = 0; o < bdpt::strategy_count(pdfs); ++o) all.push_back(o);
             all.push_back(rec.eq);
+            all.push_back(rec.seg);
             double sum = 0.0;
             for (const int o : all) sum += q[o];
             // Summed: a strategy may draw several paths in one sample (the collision estimator's
@@ -304,6 +321,7 @@ StrategyRecord record_strategies(const E& est, const Scene& sc, int n_samples, i
             for (const auto& key : keys) {
                 rec.alone[key].add(value.count(key) ? value[key] : 0.0);
                 rec.alone_medium[key].add(value_medium.count(key) ? value_medium[key] : 0.0);
+                rec.alone_volume[key].add(value_volume.count(key) ? value_volume[key] : 0.0);
                 const auto it = shares.find(key);
                 for (const auto& other : keys) {
                     const int o = other.first;
@@ -351,8 +369,10 @@ EstimatorOptions strategy_test_options() {
 /// The two checks on a record of paths of 1..3 interior vertices (see the test below): every
 /// (s, t) alone against NEE's estimate of the same path length, and the pdf symmetry over every
 /// pair of strategies, both within 5 combined SE. `hittable`: the lights can be hit (s = 0 draws
-/// paths); else s = 0 must contribute exactly nothing.
-void check_strategies_alone_and_symmetric(StrategyRecord& rec, bool hittable = true, bool equiangular = false) {
+/// paths); else s = 0 must contribute exactly nothing. `equiangular`, `segment`: the scene has a
+/// point light, an emitting medium, where these strategies draw paths.
+void check_strategies_alone_and_symmetric(StrategyRecord& rec, bool hittable = true, bool equiangular = false,
+                                          bool segment = false) {
     for (int n = 1; n <= 3; ++n) {
         const Stat& nee = rec.alone[{1, n + 1}];
         for (int s = 0; s <= n + 1; ++s) {
@@ -383,6 +403,23 @@ void check_strategies_alone_and_symmetric(StrategyRecord& rec, bool hittable = t
         CHECK(eq.mean > 0.0);
         CHECK(rec.alone_medium[{rec.eq, n + 1}].mean == eq.mean);
         CHECK(std::abs(eq.mean - nee_medium.mean) <= kSigmas * std::sqrt(eq.se() * eq.se() + nee_medium.se() * nee_medium.se()));
+    }
+    // The segment technique draws every path whose x_0 lies in an emitting medium: its estimate
+    // alone against NEE's over those paths (NEE toward the volume), 5 combined SE; without
+    // emission, nothing.
+    for (int n = 1; n <= 3; ++n) {
+        const Stat& seg = rec.alone[{rec.seg, n + 2}];
+        const Stat& nee_volume = rec.alone_volume[{1, n + 1}];
+        CAPTURE(n);
+        CAPTURE(seg.mean);
+        CAPTURE(nee_volume.mean);
+        if (!segment) {
+            CHECK(seg.mean == 0.0);
+            continue;
+        }
+        CHECK(seg.mean > 0.0);
+        CHECK(rec.alone_volume[{rec.seg, n + 2}].mean == seg.mean);
+        CHECK(std::abs(seg.mean - nee_volume.mean) <= kSigmas * std::hypot(seg.se(), nee_volume.se()));
     }
     CHECK(worst_share_asymmetry(rec, 3) <= kSigmas);
 }
@@ -807,7 +844,34 @@ TEST_CASE("bdpt: an emitting cube: each strategy alone unbiased, the pdfs true d
     const ESc sc = emitting_cube_over_floor();
     const EstimatorOptions opts = strategy_test_options();
     StrategyRecord rec = record_strategies(BdptEstimator<bdpt::NullScattering, mis::Balance>(opts), sc, 200000, 3);
-    check_strategies_alone_and_symmetric(rec);
+    check_strategies_alone_and_symmetric(rec, true, false, true);
+}
+
+/// emitting_cube_over_floor with a core [-0.5, 0.5]^3 of a denser, brighter emitting medium 1
+/// behind null interfaces inside the cube (medium 0 around it): a segment reaches the core's piece
+/// after tracking the shell's, whose nulls' P_n the segment technique's density carries.
+ESc nested_emitting_cubes() {
+    Shapes shapes;
+    shapes.boxes.push_back({Vec3(-1.f), Vec3(1.f), {-1, -1, 0, -1}});
+    shapes.boxes.push_back({Vec3(-0.5f), Vec3(0.5f), {-1, -1, 1, 0}});
+    shapes.quads.push_back({Vec3(-3.f, -1.05f, 3.f), Vec3(6.f, 0.f, 0.f), Vec3(0.f, 0.f, -6.f), {0, -1, -1, -1}});
+    const QuadLight<S> lamp{Vec3(-0.6f, 2.6f, -0.6f), Vec3(1.2f, 0.f, 0.f), Vec3(0.f, 0.f, 1.2f), Spectrum::Constant(12.f)};
+    shapes.quads.push_back({lamp.corner, lamp.edge_u, lamp.edge_v, {-1, 0, -1, -1}});
+    return ESc(shapes,
+               {emitting(Box{Vec3(-1.f), Vec3(1.f)}, 0.3f, 1.2f, 0.4f, 0.6f),
+                emitting(Box{Vec3(-0.5f), Vec3(0.5f)}, 1.f, 2.f, 3.f, 0.2f)},
+               materials(0.6f), Ls(LightSelection::Power, 4.f, {lamp}, {}), -1);
+}
+
+TEST_CASE("bdpt: nested emitting media: each strategy alone unbiased, the pdfs true densities") {
+    // The emitting cube's checks with an emitting core behind null interfaces inside it: the
+    // segment technique's points in the core come after the shell's tracked piece (its nulls'
+    // P_n in the technique's density, on the camera side, in NEE toward the volume and in light
+    // subpaths from the core, whose first segment crosses the shell), 5 SE.
+    const ESc sc = nested_emitting_cubes();
+    const EstimatorOptions opts = strategy_test_options();
+    StrategyRecord rec = record_strategies(BdptEstimator<bdpt::NullScattering, mis::Balance>(opts), sc, 200000, 3);
+    check_strategies_alone_and_symmetric(rec, true, false, true);
 }
 
 TEST_CASE("bdpt: agrees with PathEstimator on an emitting cube over a floor under a lamp") {

@@ -780,7 +780,7 @@ TEST_CASE("NEE counts: a count outside (0, 1] is rejected by name, by BDPT too")
     CHECK_NOTHROW((PathEstimator<strategy::NullScatteringMis, mis::Balance>(with_count(1e-3f))));
 }
 
-TEST_CASE("emission segment counts: a count outside (0, 1] is rejected by name; BDPT (no segment technique) rejects any but 1") {
+TEST_CASE("emission segment counts: a count outside (0, 1] is rejected by name, by every estimator") {
     for (const float bad : {0.f, -0.5f, 1.5f, std::nanf("")}) {
         CAPTURE(bad);
         EstimatorOptions o;
@@ -789,9 +789,12 @@ TEST_CASE("emission segment counts: a count outside (0, 1] is rejected by name; 
                              doctest::Contains("emission_segment_count"), InvalidArgument);
         CHECK_THROWS_WITH_AS((SpectralPathEstimator<channels::SpectralMis, strategy::NullScatteringMis, mis::Balance>(o)),
                              doctest::Contains("emission_segment_count"), InvalidArgument);
+        EstimatorOptions b = BdptEstimator<>::default_options();
+        b.emission_segment_count = bad;
+        CHECK_THROWS_WITH_AS((BdptEstimator<bdpt::NullScattering, mis::Balance>(b)),
+                             doctest::Contains("emission_segment_count"), InvalidArgument);
     }
     EstimatorOptions half = BdptEstimator<>::default_options();
     half.emission_segment_count = 0.5f;
-    CHECK_THROWS_WITH_AS((BdptEstimator<bdpt::NullScattering, mis::Balance>(half)),
-                         doctest::Contains("emission_segment_count"), InvalidArgument);
+    CHECK_NOTHROW((BdptEstimator<bdpt::NullScattering, mis::Balance>(half)));
 }

@@ -138,6 +138,11 @@ double brute_channel_pdf(const Pdfs3& p, int c, int s) {
         for (int i = 2; i < p.k; ++i) v *= p.from_camera[i][c];
         return v * p.gamma[c];
     }
+    if (s == Pdfs3::kSegment) {  // x_0 by the segment technique from x_1, x_1.. from the camera
+        double v = double(p.seg[c]);
+        for (int i = 1; i < p.k; ++i) v *= p.from_camera[i][c];
+        return v * p.gamma[c];
+    }
     if (s == p.k) {
         if (!p.light_tracing || p.k < 2 || !p.connectible[p.k - 1]) return 0.0;
     } else {
@@ -182,10 +187,12 @@ TEST_CASE("spectral bdpt: the weights over channels x strategies are the heurist
         p.gamma /= p.gamma.maxCoeff();
         p.eq = rng.uniform() < 0.3f ? Rgb::Spectrum(Rgb::Spectrum::Zero()) : channels();
         p.eq_nee = rng.uniform() < 0.2f ? 0.f : density();
+        p.seg = rng.uniform() < 0.3f ? Rgb::Spectrum(Rgb::Spectrum::Zero()) : channels();
         const int count = bdpt::strategy_count(p);
         std::vector<int> strategies;
         for (int s = 0; s < count; ++s) strategies.push_back(s);
         strategies.push_back(Pdfs3::kEquiangular);
+        strategies.push_back(Pdfs3::kSegment);
         double total = 0.0, total2 = 0.0;
         for (int c = 0; c < 3; ++c)
             for (const int s : strategies) {
@@ -403,21 +410,27 @@ TEST_CASE("spectral bdpt: agrees with SpectralPathEstimator under a lamp and a s
 /// / sum_c q_c gamma_c p_(s,c), the one-sample estimate of s alone), the same over the paths whose
 /// x_1 is a medium vertex and x_0 a light's (outside the cube [-1, 1]^3), and for every other
 /// strategy o the share pbar_o / sum_r pbar_r of the path s drew, pbar_s = sum_c q_c p_(s,c) the
-/// density of strategy s over the channel selection. The equiangular strategy is (eq, t).
+/// density of strategy s over the channel selection; `alone_volume` over the paths whose x_0 lies
+/// inside the cube (an emitting cube's volume sources). The equiangular strategy is (eq, t), the
+/// segment technique (seg, t).
 struct ChannelStrategyRecord {
-    int eq = 0;  ///< the equiangular strategy's index (PathPdfs::kEquiangular)
+    int eq = 0;   ///< the equiangular strategy's index (PathPdfs::kEquiangular)
+    int seg = 0;  ///< the segment technique's (PathPdfs::kSegment)
     std::map<std::pair<int, int>, SpecStat<Rgb>> alone;
     std::map<std::pair<int, int>, SpecStat<Rgb>> alone_medium;
+    std::map<std::pair<int, int>, SpecStat<Rgb>> alone_volume;
     std::map<std::pair<int, int>, std::map<int, Stat>> share;
     /// Per sampling channel c: p_(o,c) / sum_r p_(r,c) of the paths that s drew with c (0 on the
     /// samples of the other channels).
     std::array<std::map<std::pair<int, int>, std::map<int, Stat>>, 3> channel_share;
 
-    /// The strategies of the paths of n interior vertices: (s, n + 2 - s), s = 0..n+1, and (eq, n + 1).
+    /// The strategies of the paths of n interior vertices: (s, n + 2 - s), s = 0..n+1, (eq, n + 1)
+    /// and (seg, n + 2).
     std::vector<std::pair<int, int>> strategies(int n) const {
         std::vector<std::pair<int, int>> out;
         for (int s = 0; s <= n + 1; ++s) out.emplace_back(s, n + 2 - s);
         out.emplace_back(eq, n + 1);
+        out.emplace_back(seg, n + 2);
         return out;
     }
 };
@@ -427,11 +440,13 @@ ChannelStrategyRecord record_channel_strategies(const E& est, const Scene& sc, i
     constexpr int N = E::kMaxPath;
     using Spectrum = Rgb::Spectrum;
     ChannelStrategyRecord rec;
+    constexpr int kSlots = E::template PdfsFor<Rgb>::kSlots;
     rec.eq = N;
+    rec.seg = N + 1;
     Pcg32 rng(43, 7);
     LookupCount counter;
     const PinholeCamera camera = cube_view();
-    std::map<std::pair<int, int>, Spectrum> value, value_medium;
+    std::map<std::pair<int, int>, Spectrum> value, value_medium, value_volume;
     std::map<std::pair<int, int>, std::map<int, double>> shares, own_shares;
     int channel = 0;
     auto far_apart = [](const auto& v) {
@@ -446,24 +461,26 @@ ChannelStrategyRecord record_channel_strategies(const E& est, const Scene& sc, i
     for (int i = 0; i < n_samples; ++i) {
         value.clear();
         value_medium.clear();
+        value_volume.clear();
         shares.clear();
         own_shares.clear();
         auto observe = [&](int s, int t, const Spectrum& f, float, const auto& pdfs, const auto& vertices) {
             if (!far_apart(vertices)) return;
-            double q[3 * (N + 1)];
+            double q[3 * kSlots];
             REQUIRE(bdpt::channel_strategy_pdfs(pdfs, q));
             std::vector<int> all;
             for (int o = 0; o < bdpt::strategy_count(pdfs); ++o) all.push_back(o);
             all.push_back(N);
+            all.push_back(N + 1);
             double own_sum = 0.0, total = 0.0;
             std::map<int, double> mixture;
             for (int c = 0; c < 3; ++c) {
-                own_sum += q[c * (N + 1) + s] / 3.0;
-                for (const int o : all) mixture[o] += q[c * (N + 1) + o] / 3.0;
+                own_sum += q[c * kSlots + s] / 3.0;
+                for (const int o : all) mixture[o] += q[c * kSlots + o] / 3.0;
             }
             for (const auto& [o, x] : mixture) total += x;
             REQUIRE(own_sum > 0.0);
-            const Spectrum alone = f * float(q[pdfs.channel * (N + 1) + s] / own_sum);
+            const Spectrum alone = f * float(q[pdfs.channel * kSlots + s] / own_sum);
             value.try_emplace({s, t}, Spectrum::Zero());
             value[{s, t}] += alone;
             const auto& x1 = vertices.s >= 2 ? vertices.light[1] : vertices.camera[vertices.t - 1];
@@ -472,11 +489,15 @@ ChannelStrategyRecord record_channel_strategies(const E& est, const Scene& sc, i
                 value_medium.try_emplace({s, t}, Spectrum::Zero());
                 value_medium[{s, t}] += alone;
             }
+            if (!x0_on_light) {
+                value_volume.try_emplace({s, t}, Spectrum::Zero());
+                value_volume[{s, t}] += alone;
+            }
             for (const int o : all) shares[{s, t}][o] += mixture[o] / total;
             channel = pdfs.channel;
             double own_total = 0.0;
-            for (const int o : all) own_total += q[channel * (N + 1) + o];
-            for (const int o : all) own_shares[{s, t}][o] += q[channel * (N + 1) + o] / own_total;
+            for (const int o : all) own_total += q[channel * kSlots + o];
+            for (const int o : all) own_shares[{s, t}][o] += q[channel * kSlots + o] / own_total;
         };
         auto splat = [](float, float, const Spectrum&) {};
         const float u = rng.uniform(), v = rng.uniform();
@@ -487,6 +508,7 @@ ChannelStrategyRecord record_channel_strategies(const E& est, const Scene& sc, i
             for (const auto& key : keys) {
                 rec.alone[key].add(value.count(key) ? value[key] : Spectrum(Spectrum::Zero()));
                 rec.alone_medium[key].add(value_medium.count(key) ? value_medium[key] : Spectrum(Spectrum::Zero()));
+                rec.alone_volume[key].add(value_volume.count(key) ? value_volume[key] : Spectrum(Spectrum::Zero()));
                 const auto it = shares.find(key);
                 const auto own = own_shares.find(key);
                 for (const auto& other : keys) {
@@ -506,7 +528,10 @@ ChannelStrategyRecord record_channel_strategies(const E& est, const Scene& sc, i
 /// the lights can be hit (s = 0 draws paths); else s = 0 must contribute exactly nothing.
 /// `equiangular`: the equiangular strategy draws every path whose x_1 is a medium vertex and x_0
 /// a light's (against NEE over those, 5 combined SE per channel); else it draws none.
-void check_channel_strategies(ChannelStrategyRecord& rec, bool hittable = true, bool equiangular = false) {
+/// `segment`: the segment technique draws every path whose x_0 lies in the emitting cube (against
+/// NEE toward the volume, 5 combined SE per channel); else it draws none.
+void check_channel_strategies(ChannelStrategyRecord& rec, bool hittable = true, bool equiangular = false,
+                              bool segment = false) {
     for (int n = 1; n <= 3; ++n) {
         const SpecStat<Rgb>& nee = rec.alone[{1, n + 1}];
         for (int s = 0; s <= n + 1; ++s) {
@@ -539,6 +564,21 @@ void check_channel_strategies(ChannelStrategyRecord& rec, bool hittable = true, 
             CHECK(eq.ch[c].mean > 0.0);
             CHECK(std::abs(eq.ch[c].mean - nee_medium.ch[c].mean) <=
                   kSigmas * std::hypot(eq.ch[c].se(), nee_medium.ch[c].se()));
+        }
+        const SpecStat<Rgb>& seg = rec.alone[{rec.seg, n + 2}];
+        const SpecStat<Rgb>& nee_volume = rec.alone_volume[{1, n + 1}];
+        for (int c = 0; c < 3; ++c) {
+            CAPTURE(n);
+            CAPTURE(c);
+            CAPTURE(seg.ch[c].mean);
+            CAPTURE(nee_volume.ch[c].mean);
+            if (!segment) {
+                CHECK(seg.ch[c].mean == 0.0);
+                continue;
+            }
+            CHECK(seg.ch[c].mean > 0.0);
+            CHECK(std::abs(seg.ch[c].mean - nee_volume.ch[c].mean) <=
+                  kSigmas * std::hypot(seg.ch[c].se(), nee_volume.ch[c].se()));
         }
     }
     auto worst_asymmetry = [&rec](std::map<std::pair<int, int>, std::map<int, Stat>>& share) {
@@ -699,8 +739,8 @@ using EmittingScene = SurfaceScene<Shapes, EM<S>, ChannelMajorant<EM<S>>, Henyey
 SceneMedium<EM<Rgb>, ChannelMajorant<EM<Rgb>>, HenyeyGreensteinPhase> emitting_cube(const Rgb::Spectrum& sigma_a,
                                                                                    const Rgb::Spectrum& sigma_s,
                                                                                    const Rgb::Spectrum& le, bool uneven,
-                                                                                   float g) {
-    const Box box{Vec3(-1.f), Vec3(1.f)};
+                                                                                   float g,
+                                                                                   Box box = Box{Vec3(-1.f), Vec3(1.f)}) {
     std::vector<float> cells(8, 1.f);
     if (uneven) cells[7] = 4.f;
     const EM<Rgb> m(M<Rgb>(box, sigma_a, sigma_s), EmissionGrid(box, {2, 2, 2}, cells), le, {4, 4, 4});
@@ -752,7 +792,29 @@ TEST_CASE("spectral bdpt: an emitting chromatic cube: each strategy alone, every
     opts.russian_roulette = false;
     opts.max_depth = 3;
     ChannelStrategyRecord rec = record_channel_strategies(SpectralBdptEstimator<>(opts), emitting_chromatic_cube(), 200000);
-    check_channel_strategies(rec);
+    check_channel_strategies(rec, true, false, true);
+}
+
+TEST_CASE("spectral bdpt: nested emitting chromatic media: each strategy alone, every channel's pdfs true densities") {
+    // The emitting chromatic cube with a core [-0.5, 0.5]^3 of another emitting chromatic medium
+    // behind null interfaces inside it: every channel's P_n of the shell's nulls before the core's
+    // piece enters the segment technique's densities (camera side, NEE toward the volume, light
+    // subpaths from the core), 5 combined SE.
+    using Spectrum = Rgb::Spectrum;
+    EmittingScene<Rgb> base = emitting_chromatic_cube();
+    Shapes shapes = base.geometry;
+    shapes.boxes.push_back({Vec3(-0.5f), Vec3(0.5f), {-1, -1, 1, 0}});
+    const Spectrum sigma_t(3.f, 0.8f, 1.6f), albedo(0.5f, 0.9f, 0.7f);
+    const EmittingScene<Rgb> sc(
+        shapes,
+        {base.media[0], emitting_cube(sigma_t * (1.f - albedo), sigma_t * albedo, Spectrum(2.f, 3.f, 0.5f), false, 0.2f,
+                                      Box{Vec3(-0.5f), Vec3(0.5f)})},
+        base.materials, base.lights, -1);
+    EstimatorOptions opts;
+    opts.russian_roulette = false;
+    opts.max_depth = 3;
+    ChannelStrategyRecord rec = record_channel_strategies(SpectralBdptEstimator<>(opts), sc, 200000);
+    check_channel_strategies(rec, true, false, true);
 }
 
 TEST_CASE("spectral bdpt: agrees with SpectralPathEstimator on an emitting chromatic cube") {

@@ -155,6 +155,16 @@ bdpt::PathPdfs<12> read_path_pdfs(Input& in) {
     return p;
 }
 
+/// Every strategy of a BDPT path: the (s, t) ones, the equiangular strategy and the segment technique.
+template <class P>
+std::vector<int> every_strategy(const bdpt::PathPdfs<12, P>& p) {
+    std::vector<int> out;
+    for (int s = 0; s < bdpt::strategy_count(p); ++s) out.push_back(s);
+    out.push_back(p.kEquiangular);
+    out.push_back(p.kSegment);
+    return out;
+}
+
 template <class H>
 void check_heuristic(Input& in, const H& h) {
     g_context = "mis heuristic";
@@ -194,18 +204,18 @@ void check_heuristic(Input& in, const H& h) {
     for (const float x : {ec, es, en}) NSP_FUZZ_CHECK(x >= 0.f && x <= 1.f);
     if (ep.collision > 0.f || ep.segment > 0.f || ep.nee > 0.f) NSP_FUZZ_CHECK(std::abs(ec + es + en - 1.f) <= kWeightTol);
 
-    // BDPT (THEORY 5.5): the (s, t) strategies of one path (the equiangular one off: weight 0),
-    // densities in [0, inf] per vertex, delta vertices, with and without light tracing: every
-    // weight in [0, 1], and they sum to 1 where any
+    // BDPT (THEORY 5.5): the (s, t) strategies of one path (the equiangular one and the segment
+    // technique off: weight 0), densities in [0, inf] per vertex, delta vertices, with and without
+    // light tracing: every weight in [0, 1], and they sum to 1 where any
     // strategy can draw the path (strategy_pdfs true), to 0 where none can.
     bdpt::PathPdfs<12> p = read_path_pdfs(in);
-    double q[13];
+    double q[bdpt::PathPdfs<12>::kSlots];
     const bool drawable = bdpt::strategy_pdfs(p, q);
     float sum = 0.f;
-    for (int s = 0; s <= bdpt::strategy_count(p); ++s) {  // the last: the equiangular strategy
-        const float w = bdpt::strategy_weight(h, p, s == bdpt::strategy_count(p) ? p.kEquiangular : s);
-        NSP_FUZZ_CHECK(w >= 0.f && w <= 1.f);
-        sum += w;
+    for (const int s : every_strategy(p)) {
+        const float ws = bdpt::strategy_weight(h, p, s);
+        NSP_FUZZ_CHECK(ws >= 0.f && ws <= 1.f);
+        sum += ws;
     }
     NSP_FUZZ_CHECK(drawable ? std::abs(sum - 1.f) <= kWeightTol : sum == 0.f);
 }
@@ -244,14 +254,14 @@ void check_channel_bdpt(Input& in, const H& h) {
     p.gamma = Rgb::Spectrum(gammas[in.pick(4)], gammas[in.pick(4)], 1.f);
     p.eq = Rgb::Spectrum(ratio(in), ratio(in), ratio(in));  // the equiangular strategy
     p.eq_nee = ratio(in);
-    double q[3 * 13];
+    p.seg = Rgb::Spectrum(ratio(in), ratio(in), ratio(in));  // the segment technique: read last
+    double q[3 * bdpt::PathPdfs<12, Rgb::Spectrum>::kSlots];
     const bool drawable = bdpt::channel_strategy_pdfs(p, q);
     float sum = 0.f;
     for (int c = 0; c < 3; ++c) {
         p.channel = c;
-        for (int s = 0; s <= bdpt::strategy_count(p); ++s) {  // the last: the equiangular strategy
-            const float w =
-                bdpt::channel_strategy_weight(h, p, s == bdpt::strategy_count(p) ? p.kEquiangular : s) / 3.f;
+        for (const int s : every_strategy(p)) {
+            const float w = bdpt::channel_strategy_weight(h, p, s) / 3.f;
             NSP_FUZZ_CHECK(w >= 0.f && w <= 1.f + kWeightTol);
             sum += w;
         }
@@ -259,9 +269,10 @@ void check_channel_bdpt(Input& in, const H& h) {
     NSP_FUZZ_CHECK(drawable ? std::abs(sum - 1.f) <= kWeightTol : sum == 0.f);
 }
 
-/// BDPT's grey weights with the equiangular strategy (THEORY 5.4 in 5.5), as check_heuristic's:
-/// every weight in [0, 1], summing to 1 where any strategy can draw the path, to 0 where none can.
-/// Reads its bytes last.
+/// BDPT's grey weights with the equiangular strategy (THEORY 5.4 in 5.5) and the segment
+/// technique (5.7 in 5.5), as check_heuristic's: every weight in [0, 1], summing to 1 where any
+/// strategy can draw the path, to 0 where none can. Reads its bytes last (the segment
+/// technique's after the rest).
 void check_bdpt_equiangular(Input& in) {
     bdpt::PathPdfs<12> p = read_path_pdfs(in);
     p.eq = ratio(in);
@@ -269,11 +280,11 @@ void check_bdpt_equiangular(Input& in) {
     const float betas[] = {1.f, 2.f, 10.f, 100.f};
     const bool balance = in.pick(2) == 0;
     const mis::Power power(betas[in.pick(4)]);
-    double q[13];
+    p.seg = ratio(in);
+    double q[bdpt::PathPdfs<12>::kSlots];
     const bool drawable = bdpt::strategy_pdfs(p, q);
     float sum = 0.f;
-    for (int s = 0; s <= bdpt::strategy_count(p); ++s) {
-        const int strategy = s == bdpt::strategy_count(p) ? p.kEquiangular : s;
+    for (const int strategy : every_strategy(p)) {
         const float w = balance ? bdpt::strategy_weight(mis::Balance{}, p, strategy) : bdpt::strategy_weight(power, p, strategy);
         NSP_FUZZ_CHECK(w >= 0.f && w <= 1.f);
         sum += w;

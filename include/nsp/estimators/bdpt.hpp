@@ -22,7 +22,10 @@
 // strategy_weight). An emissive medium is a light source too (THEORY 5.7): the camera subpath
 // collects its emission at every tentative collision (s = 0), NEE also draws a point in the
 // volume (s = 1), and light subpaths start there (one half of them when the scene also has
-// lights), so connections and light tracing carry it as well.
+// lights), so connections and light tracing carry it as well; with null-scattering MIS the
+// segment technique also draws one point on every piece of a camera segment in an emitting
+// medium (PathPdfs::kSegment). Toward point lights, the equiangular strategy draws a vertex on
+// every camera segment and connects it by NEE (PathPdfs::kEquiangular).
 //
 // Policies: bdpt::NullScattering (the paper's full null-scattering MIS) or bdpt::Directional
 // (the baseline: direction pdfs and geometry only, the tracking factors left out, as pbrt's BDPT
@@ -160,6 +163,14 @@ P broadcast(float v) noexcept {
 ///   medium vertex or the technique is off), eq_nee the density of x_0 under NEE from it (NEE
 ///   from an equiangular vertex always runs: no count; 0 where NEE does not draw x_0 there). Its
 ///   index among the strategies is kEquiangular (k >= 2 only).
+/// - seg: the segment technique (THEORY 5.7 in 5.5; BdptEstimator with
+///   EstimatorOptions::emission_along_segments), s = 0 with x_0 drawn from x_1 on its piece of
+///   the segment (the part in one medium between surfaces or null interfaces) in proportion to
+///   the medium's power grid along it instead of by tracking: the density of x_0 so drawn
+///   (volume measure; its count, EstimatorOptions::emission_segment_count, included), with the
+///   P_n of the nulls on the pieces before x_0's (tracked) and none for x_0's own (ratio-tracked,
+///   their Tbar and mu_bar shared with every strategy); 0 where x_0 is not in an emitting
+///   medium or the technique is off. Its index is kSegment; q arrays hold kSlots entries.
 ///
 /// Per channel (P a Spectrum, THEORY 5.3 with 5.5), from_light and from_camera hold every
 /// channel's density (its own majorant and event probabilities in the null and event factors),
@@ -169,12 +180,17 @@ template <int N, class P = float>
 struct PathPdfs {
     /// The equiangular strategy's index (above every (s, t) strategy's, s <= k <= N - 1).
     static constexpr int kEquiangular = N;
+    /// The segment technique's index.
+    static constexpr int kSegment = N + 1;
+    /// The size of a q array of strategy_pdfs (per channel: of each channel's part).
+    static constexpr int kSlots = N + 2;
     int k = 0;
     bool light_tracing = false;
     float emit = 0.f, nee = 0.f, eq_nee = 0.f;
     P from_light[N] = {};
     P from_camera[N] = {};
     P eq = broadcast<P>(0.f);
+    P seg = broadcast<P>(0.f);
     bool connectible[N] = {};
     [[no_unique_address]] GammaOf<P> gamma = unit_gamma<P>();
     [[no_unique_address]] std::conditional_t<std::is_same_v<P, float>, NoGamma, int> channel{};
@@ -187,15 +203,17 @@ int strategy_count(const PathPdfs<N, P>& p) noexcept {
     return p.light_tracing && p.k >= 2 ? p.k + 1 : p.k;
 }
 
-/// Whether strategy s is one of the path's: s < strategy_count(p), or the equiangular strategy.
+/// Whether strategy s is one of the path's: s < strategy_count(p), the equiangular strategy or
+/// the segment technique.
 template <int N, class P>
 bool is_strategy(const PathPdfs<N, P>& p, int s) noexcept {
-    return (s >= 0 && s < strategy_count(p)) || s == PathPdfs<N, P>::kEquiangular;
+    return (s >= 0 && s < strategy_count(p)) || s == PathPdfs<N, P>::kEquiangular || s == PathPdfs<N, P>::kSegment;
 }
 
 /// Strategy s's pdf of the path relative to the largest of all strategies' (each in [0, 1]; 0
-/// where s cannot draw it), written into q[0..k-1] (q[0..k] with light tracing) and the
-/// equiangular strategy's into q[N] (q has N + 1 entries). Each vertex's
+/// where s cannot draw it), written into q[0..k-1] (q[0..k] with light tracing), the
+/// equiangular strategy's into q[N] and the segment technique's into q[N + 1] (q has N + 2 =
+/// PathPdfs::kSlots entries). Each vertex's
 /// two densities are scaled by their larger one (an infinite one, an overflowed density, wins)
 /// and the products taken in double, so long paths neither overflow nor underflow. Returns false
 /// when no strategy can draw the path. NaN densities give NaN.
@@ -230,17 +248,19 @@ bool strategy_pdfs(const PathPdfs<N>& p, double* q) noexcept {
     double suffix[N + 1];
     suffix[k] = 1.0;
     for (int i = k - 1; i >= 1; --i) suffix[i] = suffix[i + 1] * c[i];
-    // x_0 under s = 0, 1, >= 2 and the equiangular strategy
-    double x0[4] = {double(p.from_camera[0]), double(p.nee), double(p.emit), double(p.eq_nee)};
-    scale(x0, 4);
+    // x_0 under s = 0, 1, >= 2, the equiangular strategy and the segment technique
+    double x0[5] = {double(p.from_camera[0]), double(p.nee), double(p.emit), double(p.eq_nee), double(p.seg)};
+    scale(x0, 5);
     const int last = strategy_count(p);
     double prefix = 1.0, largest = 0.0;  // prefix = prod_{i=1}^{s-1} l_i
     q[N] = k >= 2 && p.connectible[1] ? x0[3] * eq1 * suffix[2] : 0.0;
-    if (std::isnan(q[N])) {
-        for (int r = 0; r <= N; ++r) q[r] = q[N];
+    q[N + 1] = x0[4] * suffix[1];  // drawn along x_1's sampled direction, as s = 0: x_1 may be delta
+    if (std::isnan(q[N]) || std::isnan(q[N + 1])) {
+        const double nan = std::numeric_limits<double>::quiet_NaN();
+        for (int r = 0; r <= N + 1; ++r) q[r] = nan;
         return true;
     }
-    largest = q[N];
+    largest = std::max(q[N], q[N + 1]);
     for (int s = 0; s < last; ++s) {
         if (s >= 2) prefix *= l[s - 1];
         double v = 0.0;
@@ -250,7 +270,7 @@ bool strategy_pdfs(const PathPdfs<N>& p, double* q) noexcept {
         else if (p.connectible[s - 1] && p.connectible[s]) v = x0[2] * prefix * suffix[s];
         q[s] = v;
         if (std::isnan(v)) {  // a NaN density: every strategy's pdf is NaN
-            for (int r = 0; r <= N; ++r) q[r] = v;
+            for (int r = 0; r <= N + 1; ++r) q[r] = v;
             return true;
         }
         largest = std::max(largest, v);
@@ -258,6 +278,7 @@ bool strategy_pdfs(const PathPdfs<N>& p, double* q) noexcept {
     if (!(largest > 0.0)) return false;
     for (int s = 0; s < last; ++s) q[s] /= largest;
     q[N] /= largest;
+    q[N + 1] /= largest;
     return true;
 }
 
@@ -268,17 +289,18 @@ template <mis::CombiningHeuristic H, int N>
 float strategy_weight(const H& h, const PathPdfs<N>& p, int s) noexcept {
     const int n = strategy_count(p);
     if (!is_strategy(p, s)) return 0.f;
-    double q[N + 1];
+    double q[N + 2];
     if (!strategy_pdfs(p, q)) return 0.f;
     if (!(q[s] > 0.0)) return std::isnan(q[s]) ? q[s] : 0.f;
     double sum = q[N] > 0.0 ? double(h.power(float(q[N]))) : 0.0;
+    if (q[N + 1] > 0.0) sum += double(h.power(float(q[N + 1])));
     for (int i = 0; i < n; ++i) sum += double(h.power(float(q[i])));
     return float(double(h.power(float(q[s]))) / sum);
 }
 
 /// Per channel (THEORY 5.3 with 5.5): every channel's pdf of the path under every strategy,
-/// gamma_c x the strategy's product of densities, written into q[c * (N + 1) + s] (the equiangular
-/// strategy's into q[c * (N + 1) + N]), all relative
+/// gamma_c x the strategy's product of densities, written into q[c * (N + 2) + s] (the equiangular
+/// strategy's into q[c * (N + 2) + N], the segment technique's into q[c * (N + 2) + N + 1]), all relative
 /// to one scale (each vertex's densities scaled by the largest over both directions and every
 /// channel, the products in double, the whole divided by the largest), as strategy_pdfs does for
 /// one channel. Returns false when no strategy of any channel can draw the path. NaN gives NaN.
@@ -305,11 +327,12 @@ bool channel_strategy_pdfs(const PathPdfs<N, P>& p, double* q) noexcept {
         inf[i] = std::isinf(m);
         inv[i] = m > 0.0 && !inf[i] ? 1.0 / m : 0.0;
     }
-    const double m0 = std::max({double(p.from_camera[0].maxCoeff()), double(p.nee), double(p.emit), double(p.eq_nee)});
+    const double m0 = std::max({double(p.from_camera[0].maxCoeff()), double(p.nee), double(p.emit), double(p.eq_nee),
+                                double(p.seg.maxCoeff())});
     nan = nan || p.from_camera[0].isNaN().any() || std::isnan(p.nee) || std::isnan(p.emit) || std::isnan(p.eq_nee) ||
-          p.gamma.isNaN().any();
+          p.seg.isNaN().any() || p.gamma.isNaN().any();
     if (nan) {
-        for (int i = 0; i < C * (N + 1); ++i) q[i] = std::numeric_limits<double>::quiet_NaN();
+        for (int i = 0; i < C * (N + 2); ++i) q[i] = std::numeric_limits<double>::quiet_NaN();
         return true;
     }
     const bool inf0 = std::isinf(m0);
@@ -318,7 +341,7 @@ bool channel_strategy_pdfs(const PathPdfs<N, P>& p, double* q) noexcept {
     auto rel = [](double v, double iv, bool is_inf) { return is_inf ? (std::isinf(v) ? 1.0 : 0.0) : v * iv; };
     double largest = 0.0;
     for (int ch = 0; ch < C; ++ch) {
-        double* qc = q + ch * (N + 1);
+        double* qc = q + ch * (N + 2);
         double suffix[N + 1];
         suffix[k] = 1.0;
         for (int i = k - 1; i >= 1; --i) suffix[i] = suffix[i + 1] * rel(double(p.from_camera[i][ch]), inv[i], inf[i]);
@@ -326,7 +349,8 @@ bool channel_strategy_pdfs(const PathPdfs<N, P>& p, double* q) noexcept {
                               rel(double(p.emit), inv0, inf0), rel(double(p.eq_nee), inv0, inf0)};
         const double g = double(p.gamma[ch]);
         qc[N] = k >= 2 && p.connectible[1] ? g * x0[3] * rel(double(p.eq[ch]), inv[1], inf[1]) * suffix[2] : 0.0;
-        largest = std::max(largest, qc[N]);
+        qc[N + 1] = g * rel(double(p.seg[ch]), inv0, inf0) * suffix[1];
+        largest = std::max({largest, qc[N], qc[N + 1]});
         double prefix = 1.0;
         for (int s = 0; s < last; ++s) {
             if (s >= 2) prefix *= rel(double(p.from_light[s - 1][ch]), inv[s - 1], inf[s - 1]);
@@ -341,8 +365,9 @@ bool channel_strategy_pdfs(const PathPdfs<N, P>& p, double* q) noexcept {
     }
     if (!(largest > 0.0)) return false;
     for (int ch = 0; ch < C; ++ch) {
-        for (int s = 0; s < last; ++s) q[ch * (N + 1) + s] /= largest;
-        q[ch * (N + 1) + N] /= largest;
+        for (int s = 0; s < last; ++s) q[ch * (N + 2) + s] /= largest;
+        q[ch * (N + 2) + N] /= largest;
+        q[ch * (N + 2) + N + 1] /= largest;
     }
     return true;
 }
@@ -358,17 +383,19 @@ float channel_strategy_weight(const H& h, const PathPdfs<N, P>& p, int s) noexce
     constexpr int C = int(P::SizeAtCompileTime);
     const int n = strategy_count(p);
     if (!is_strategy(p, s) || p.channel < 0 || p.channel >= C) return 0.f;
-    double q[C * (N + 1)];
+    double q[C * (N + 2)];
     if (!channel_strategy_pdfs(p, q)) return 0.f;
-    const double own = q[p.channel * (N + 1) + s];
+    const double own = q[p.channel * (N + 2) + s];
     if (!(own > 0.0)) return std::isnan(own) ? float(own) : 0.f;
     // With one selection probability for every channel it factors out of the heuristic (balance
     // and power are homogeneous): the pdfs enter as they are, the largest 1, so the sum is at
     // least 1 (q_c x the largest under a power of 100 would underflow to 0).
     double sum = 0.0;
     for (int ch = 0; ch < C; ++ch) {
-        for (int r = 0; r < n; ++r) sum += double(h.power(float(q[ch * (N + 1) + r])));
-        if (q[ch * (N + 1) + N] > 0.0) sum += double(h.power(float(q[ch * (N + 1) + N])));
+        const double* qc = q + ch * (N + 2);
+        for (int r = 0; r < n; ++r) sum += double(h.power(float(qc[r])));
+        if (qc[N] > 0.0) sum += double(h.power(float(qc[N])));
+        if (qc[N + 1] > 0.0) sum += double(h.power(float(qc[N + 1])));
     }
     return float(double(h.power(float(own))) / sum * double(C));
 }
@@ -589,9 +616,6 @@ private:
 
     static EstimatorOptions checked(EstimatorOptions o) {
         validate(o);
-        if (o.emission_segment_count != 1.f)
-            detail::fail("EstimatorOptions emission_segment_count = ", o.emission_segment_count,
-                         " is not allowed for nsp::BdptEstimator: it has no segment technique (count 1)");
         if (o.max_depth > MaxDepth)
             detail::fail("BdptEstimator max_depth = ", o.max_depth, " is not allowed: it must be <= ", MaxDepth,
                          " (the estimator's MaxDepth template argument, the size of its vertex arrays)");
@@ -617,7 +641,9 @@ private:
     /// A walk's emission callback that does nothing (light subpaths, media without emission).
     struct NoEmission {};
 
-    /// Calls the walk's emission callback at every tentative collision of a tracked piece.
+    /// Calls the walk's emission callback at every tentative collision of a tracked piece: `nulls`
+    /// the segment's null product before the piece, `along` the segment technique's normaliser
+    /// on it (0: the technique does not run).
     template <class Sc, class F>
     struct EmissionVisitor {
         static constexpr bool enabled = true;
@@ -626,11 +652,11 @@ private:
         int count, medium;
         const Ray& ray;
         const typename Sc::Spectrum& beta;
-        float nulls, pdf_dir;
+        float nulls, pdf_dir, along;
         void operator()(float t, const Coefficients<typename Sc::Spectral>& c, float mu_bar,
                         const typename Sc::Spectrum& w, float null_pdf_product) const {
             f(path, count, medium, ray.at(t), c, mu_bar, mu_bar, typename Sc::Spectrum(beta * w),
-              Mis::null_pdfs ? nulls * null_pdf_product : 1.f, pdf_dir, bdpt::NoGamma{});
+              Mis::null_pdfs ? nulls * null_pdf_product : 1.f, pdf_dir, bdpt::NoGamma{}, nulls, along);
         }
     };
 
@@ -672,6 +698,7 @@ private:
         const Spec& beta0;  // the throughput where the segment started
         const Spec& nulls;  // the segment's null product before this piece
         float pdf_dir;
+        float along;  // the segment technique's normaliser on this piece (0: it does not run)
         template <class State>
         void operator()(float t, const Coefficients<S>& k, const Spec& mu, const Spec& tbar, const State& st) const {
             null_visit(t, k, mu, tbar, st);
@@ -680,7 +707,7 @@ private:
                 if (!(p_here > 0.f)) return;
                 (*emission)(path, count, medium, ray.at(t), k, mu, mu[channel], Spec(beta0 * st.f * tbar / p_here),
                             Spec(nulls * null_visit.nulls->template cast<float>()), pdf_dir,
-                            relative_to_largest<Spec>(path[count - 1].gamma * st.eq.vertex * tbar));
+                            relative_to_largest<Spec>(path[count - 1].gamma * st.eq.vertex * tbar), nulls, along);
             }
         }
     };
@@ -737,19 +764,32 @@ private:
         }
     };
 
-    /// A walk's segment callback that does nothing (light subpaths, the equiangular strategy off).
+    /// A walk's segment or piece callback that does nothing (light subpaths, the technique off).
     struct NoSegment {};
+
+    /// What the segment technique needs of a light subpath's first segment, y_0 (in an emitting
+    /// medium) to y_1: the P_n product of the nulls on its pieces after the first (y_0's own, seen
+    /// from y_1), and y_1's direction density toward y_0 (arriving from y_2) in y_0's measure.
+    template <class Sc>
+    struct FirstSegment {
+        bdpt::PdfType<Ch, typename Sc::Spectral> later_nulls = bdpt::broadcast<bdpt::PdfType<Ch, typename Sc::Spectral>>(1.f);
+        float y0_reverse = 0.f;
+    };
 
     /// Tracks a subpath from path[count - 1] (see trace). With `eq` (the equiangular strategy on),
     /// stores its densities: a camera subpath's (`camera_side`) at each medium vertex, a light
     /// subpath's at y_1; `on_segment(path, count, ray, medium, pdf_dir, beta)` runs at the start of
-    /// every segment, before it is tracked.
+    /// every segment, before it is tracked; `on_piece(path, count, ray, medium, t_max, pdf_dir,
+    /// beta, nulls, gamma)` before every piece in a medium is tracked, returning the segment
+    /// technique's normaliser on it (which `on_emission` then gets). `first`, if given, receives
+    /// the first segment's FirstSegment.
     template <class Sc, UniformRng R, LookupCounter C, class OnHit, class OnEmission = NoEmission,
-              class OnSegment = NoSegment>
+              class OnSegment = NoSegment, class OnPiece = NoSegment>
     int walk(const Sc& sc, VertexT<Sc>* path, int count, int max_vertices, Ray ray, int medium, float pdf_dir,
              typename Sc::Spectrum beta, const typename Sc::Spectral::Wavelengths& lambda, int channel, R& rng,
              C& counter, OnHit on_hit, Status& status, const EqRegion* eq, bool camera_side,
-             OnEmission on_emission = {}, OnSegment on_segment = {}) const;
+             OnEmission on_emission = {}, OnSegment on_segment = {}, OnPiece on_piece = {},
+             FirstSegment<Sc>* first = nullptr) const;
 
     Kernels kernels_;
     float light_probability_ = 1.f;
@@ -758,13 +798,13 @@ private:
 // ---------------------------------------------------------------------------------------------
 
 template <bdpt::MisPolicy Mis, mis::CombiningHeuristic H, AbsorptionPolicy A, int MaxDepth, bdpt::ChannelAxis Ch>
-template <class Sc, UniformRng R, LookupCounter C, class OnHit, class OnEmission, class OnSegment>
+template <class Sc, UniformRng R, LookupCounter C, class OnHit, class OnEmission, class OnSegment, class OnPiece>
 int BdptEstimator<Mis, H, A, MaxDepth, Ch>::walk(const Sc& sc, VertexT<Sc>* path, int count, int max_vertices,
                                                  Ray ray, int medium, float pdf_dir, typename Sc::Spectrum beta,
                                                  const typename Sc::Spectral::Wavelengths& lambda, int channel, R& rng,
                                                  C& counter, OnHit on_hit, Status& status, const EqRegion* eq,
-                                                 bool camera_side, OnEmission on_emission,
-                                                 OnSegment on_segment) const {
+                                                 bool camera_side, OnEmission on_emission, OnSegment on_segment,
+                                                 OnPiece on_piece, FirstSegment<Sc>* first) const {
     using namespace bdpt;
     using V = VertexT<Sc>;
     using S = typename Sc::Spectral;
@@ -798,6 +838,12 @@ int BdptEstimator<Mis, H, A, MaxDepth, Ch>::walk(const Sc& sc, VertexT<Sc>* path
         }
         V v;
         bool scattered = false;
+        // The segment technique's normaliser on this piece (0: it does not run here).
+        float along = 0.f;
+        (void)along;
+        if constexpr (!std::is_same_v<OnPiece, NoSegment>) {
+            if (sc.has_medium(medium)) along = on_piece(path, count, ray, medium, hit.t, pdf_dir, beta, nulls, gamma_here());
+        }
         if constexpr (kPerChannel) {
             if (sc.has_medium(medium)) {
                 const auto& m = sc.media[std::size_t(medium)];
@@ -808,7 +854,7 @@ int BdptEstimator<Mis, H, A, MaxDepth, Ch>::walk(const Sc& sc, VertexT<Sc>* path
                     m.medium, m.majorant, ray, hit.t, lambda, channel, st, false, rng, counter,
                     ChannelWalkVisit<Sc, OnEmission>{{&piece_nulls, &last_null, &last_event, &pending},
                                                      &on_emission, path, count, medium, channel, ray, beta0, nulls,
-                                                     pdf_dir});
+                                                     pdf_dir, along});
                 if (const Status fs = flight_status(seg.end); fs != Status::Ok) {
                     status = fs;
                     return count;
@@ -816,6 +862,7 @@ int BdptEstimator<Mis, H, A, MaxDepth, Ch>::walk(const Sc& sc, VertexT<Sc>* path
                 if (seg.end != SegmentEnd::Scattered && seg.end != SegmentEnd::Passed) return count;  // absorbed, or no pdf left
                 if (seg.end == SegmentEnd::Passed && pending) piece_nulls *= last_null.template cast<double>();
                 nulls *= piece_nulls.template cast<float>();
+                if (first && count == 1 && crossings > 0) first->later_nulls *= piece_nulls.template cast<float>();
                 beta = beta0 * st.f / st.uni[channel];
                 if (seg.end == SegmentEnd::Scattered) {
                     scattered = true;
@@ -833,7 +880,7 @@ int BdptEstimator<Mis, H, A, MaxDepth, Ch>::walk(const Sc& sc, VertexT<Sc>* path
                 // throughput and null product of the nulls before it (THEORY 5.7).
                 seg = kernels_.track_visiting(
                     m.medium, m.majorant, ray, hit.t, lambda, rng, counter,
-                    EmissionVisitor<Sc, OnEmission>{on_emission, path, count, medium, ray, beta, nulls, pdf_dir});
+                    EmissionVisitor<Sc, OnEmission>{on_emission, path, count, medium, ray, beta, nulls, pdf_dir, along});
             } else {
                 seg = kernels_.track(m.medium, m.majorant, ray, hit.t, lambda, rng, counter);
             }
@@ -842,7 +889,10 @@ int BdptEstimator<Mis, H, A, MaxDepth, Ch>::walk(const Sc& sc, VertexT<Sc>* path
                 return count;
             }
             beta *= seg.weight;
-            if constexpr (Mis::null_pdfs) nulls *= seg.null_pdf_product;
+            if constexpr (Mis::null_pdfs) {
+                nulls *= seg.null_pdf_product;
+                if (first && count == 1 && crossings > 0) first->later_nulls *= seg.null_pdf_product;
+            }
             if (seg.end == SegmentEnd::Scattered) {
                 scattered = true;
                 v.kind = VertexKind::Medium;
@@ -912,6 +962,7 @@ int BdptEstimator<Mis, H, A, MaxDepth, Ch>::walk(const Sc& sc, VertexT<Sc>* path
         const float rev = next.delta ? next.pdf : detail::eval_vertex(sc, sv, -next.wi, -ray.d, lambda).pdf;
         const float g_rev = to_vertex_measure(rev, cur.p, prev);
         prev.pdf_rev = g_rev * nulls * prev.event;
+        if (first && count == 2) first->y0_reverse = g_rev;
         if (!camera_side && eq && count == 3 && prev.kind == VertexKind::Medium) {  // y_1, drawn from y_2
             const Vec3 d = prev.p - cur.p;
             const float len = glm::length(d);
@@ -960,6 +1011,7 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
     PathPdfsT pdfs;
     pdfs.light_tracing = kLightTracing;
     constexpr int kEq = PathPdfsT::kEquiangular;
+    constexpr int kSeg = PathPdfsT::kSegment;
     // The equiangular strategy: with null-scattering MIS (directional MIS has no distance pdfs to
     // weigh it against tracking by), the option on, a light with a target and a medium.
     EqRegion eq_region;
@@ -1011,6 +1063,16 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
     const float q_volume_share = has_volume ? (sc.lights.has_emitters() ? 0.5f : 1.f) : 0.f;
     const float q_volume = light_probability_ * q_volume_share;
     const float q_lights = light_probability_ * (1.f - q_volume_share);
+    // The segment technique (THEORY 5.7 in 5.5): with null-scattering MIS (directional MIS has no
+    // distance pdfs to weigh it against tracking by) in emitting media, the option on.
+    const bool seg_on = kEmissive && Mis::null_pdfs && kernels_.options().emission_along_segments;
+    const float seg_count = kernels_.options().emission_segment_count;
+    // Its density of x_0 = y drawn from x_1 on y's piece: the direction density at x_1 in y's
+    // measure (g), the nulls of the pieces before y's, p_V(y) / W with W the normaliser `along`.
+    auto seg_density = [&](float g, const P& nulls_before, float p_v, float along) -> P {
+        if (!seg_on) return broadcast<P>(0.f);
+        return nulls_before * (g * segment_density(kernels_.options(), p_v, along));
+    };
     const float nee_count = kernels_.options().nee_count;
     // A BdptRecorder (NeeCountLearner) sees every strategy's contribution with the path's pdfs
     // summed by count group: s = 0 (and NEE toward the volume, `volume_x0`) at count 1, NEE toward
@@ -1022,23 +1084,24 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
             const int n = strategy_count(p);
             double p_fixed = 0.0, p_nee = 0.0, p_light = 0.0, own = 0.0;
             auto add_group = [&](const double* q, double selection) {
-                p_fixed += selection * (q[0] + q[kMaxPath]);  // the equiangular strategy: count 1
+                // The equiangular strategy (count 1) and the segment technique (its own count).
+                p_fixed += selection * (q[0] + q[kEq] + q[kSeg]);
                 if (n > 1) (volume_x0 ? p_fixed : p_nee) += selection * q[1];
                 for (int r = 2; r < n; ++r) p_light += selection * q[r];
             };
             if constexpr (kPerChannel) {
                 constexpr int kChannels = int(Spectrum::SizeAtCompileTime);
-                double q[kChannels * (kMaxPath + 1)];
+                double q[kChannels * PathPdfsT::kSlots];
                 if (!channel_strategy_pdfs(p, q)) return;
-                for (int ch = 0; ch < kChannels; ++ch) add_group(q + ch * (kMaxPath + 1), 1.0 / kChannels);
-                own = q[p.channel * (kMaxPath + 1) + s];
+                for (int ch = 0; ch < kChannels; ++ch) add_group(q + ch * PathPdfsT::kSlots, 1.0 / kChannels);
+                own = q[p.channel * PathPdfsT::kSlots + s];
             } else {
-                double q[kMaxPath + 1];
+                double q[PathPdfsT::kSlots];
                 if (!strategy_pdfs(p, q)) return;
                 add_group(q, 1.0);
                 own = q[s];
             }
-            const BdptTechnique group = s == 0 || s == kEq ? BdptTechnique::Fixed
+            const BdptTechnique group = s == 0 || s == kEq || s == kSeg ? BdptTechnique::Fixed
                                         : s == 1 ? (volume_x0 ? BdptTechnique::Fixed : BdptTechnique::Nee)
                                                  : BdptTechnique::Light;
             detail::record_bdpt(counter, float(double(f.mean()) * own), float(p_fixed),
@@ -1053,7 +1116,8 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
                    bool volume_x0 = false) {
         const float w = weight_of(p, s);
         record(s, f, p, volume_x0, false);
-        const int sv = s == kEq ? 1 : s;  // the equiangular strategy's vertices are s = 1's
+        // The equiangular strategy's vertices are s = 1's, the segment technique's s = 0's.
+        const int sv = s == kEq ? 1 : s == kSeg ? 0 : s;
         observe(s, t, f, w, p,
                 PathVertices<typename Sc::Spectral, P>{light, sv, camera, sv == 0 ? t - 1 : t, x0, x0_at_infinity});
         L += f * w;
@@ -1068,6 +1132,7 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
     auto gather = [&](int s, int nz, int k) {
         pdfs.k = k;
         pdfs.eq = broadcast<P>(0.f);
+        pdfs.seg = broadcast<P>(0.f);
         pdfs.eq_nee = 0.f;
         for (int i = 0; i < s; ++i) {
             pdfs.from_light[i] = light[i].pdf_fwd;
@@ -1100,6 +1165,7 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
                 if constexpr (kPerChannel) pdfs.from_camera[0] = nulls;
                 else pdfs.from_camera[0] = 1.f;
                 pdfs.nee = pdfs.emit = 0.f;
+                pdfs.seg = broadcast<P>(0.f);
                 add(0, 2, f, pdfs, std::isfinite(dist) ? hit.p : z.p, !std::isfinite(dist));
                 return;
             }
@@ -1141,15 +1207,62 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
         }
     };
 
+    // The densities of the path made of the camera subpath camera[0..count-1] and x_0 = y in
+    // emitting medium `medium` (the collision estimator's and the segment technique's paths): y
+    // reached from x_1 = camera[count - 1] with direction density pdf_dir, `nulls` the P_n of
+    // the segment's nulls before y, `nulls_before` those of the pieces before y's, mu_bar the
+    // majorant at y, `along` the segment technique's W on y's piece, `gamma` (per channel) the
+    // shared factors up to y. False where y is x_1 itself (a flight of length 0: no direction).
+    auto emission_path_pdfs = [&](int count, int medium, const Vec3& y, const P& nulls, const P& mu_bar, float pdf_dir,
+                                  const P& nulls_before, float along, const auto& gamma) -> bool {
+        if constexpr (!kEmissive) {
+            (void)count, (void)medium, (void)y, (void)nulls, (void)mu_bar, (void)pdf_dir, (void)nulls_before,
+                (void)along, (void)gamma;
+            return false;
+        } else {
+            const float p_y = sc.media[std::size_t(medium)].medium.emission_pdf(y);
+            if constexpr (kPerChannel) pdfs.gamma = gamma;
+            else (void)gamma;
+            const int t = count + 1;
+            if (t == 2) {  // seen from the camera: the collision estimator and the segment technique
+                pdfs.k = 1;
+                // Relative to the camera's density of the ray and 1 / d^2, the same for both.
+                pdfs.from_camera[0] = nulls * mu_bar;
+                pdfs.nee = pdfs.emit = 0.f;
+                pdfs.seg = seg_density(1.f, nulls_before, p_y, along);
+                return true;
+            }
+            const V& z = camera[count - 1];  // x_1
+            const Vec3 d = y - z.p;
+            const float d2 = glm::dot(d, d);
+            if (!(d2 > 0.f)) return false;
+            gather(0, t - 1, t - 1);
+            const float p_v = sc.emission_selection_pdf(medium) * p_y;
+            pdfs.from_camera[0] = pdf_dir / d2 * nulls * mu_bar;
+            pdfs.seg = seg_density(pdf_dir / d2, nulls_before, p_y, along);
+            pdfs.nee = p_v;
+            pdfs.emit = q_volume * p_v;
+            pdfs.from_light[1] = to_vertex_measure(kInv4Pi, y, z) * nulls * z.event;
+            if (t >= 4) {
+                const V& z2 = camera[count - 2];  // x_2
+                const float pd = z.delta ? 1.f : eval_at(z, -(d / std::sqrt(d2)), -z.wo).pdf;
+                pdfs.from_light[2] = to_vertex_measure(pd, z.p, z2) * z.nulls_in * z2.event;
+            }
+            return true;
+        }
+    };
+
     // s = 0 in an emissive medium: the camera subpath's tentative collision at y, after
     // camera[0..count-1], collects mu_a L_e / mu_bar (the collision estimator); as a path ending
     // at y its camera-side density is the direction pdf / d^2 x the nulls' P_n x mu_bar(y).
     // `mu_bar` the majorant at y (per channel: every channel's), `mu_sample` the sampling
     // channel's, `beta` the throughput up to y over the density of reaching it, `gamma` (per
-    // channel) the shared factors up to y.
+    // channel) the shared factors up to y, `nulls_before` the nulls' P_n on the segment's pieces
+    // before y's and `along` the segment technique's normaliser on y's piece.
     auto on_camera_emission = [&](const V* path, int count, int medium, const Vec3& y,
                                   const Coefficients<typename Sc::Spectral>& c, const P& mu_bar, float mu_sample,
-                                  const Spectrum& beta, const P& nulls, float pdf_dir, const auto& gamma) {
+                                  const Spectrum& beta, const P& nulls, float pdf_dir, const auto& gamma,
+                                  const P& nulls_before, float along) {
         if constexpr (kEmissive) {
             const int t = count + 1;
             if (t - 2 > depth || !(c.sigma_a > 0.f).any() || !(mu_sample > 0.f)) return;
@@ -1157,36 +1270,12 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
             const Spectrum le = m.emission(y, lambda);
             if (!(le > 0.f).any()) return;
             const Spectrum f = beta * c.sigma_a * le / mu_sample;
-            if constexpr (kPerChannel) pdfs.gamma = gamma;
-            else (void)gamma;
-            if (t == 2) {  // seen from the camera: the only strategy
-                pdfs.k = 1;
-                // Per channel its nulls' P_n,c and mu_bar_c(y) still weigh the channels.
-                if constexpr (kPerChannel) pdfs.from_camera[0] = nulls * mu_bar;
-                else pdfs.from_camera[0] = 1.f;
-                pdfs.nee = pdfs.emit = 0.f;
-                add(0, 2, f, pdfs, y, false, true);
-                return;
-            }
-            const V& z = path[count - 1];  // x_1
-            gather(0, t - 1, t - 1);
-            const Vec3 d = y - z.p;
-            const float d2 = glm::dot(d, d);
-            if (!(d2 > 0.f)) return;  // a collision at the segment's origin (a flight of length 0): no direction
-            const float p_v = sc.emission_selection_pdf(medium) * m.emission_pdf(y);
-            pdfs.from_camera[0] = pdf_dir / d2 * nulls * mu_bar;
-            pdfs.nee = p_v;
-            pdfs.emit = q_volume * p_v;
-            pdfs.from_light[1] = to_vertex_measure(kInv4Pi, y, z) * nulls * z.event;
-            if (t >= 4) {
-                const V& z2 = camera[t - 3];  // x_2
-                const float pd = z.delta ? 1.f : eval_at(z, -(d / std::sqrt(d2)), -z.wo).pdf;
-                pdfs.from_light[2] = to_vertex_measure(pd, z.p, z2) * z.nulls_in * z2.event;
-            }
-            add(0, t, f, pdfs, y, false, true);
+            (void)path;  // camera[], which emission_path_pdfs reads
+            if (emission_path_pdfs(count, medium, y, nulls, mu_bar, pdf_dir, nulls_before, along, gamma))
+                add(0, t, f, pdfs, y, false, true);
         } else {
             (void)path, (void)count, (void)medium, (void)y, (void)c, (void)mu_bar, (void)mu_sample, (void)beta,
-                (void)nulls, (void)pdf_dir, (void)gamma;
+                (void)nulls, (void)pdf_dir, (void)gamma, (void)nulls_before, (void)along;
         }
     };
 
@@ -1335,6 +1424,52 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
         if constexpr (kPerChannel) x.gamma = path_gamma(z.gamma, sh.gamma);
         if ((x.beta != 0.f).any()) next_event(t, true);
     };
+    // The segment technique on a camera segment's piece in emitting medium `medium` (from
+    // z = path[count - 1] along `ray` up to t_max; `pdf_dir` z's direction density, `beta` the
+    // throughput at the piece's start, `nulls_before` the P_n of the segment's nulls before it,
+    // `gamma` the shared factors up to it): x_0 drawn in proportion to the medium's power grid
+    // along the piece (with the count EstimatorOptions::emission_segment_count), the nulls before
+    // it ratio-tracked, mu_a L_e collected there. Returns the piece's normaliser W, which the
+    // collision estimator's weights on the piece need (0: the technique does not run).
+    auto on_camera_piece = [&](V* path, int count, const Ray& ray, int medium, float t_max, float pdf_dir,
+                               const Spectrum& beta, const P& nulls_before, const auto& gamma) -> float {
+        if constexpr (kEmissive) {
+            (void)path;  // camera[], which emission_path_pdfs reads
+            const int t = count + 1;
+            if (!seg_on || t - 2 > depth) return 0.f;
+            const auto& m = sc.media[std::size_t(medium)];
+            const float along = m.medium.emission_along(ray, 0.f, t_max);
+            if (!(along > 0.f) || !draw_technique(seg_count, rng)) return along;
+            // Its work is a fixed technique's to the learner: it runs whatever the learned counts.
+            const double before = detail::recorder_work(counter);
+            const DistanceSample ds = m.medium.sample_emission_along(ray, 0.f, t_max, along, rng.uniform());
+            if (!(ds.pdf > 0.f && ds.t > 0.f)) return along;
+            const Shadow sh = shadow(ray, ds.t, medium);
+            if (sh.status != Status::Ok) status = sh.status;
+            const auto c = sh.status == Status::Ok && (sh.tr != 0.f).any()
+                               ? lookup_untracked(m.medium, m.majorant, ray, ds.t, lambda, counter)
+                               : std::nullopt;
+            detail::record_shadow_walk(counter, before, false);
+            if (sh.status != Status::Ok || !(sh.tr != 0.f).any()) return along;
+            if (!c) {
+                status = Status::Rejected;
+                return along;
+            }
+            if (!(c->k.sigma_a > 0.f).any()) return along;
+            const Vec3 y = ray.at(ds.t);
+            const Spectrum le = m.medium.emission(y, lambda);
+            if (!(le > 0.f).any()) return along;
+            const Spectrum f = beta * sh.tr * c->k.sigma_a * le / (seg_count * ds.pdf);
+            if (emission_path_pdfs(count, medium, y, P(nulls_before * sh.nulls), majorants<P>(c->mu), pdf_dir,
+                                   nulls_before, along, path_gamma(gamma, sh.gamma)))
+                add(kSeg, t, f, pdfs, y, false, true);
+            return along;
+        } else {
+            (void)path, (void)count, (void)ray, (void)medium, (void)t_max, (void)pdf_dir, (void)beta,
+                (void)nulls_before, (void)gamma;
+            return 0.f;
+        }
+    };
     // The camera subpath.
     camera[0] = V{};
     camera[0].kind = VertexKind::Camera;
@@ -1347,7 +1482,8 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
     int nc = 0;
     if constexpr (kEmissive)
         nc = walk(sc, camera, 1, depth + 2, camera_ray, sc.camera_medium, camera_pdf, Spectrum::Ones(), lambda, channel,
-                  rng, counter, on_camera_hit, status, eq, true, on_camera_emission, on_camera_segment);
+                  rng, counter, on_camera_hit, status, eq, true, on_camera_emission, on_camera_segment,
+                  on_camera_piece);
     else
         nc = walk(sc, camera, 1, depth + 2, camera_ray, sc.camera_medium, camera_pdf, Spectrum::Ones(), lambda, channel,
                   rng, counter, on_camera_hit, status, eq, true, NoEmission{}, on_camera_segment);
@@ -1358,6 +1494,10 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
     float eq_nee_y0 = 0.f;      // the same without the count (the equiangular strategy's; 0 in the volume)
     float emit_y0 = 0.f;        // the light subpath's density of y_0
     bool volume_start = true;  // y_0 lies in the emitting volume (else on a light)
+    // The segment technique's density of y_0 (in the volume) drawn from y_1, without y_1's
+    // direction density (which depends on where x_2 is), and y_1's from y_2 (s >= 3).
+    P seg_y0_unit = broadcast<P>(0.f);
+    FirstSegment<Sc> first_segment;
     const int light_vertices = kLightTracing ? depth + 1 : depth;
     const bool traced = draw_technique(light_probability_, rng);
     const double light_work_before = detail::recorder_work(counter);
@@ -1395,8 +1535,24 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
                             y0.beta = source / emit_y0;
                             nl = walk(sc, light, 1, light_vertices, Ray{yv.p, w}, i, kInv4Pi,
                                       Spectrum(y0.beta * (4.f * kPi)), lambda, channel, rng, counter,
-                                      [](auto&&...) {}, status, eq, false);
+                                      [](auto&&...) {}, status, eq, false, NoEmission{}, NoSegment{}, NoSegment{},
+                                      seg_on ? &first_segment : nullptr);
                             nee_y0 = select * yv.pdf;
+                            if (seg_on && nl >= 2) {
+                                // y_0's piece seen from y_1: from the last surface between them
+                                // (else y_1) through y_0 to the first surface beyond it.
+                                const float dist = glm::length(light[1].p - yv.p);
+                                const SurfaceHit ahead = sc.geometry.intersect(Ray{yv.p, w}, dist);
+                                const SurfaceHit behind = sc.geometry.intersect(Ray{yv.p, -w}, kInf);
+                                if (!detail::usable_hit(sc, ahead) || !detail::usable_hit(sc, behind)) {
+                                    status = Status::InvalidInput;
+                                } else {
+                                    const float a = ahead.found() ? std::min(ahead.t, dist) : dist;
+                                    const float b = behind.found() ? behind.t : kInf;
+                                    const float along = m.medium.emission_along(Ray{yv.p + a * w, -w}, 0.f, a + b);
+                                    seg_y0_unit = seg_density(1.f, first_segment.later_nulls, yv.pdf, along);
+                                }
+                            }
                         }
                     }
                 }
@@ -1440,23 +1596,27 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
 
     // A shadow ray toward a point drawn in emitting medium `target` (NEE toward the volume): its
     // throughput, nulls and shared factors as `shadow`'s, whether it reached the point inside
-    // `target`, and the point's piece (the point is last.at(t_last)).
+    // `target`, the point's piece (the point is last.at(t_last)) and, with the segment technique
+    // on, the P_n of the nulls on the pieces before the point's and the technique's normaliser W
+    // on the point's piece.
     struct EmissionShadowT {
         Status status = Status::Ok;
         bool reached = false;
         Spectrum tr = Spectrum::Zero();
         P nulls = broadcast<P>(1.f);
+        P nulls_before = broadcast<P>(1.f);
         GammaT gamma = unit_gamma<P>();
         Ray last{};
         float t_last = 0.f;
+        float along = 0.f;
     };
     auto shadow_to_emission = [&](const Ray& r, float distance, int start, int target) {
         EmissionShadowT out;
         if constexpr (!kEmissive) {
             (void)r, (void)distance, (void)start, (void)target;
         } else if constexpr (kPerChannel) {
-            const auto sh = detail::channel_emission_shadow<Ch, A>(sc, r, distance, start, target, false, lambda, channel,
-                                                                   Spectrum::Ones(), rng, counter);
+            const auto sh = detail::channel_emission_shadow<Ch, A>(sc, r, distance, start, target, seg_on, lambda,
+                                                                   channel, Spectrum::Ones(), rng, counter);
             if (sh.end != SegmentEnd::Passed) {
                 out.status = detail::shadow_status(sh.end);
                 return out;
@@ -1465,18 +1625,23 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
             out.reached = true;
             out.tr = sh.f / sh.nee[channel];
             out.nulls = (sh.nee > 0.f).select(sh.uni / sh.nee, 0.f);
+            // sh.seg is uni of the pieces before the point's times nee of its own.
+            out.nulls_before = (sh.nee > 0.f).select(sh.seg / sh.nee, 0.f);
             out.gamma = relative_to_largest<Spectrum>(sh.nee);
             out.last = sh.last;
             out.t_last = sh.t_last;
+            out.along = sh.along;
         } else {
-            const auto sh = detail::emission_shadow(kernels_, sc, r, distance, start, target, false, lambda, rng, counter);
+            const auto sh = detail::emission_shadow(kernels_, sc, r, distance, start, target, seg_on, lambda, rng, counter);
             out.status = sh.status;
             if (sh.status != Status::Ok) return out;
             out.reached = sh.reached;
             out.tr = sh.transmittance;
             out.nulls = Mis::null_pdfs ? sh.nulls_before * sh.nulls_own : 1.f;
+            out.nulls_before = Mis::null_pdfs ? sh.nulls_before : 1.f;
             out.last = sh.last;
             out.t_last = sh.t_last;
+            out.along = sh.along;
         }
         return out;
     };
@@ -1528,6 +1693,7 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
                                 gather(0, t, t);  // camera[0..t-1]; the emission point is x_0
                                 if constexpr (kPerChannel) pdfs.gamma = path_gamma(z.gamma, sh.gamma);
                                 pdfs.from_camera[0] = fz.pdf / e->dist2 * nulls * majorants<P>(c->mu);
+                                pdfs.seg = seg_density(fz.pdf / e->dist2, sh.nulls_before, e->y.pdf, sh.along);
                                 pdfs.nee = p_v;
                                 pdfs.emit = q_volume * p_v;
                                 pdfs.from_light[1] = to_vertex_measure(kInv4Pi, e->y.p, z) * nulls * z.event;
@@ -1578,6 +1744,9 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
             // or y_2 as its light subpath stored).
             pdfs.eq_nee = eq_nee_y0;
             pdfs.eq = s == 2 ? eq_from(z.p, fz.pdf, y) : s == 3 ? eq_from(y.p, pd_y2, y2) : light[1].eq;
+            // x_0 = y_0 as the segment technique draws it from x_1 = y_1, arriving there from x_2
+            // (z, or y_2 as the light subpath drew it).
+            pdfs.seg = seg_y0_unit * (s == 2 ? to_vertex_measure(pd_y2, y.p, y2) : first_segment.y0_reverse);
             add(s, t, f, pdfs, light[0].p, light[0].at_infinity, volume_start);
         }
     }
@@ -1613,6 +1782,7 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
             pdfs.from_camera[s - 2] = to_vertex_measure(pd_y2, y.p, y2) * y.nulls_in * y2.event;
             pdfs.eq_nee = eq_nee_y0;
             pdfs.eq = s == 2 ? eq_from(eye, pc, y) : s == 3 ? eq_from(y.p, pd_y2, y2) : light[1].eq;
+            pdfs.seg = seg_y0_unit * (s == 2 ? to_vertex_measure(pd_y2, y.p, y2) : first_segment.y0_reverse);
             const float wt = weight_of(pdfs, s);
             record(s, f, pdfs, volume_start, true);
             observe(s, 1, f, wt, pdfs,

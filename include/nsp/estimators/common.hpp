@@ -90,6 +90,9 @@ struct EstimatorOptions {
     /// the nulls before it ratio-tracked), combined with the collision estimator and NEE toward
     /// the volume by MIS. It is the only sampling technique for the emission a camera ray sees
     /// directly. Off: collisions and NEE only. No effect on other media or strategies.
+    /// nsp::BdptEstimator<bdpt::NullScattering> (grey and per channel) draws it on every piece of
+    /// a camera segment in an emitting medium, one more strategy among the (s, t) ones (THEORY 5.7
+    /// in 5.5); directional MIS leaves it out.
     bool emission_along_segments = true;
     /// The expected count of the segment technique on each segment, in (0, 1] (THEORY 5.9,
     /// counts.hpp; with emission_along_segments on): it runs on a segment with this probability,
@@ -97,7 +100,8 @@ struct EstimatorOptions {
     /// segment. Below 1 it saves the technique's flight and lookup where the collision estimator
     /// and NEE find the emission well; the power grid's walk along the segment stays (the other
     /// techniques' weights need W). nsp::PathEstimator and nsp::SpectralPathEstimator, media and
-    /// surfaces; nsp::BdptEstimator rejects a value other than 1.
+    /// surfaces, and nsp::BdptEstimator (on the camera segments' pieces; NeeCountLearner does
+    /// not learn it there).
     float emission_segment_count = 1.f;
     /// The expected count of NEE toward the lights at each real vertex, in (0, 1] (THEORY 5.9,
     /// counts.hpp): NEE runs there with this probability, its estimate divided by it, and the MIS
