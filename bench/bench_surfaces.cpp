@@ -16,6 +16,10 @@
 //   SurfaceScene through its camera: uni + NEE + equiangular MIS against BDPT with light tracing,
 //   with its equiangular strategy and without; for BDPT the equiangular strategy's contributions
 //   per sample.
+// - BM_FlameSmoke/<estimator>: the same for nsp_render's P1 (a flame in smoke, no other light;
+//   Rgb): uni + NEE MIS (with the emission segment technique) against BDPT with light tracing,
+//   with its segment technique and without; for BDPT the segment technique's contributions per
+//   sample.
 // - BM_ChromaticRoom/<estimator>: one sample of the room around the chromatic cloud (Rgb,
 //   extinction 5, 20 and 80 per unit density: nsp_room's second table), spectral MIS + NEE and
 //   per-channel BDPT under per-channel majorants, grey BDPT under the grey one; the BDPT rows with
@@ -214,32 +218,22 @@ BENCHMARK_TEMPLATE(BM_Lantern, nsp::BdptEstimator<nsp::bdpt::NullScattering>)->N
 BENCHMARK_TEMPLATE(BM_Lantern, nsp::BdptEstimator<nsp::bdpt::NullScattering>, true)
     ->Name("BM_Lantern/bdpt-null-mis:balance+light-tracing");
 
-/// nsp_render's F2 as a SurfaceScene (see the header); BDPT with its equiangular strategy when
-/// kEquiangular.
-template <class E, bool kEquiangular = true>
-void BM_FogLamp(benchmark::State& state) {
-    static const auto scene = [] {
-        const nsp_examples::SceneChoice c{nsp_examples::SceneKind::Fog, {}, {}, nsp_examples::FogSetup::F2};
-        auto medium = nsp_examples::DenseGridCloud::make<nsp::Mono>(c);
-        const auto majorant = nsp_examples::GridMajorantPolicy<>::make(medium, nsp_examples::MajorantSettings{});
-        return nsp_examples::make_empty_space_scene(std::move(medium), majorant, nsp_examples::phase_g(c.kind),
-                                                    nsp_examples::scene_lights<nsp::Mono>(c));
-    }();
+/// One sample per iteration of `scene` at image_points() through nsp_render's camera: BDPT's with
+/// light tracing (its splats summed), a path tracer's camera ray; BDPT's contributions of the
+/// strategy `strategy(pdfs)` names are reported per sample as `name`.
+template <class E, class Scene, class Strategy>
+void pinhole_samples(benchmark::State& state, const Scene& scene, const E& estimator, Strategy strategy,
+                     const char* name) {
     static const nsp::PinholeCamera camera = nsp_examples::cloud_pinhole();
-    const E estimator = [] {
-        nsp::EstimatorOptions o = nsp::BdptEstimator<>::default_options();  // every row at BDPT's 32 vertices, as nsp_room's
-        if constexpr (requires { E::kMaxPath; }) o.bdpt_equiangular = kEquiangular;
-        return E(o);
-    }();
     nsp::Pcg32 rng(6, 66);
     nsp::LookupCount counter;
-    double equiangular = 0;
+    double counted = 0;
     std::size_t i = 0;
     const auto& uv = image_points();
     for (auto _ : state) {
         if constexpr (requires { E::kMaxPath; }) {
             auto count = [&](int s, int, const auto&, float, const auto& pdfs, const auto&) {
-                if (s == std::remove_cvref_t<decltype(pdfs)>::kEquiangular) equiangular += 1.0;
+                if (s == strategy(pdfs)) counted += 1.0;
             };
             double sink = 0.0;
             auto splat = [&](float, float, const auto& value) { sink += double(value[0]); };
@@ -253,7 +247,45 @@ void BM_FogLamp(benchmark::State& state) {
         i = (i + 1) & kSetMask;
     }
     report_lookups(state, counter, "lookups/sample");
-    if constexpr (requires { E::kMaxPath; }) state.counters["equiangular/sample"] = equiangular / double(state.iterations());
+    if constexpr (requires { E::kMaxPath; }) state.counters[name] = counted / double(state.iterations());
+}
+
+/// Every row's options: BDPT's 32 real vertices, as nsp_room's; `set` changes them for BDPT.
+template <class E, class Set>
+E with_bdpt_depth(Set set) {
+    nsp::EstimatorOptions o = nsp::BdptEstimator<>::default_options();
+    if constexpr (requires { E::kMaxPath; }) set(o);
+    return E(o);
+}
+
+/// nsp_render's F2 as a SurfaceScene (see the header); BDPT with its equiangular strategy when
+/// kEquiangular.
+template <class E, bool kEquiangular = true>
+void BM_FogLamp(benchmark::State& state) {
+    static const auto scene = [] {
+        const nsp_examples::SceneChoice c{nsp_examples::SceneKind::Fog, {}, {}, nsp_examples::FogSetup::F2};
+        auto medium = nsp_examples::DenseGridCloud::make<nsp::Mono>(c);
+        const auto majorant = nsp_examples::GridMajorantPolicy<>::make(medium, nsp_examples::MajorantSettings{});
+        return nsp_examples::make_empty_space_scene(std::move(medium), majorant, nsp_examples::phase_g(c.kind),
+                                                    nsp_examples::scene_lights<nsp::Mono>(c));
+    }();
+    const E estimator = with_bdpt_depth<E>([](nsp::EstimatorOptions& o) { o.bdpt_equiangular = kEquiangular; });
+    pinhole_samples(state, scene, estimator, [](const auto& pdfs) { return pdfs.kEquiangular; }, "equiangular/sample");
+}
+
+/// nsp_render's P1 (the flame in the smoke, no other light; Rgb, 16^3 grid majorant) as a
+/// SurfaceScene, as nsp_room renders it; BDPT with its segment technique when kSegment.
+template <class E, bool kSegment = true>
+void BM_FlameSmoke(benchmark::State& state) {
+    static const auto scene = [] {
+        const nsp_examples::SceneChoice c{nsp_examples::SceneKind::Plume};
+        auto medium = nsp_examples::EmissivePlume::make<nsp::Rgb>(c);
+        const auto majorant = nsp_examples::GridMajorantPolicy<>::make(medium, nsp_examples::MajorantSettings{});
+        return nsp_examples::make_empty_space_scene(std::move(medium), majorant, nsp_examples::phase_g(c.kind),
+                                                    nsp_examples::scene_lights<nsp::Rgb>(c));
+    }();
+    const E estimator = with_bdpt_depth<E>([](nsp::EstimatorOptions& o) { o.emission_along_segments = kSegment; });
+    pinhole_samples(state, scene, estimator, [](const auto& pdfs) { return pdfs.kSegment; }, "segment/sample");
 }
 
 BENCHMARK_TEMPLATE(BM_FogLamp, nsp::PathEstimator<nsp::strategy::EquiangularMis, nsp::mis::Balance>)
@@ -262,6 +294,11 @@ BENCHMARK_TEMPLATE(BM_FogLamp, nsp::BdptEstimator<nsp::bdpt::NullScattering>, fa
     ->Name("BM_FogLamp/bdpt-null-mis:balance+light-tracing");
 BENCHMARK_TEMPLATE(BM_FogLamp, nsp::BdptEstimator<nsp::bdpt::NullScattering>, true)
     ->Name("BM_FogLamp/bdpt-null-mis:balance+light-tracing+equiangular");
+BENCHMARK_TEMPLATE(BM_FlameSmoke, Nsmis)->Name("BM_FlameSmoke/uni-nee-mis:balance");
+BENCHMARK_TEMPLATE(BM_FlameSmoke, nsp::BdptEstimator<nsp::bdpt::NullScattering>, false)
+    ->Name("BM_FlameSmoke/bdpt-null-mis:balance+light-tracing");
+BENCHMARK_TEMPLATE(BM_FlameSmoke, nsp::BdptEstimator<nsp::bdpt::NullScattering>, true)
+    ->Name("BM_FlameSmoke/bdpt-null-mis:balance+light-tracing+segment");
 BENCHMARK_TEMPLATE(BM_CloudUnderSky_Scene, Uni)->Name("BM_CloudUnderSky/Scene/unidirectional");
 BENCHMARK_TEMPLATE(BM_CloudUnderSky_NoSurfaces, Uni)->Name("BM_CloudUnderSky/NoSurfaces/unidirectional");
 BENCHMARK_TEMPLATE(BM_CloudUnderSky_Scene, Nsmis)->Name("BM_CloudUnderSky/Scene/uni-nee-mis:balance");

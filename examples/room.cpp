@@ -278,6 +278,12 @@ int main(int argc, char** argv) {
         run(plume_room, PathEstimator<strategy::EquiangularMis, mis::Balance>{}, "equiangular-mis_balance");
         run_splatting(plume_room, BdptEstimator<bdpt::NullScattering, mis::Balance>{}, "bdpt_null-mis_balance");
         learned_path_render(plume_room);  // plume_rows[5]
+        {  // plume_rows[6]: BDPT without its emission segment technique
+            EstimatorOptions no_seg = BdptEstimator<>::default_options();
+            no_seg.emission_along_segments = false;
+            run_splatting(plume_room, BdptEstimator<bdpt::NullScattering, mis::Balance>(no_seg),
+                          "bdpt_null-mis_balance_no-seg");
+        }
         std::vector<Row> plume_rows(rows.begin() + std::ptrdiff_t(first_plume), rows.end());
         failed += print_table("Room, glowing plume (mono", plume_rows, 2, run_res, run_spp, threads);
         std::printf("room plume: uni-nee-mis_balance / best single strategy (%s) in cpu-s*var: %.3g\n",
@@ -285,9 +291,11 @@ int main(int argc, char** argv) {
                     cost(plume_rows, 2) / std::min(cost(plume_rows, 0), cost(plume_rows, 1)));
         std::printf("room plume: uni-nee-mis_balance_learned / best single strategy in cpu-s*var: %.3g\n",
                     cost(plume_rows, 5) / std::min(cost(plume_rows, 0), cost(plume_rows, 1)));
-        std::printf("room plume: bdpt_null-mis_balance / best path tracer in cpu-s*var: %.3g\n",
-                    cost(plume_rows, 4) / std::min({cost(plume_rows, 0), cost(plume_rows, 1), cost(plume_rows, 2),
-                                                    cost(plume_rows, 3), cost(plume_rows, 5)}));
+        const double best_path = std::min({cost(plume_rows, 0), cost(plume_rows, 1), cost(plume_rows, 2),
+                                           cost(plume_rows, 3), cost(plume_rows, 5)});
+        std::printf("room plume: bdpt_null-mis_balance / best path tracer in cpu-s*var: %.3g; without the segment "
+                    "technique: %.3g\n",
+                    cost(plume_rows, 4) / best_path, cost(plume_rows, 6) / best_path);
         print_notes();
     }
     // Table 4: the lantern (the BDPT scene): the lamp shut in a box that opens into the cloud,
@@ -452,7 +460,8 @@ int main(int argc, char** argv) {
         };
         // The grey pdfs' rows of scene `sc`: the path tracers (with the equiangular one when
         // `equiangular`), BDPT, BDPT learned (and then, where a point light gives BDPT its
-        // equiangular strategy, BDPT without it).
+        // equiangular strategy, BDPT without it; where an emitting medium gives BDPT its segment
+        // technique, BDPT without that).
         auto grey_rows = [&](const auto& sc, const SceneChoice& c, const char* mode, auto equiangular,
                              float fixed_light = 0.f) {
             const std::size_t from = rows.size();
@@ -463,18 +472,23 @@ int main(int argc, char** argv) {
                 pinhole_render(sc, camera, PathEstimator<strategy::EquiangularMis, mis::Balance>(depth), "uni-nee-eq-mis_balance");
             pinhole_render(sc, camera, BdptEstimator<bdpt::NullScattering, mis::Balance>{}, "bdpt_null-mis_balance");
             learned_render(sc, camera, "bdpt_null-mis_balance_learned", bdpt::Grey{});
-            // BDPT without its equiangular strategy, where it has one (a point light).
+            // BDPT with one of its strategies off (`off` clears its option), on the seed the next
+            // row takes too: the rows after it keep the seeds they had before it.
+            auto without = [&](auto off, const char* name) {
+                EstimatorOptions o = depth;
+                off(o);
+                const std::uint64_t next = seed;
+                pinhole_render(sc, camera, BdptEstimator<bdpt::NullScattering, mis::Balance>(o), name);
+                seed = next;
+            };
+            // Without its equiangular strategy, where it has one (a point light).
             bool point_light = false;
             for (int k = 0; k < sc.lights.equiangular_count(); ++k) point_light = point_light || sc.lights.equiangular_is_delta(k);
-            // (On the seed the next row takes too: the rows after it keep the seeds they had before it.)
-            if (point_light) {
-                EstimatorOptions no_eq = depth;
-                no_eq.bdpt_equiangular = false;
-                const std::uint64_t next = seed;
-                pinhole_render(sc, camera, BdptEstimator<bdpt::NullScattering, mis::Balance>(no_eq),
-                               "bdpt_null-mis_balance_no-eq");
-                seed = next;
-            }
+            if (point_light)
+                without([](EstimatorOptions& o) { o.bdpt_equiangular = false; }, "bdpt_null-mis_balance_no-eq");
+            // Without its segment technique, where it has one (an emitting medium).
+            if constexpr (nsp::EmissiveMedium<typename std::remove_cvref_t<decltype(sc)>::MediumType>)
+                without([](EstimatorOptions& o) { o.emission_along_segments = false; }, "bdpt_null-mis_balance_no-seg");
             if (fixed_light > 0.f) {  // a fixed light subpath probability, after the learned row
                 const std::string name = "bdpt_null-mis_balance_light-1/" + std::to_string(int(std::lround(1.f / fixed_light)));
                 pinhole_render(sc, camera,
