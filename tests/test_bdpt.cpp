@@ -316,7 +316,7 @@ StrategyRecord record_strategies(const E& est, const Scene& sc, int n_samples, i
         const float u = rng.uniform(), v = rng.uniform();
         const auto r = est.sample_observed(sc, camera, u, v, {}, rng, counter, splat, observe);
         REQUIRE(r.status == Status::Ok);
-        for (int n = 1; n <= longest; ++n) {
+        for (int n = 0; n <= longest; ++n) {
             const auto keys = rec.strategies(n);
             for (const auto& key : keys) {
                 rec.alone[key].add(value.count(key) ? value[key] : 0.0);
@@ -333,11 +333,11 @@ StrategyRecord record_strategies(const E& est, const Scene& sc, int n_samples, i
     return rec;
 }
 
-/// The largest |E_s[p_o / sum p] - E_o[p_s / sum p]| over pairs of strategies of one path length,
-/// in combined standard errors.
+/// The largest |E_s[p_o / sum p] - E_o[p_s / sum p]| over pairs of strategies of one path length
+/// (n = 0 too: the camera sees x_0), in combined standard errors.
 double worst_share_asymmetry(StrategyRecord& rec, int longest) {
     double worst = 0.0;
-    for (int n = 1; n <= longest; ++n) {
+    for (int n = 0; n <= longest; ++n) {
         const auto keys = rec.strategies(n);
         for (std::size_t i = 0; i < keys.size(); ++i)
             for (std::size_t j = i + 1; j < keys.size(); ++j) {
@@ -366,7 +366,7 @@ EstimatorOptions strategy_test_options() {
     return opts;
 }
 
-/// The two checks on a record of paths of 1..3 interior vertices (see the test below): every
+/// The two checks on a record of paths of 0..3 interior vertices (see the test below): every
 /// (s, t) alone against NEE's estimate of the same path length, and the pdf symmetry over every
 /// pair of strategies, both within 5 combined SE. `hittable`: the lights can be hit (s = 0 draws
 /// paths); else s = 0 must contribute exactly nothing. `equiangular`, `segment`: the scene has a
@@ -405,11 +405,12 @@ void check_strategies_alone_and_symmetric(StrategyRecord& rec, bool hittable = t
         CHECK(std::abs(eq.mean - nee_medium.mean) <= kSigmas * std::sqrt(eq.se() * eq.se() + nee_medium.se() * nee_medium.se()));
     }
     // The segment technique draws every path whose x_0 lies in an emitting medium: its estimate
-    // alone against NEE's over those paths (NEE toward the volume), 5 combined SE; without
-    // emission, nothing.
-    for (int n = 1; n <= 3; ++n) {
+    // alone against NEE's over those paths (NEE toward the volume), 5 combined SE; seen from the
+    // camera (no interior vertex, n = 0), against the collision estimator's; without emission,
+    // nothing.
+    for (int n = 0; n <= 3; ++n) {
         const Stat& seg = rec.alone[{rec.seg, n + 2}];
-        const Stat& nee_volume = rec.alone_volume[{1, n + 1}];
+        const Stat& nee_volume = n == 0 ? rec.alone_volume[{0, 2}] : rec.alone_volume[{1, n + 1}];
         CAPTURE(n);
         CAPTURE(seg.mean);
         CAPTURE(nee_volume.mean);

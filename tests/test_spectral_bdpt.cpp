@@ -405,7 +405,7 @@ TEST_CASE("spectral bdpt: agrees with SpectralPathEstimator under a lamp and a s
     check_agrees_with_spectral_path(sc, 13);
 }
 
-/// Per channel and strategy (s, t) of paths of 1..3 interior vertices whose consecutive real
+/// Per channel and strategy (s, t) of paths of 0..3 interior vertices whose consecutive real
 /// vertices lie 0.3 apart: the strategy alone with MIS over channels only (f_lambda gamma_c* p_(s,c*)
 /// / sum_c q_c gamma_c p_(s,c), the one-sample estimate of s alone), the same over the paths whose
 /// x_1 is a medium vertex and x_0 a light's (outside the cube [-1, 1]^3), and for every other
@@ -503,7 +503,7 @@ ChannelStrategyRecord record_channel_strategies(const E& est, const Scene& sc, i
         const float u = rng.uniform(), v = rng.uniform();
         const auto r = est.sample_observed(sc, camera, u, v, Rgb::Wavelengths{}, rng, counter, splat, observe);
         REQUIRE(r.status == Status::Ok);
-        for (int n = 1; n <= 3; ++n) {
+        for (int n = 0; n <= 3; ++n) {
             const auto keys = rec.strategies(n);
             for (const auto& key : keys) {
                 rec.alone[key].add(value.count(key) ? value[key] : Spectrum(Spectrum::Zero()));
@@ -524,7 +524,7 @@ ChannelStrategyRecord record_channel_strategies(const E& est, const Scene& sc, i
     return rec;
 }
 
-/// The checks on a record of paths of 1..3 interior vertices (see the test below). `hittable`:
+/// The checks on a record of paths of 0..3 interior vertices (see the test below). `hittable`:
 /// the lights can be hit (s = 0 draws paths); else s = 0 must contribute exactly nothing.
 /// `equiangular`: the equiangular strategy draws every path whose x_1 is a medium vertex and x_0
 /// a light's (against NEE over those, 5 combined SE per channel); else it draws none.
@@ -581,9 +581,24 @@ void check_channel_strategies(ChannelStrategyRecord& rec, bool hittable = true, 
                   kSigmas * std::hypot(seg.ch[c].se(), nee_volume.ch[c].se()));
         }
     }
+    // Seen from the camera (no interior vertex): the segment technique alone against the
+    // collision estimator alone over the paths whose x_0 lies in the volume.
+    const SpecStat<Rgb>& seg0 = rec.alone[{rec.seg, 2}];
+    const SpecStat<Rgb>& collision0 = rec.alone_volume[{0, 2}];
+    for (int c = 0; c < 3; ++c) {
+        CAPTURE(c);
+        CAPTURE(seg0.ch[c].mean);
+        CAPTURE(collision0.ch[c].mean);
+        if (!segment) {
+            CHECK(seg0.ch[c].mean == 0.0);
+            continue;
+        }
+        CHECK(seg0.ch[c].mean > 0.0);
+        CHECK(std::abs(seg0.ch[c].mean - collision0.ch[c].mean) <= kSigmas * std::hypot(seg0.ch[c].se(), collision0.ch[c].se()));
+    }
     auto worst_asymmetry = [&rec](std::map<std::pair<int, int>, std::map<int, Stat>>& share) {
         double worst = 0.0;
-        for (int n = 1; n <= 3; ++n) {
+        for (int n = 0; n <= 3; ++n) {
             const auto keys = rec.strategies(n);
             for (std::size_t i = 0; i < keys.size(); ++i)
                 for (std::size_t j = i + 1; j < keys.size(); ++j) {
