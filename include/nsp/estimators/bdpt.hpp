@@ -769,10 +769,12 @@ private:
 
     /// What the segment technique needs of a light subpath's first segment, y_0 (in an emitting
     /// medium) to y_1: the P_n product of the nulls on its pieces after the first (y_0's own, seen
-    /// from y_1), and y_1's direction density toward y_0 (arriving from y_2) in y_0's measure.
+    /// from y_1), where that first piece ends (the first surface from y_0, kInf: none), and y_1's
+    /// direction density toward y_0 (arriving from y_2) in y_0's measure.
     template <class Sc>
     struct FirstSegment {
         bdpt::PdfType<Ch, typename Sc::Spectral> later_nulls = bdpt::broadcast<bdpt::PdfType<Ch, typename Sc::Spectral>>(1.f);
+        float first_piece_end = kInf;
         float y0_reverse = 0.f;
     };
 
@@ -836,6 +838,7 @@ int BdptEstimator<Mis, H, A, MaxDepth, Ch>::walk(const Sc& sc, VertexT<Sc>* path
             status = Status::InvalidInput;
             return count;
         }
+        if (first && count == 1 && crossings == 0) first->first_piece_end = hit.t;
         V v;
         bool scattered = false;
         // The segment technique's normaliser on this piece (0: it does not run here).
@@ -1540,14 +1543,14 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
                             nee_y0 = select * yv.pdf;
                             if (seg_on && nl >= 2) {
                                 // y_0's piece seen from y_1: from the last surface between them
-                                // (else y_1) through y_0 to the first surface beyond it.
+                                // (the walk's first piece's end, else y_1) through y_0 to the
+                                // first surface beyond it.
                                 const float dist = glm::length(light[1].p - yv.p);
-                                const SurfaceHit ahead = sc.geometry.intersect(Ray{yv.p, w}, dist);
                                 const SurfaceHit behind = sc.geometry.intersect(Ray{yv.p, -w}, kInf);
-                                if (!detail::usable_hit(sc, ahead) || !detail::usable_hit(sc, behind)) {
+                                if (!detail::usable_hit(sc, behind)) {
                                     status = Status::InvalidInput;
                                 } else {
-                                    const float a = ahead.found() ? std::min(ahead.t, dist) : dist;
+                                    const float a = std::min(first_segment.first_piece_end, dist);
                                     const float b = behind.found() ? behind.t : kInf;
                                     const float along = m.medium.emission_along(Ray{yv.p + a * w, -w}, 0.f, a + b);
                                     seg_y0_unit = seg_density(1.f, first_segment.later_nulls, yv.pdf, along);
