@@ -170,7 +170,9 @@ struct ChannelTrack {
 /// A visitor with `enabled` is called at every tentative collision before its event is chosen, as
 /// `visit(t, coefficients, mu, tbar, st)` with every channel's majorant, its Tbar since the last
 /// tentative collision (relative, as the state's; ones for a grey majorant) and the state before
-/// this collision (the collision estimator of emission, THEORY 5.7 with 5.3, uses it).
+/// this collision (the collision estimator of emission, THEORY 5.7 with 5.3, uses it); a visitor
+/// that also takes `const ChannelEventDensities<Spectrum>&` gets every channel's event densities
+/// there as a sixth argument (the ones the event is chosen by), so it need not form them again.
 template <ChannelPolicy CP, AbsorptionPolicy A, SpectralMode S, UniformRng R, class Rec, bool kEq = false,
           class Visit = NoVisit>
 struct ChannelDeltaCollision {
@@ -190,10 +192,6 @@ struct ChannelDeltaCollision {
         const Spec mu = detail::broadcast_majorant<Spec>(mu_v);
         Spec tb;  // every channel's Tbar since the last tentative collision (a grey one cancels)
         if constexpr (!grey) tb = detail::relative_transmittance(tau_v, c);
-        if constexpr (Visit::enabled) {
-            if constexpr (grey) visit(t, k, mu, Spec(Spec::Ones()), st);
-            else visit(t, k, mu, tb, st);
-        }
         // Every channel's density mu_bar_c P_x,c of each event: its own (own pdfs) or the one
         // shared by all channels (spectral tracking). The sampling channel's picks the event.
         ChannelEventDensities<Spec> d;
@@ -204,6 +202,16 @@ struct ChannelDeltaCollision {
                                 "(GlobalMajorant or GridMajorant)");
             const EventProbabilities p = shared_event_probabilities<A, CP::throughput_weighted, S>(k, mu_v, st.f);
             d = {Spec::Constant(mu_v * p.absorb), Spec::Constant(mu_v * p.scatter), Spec::Constant(mu_v * p.null)};
+        }
+        if constexpr (Visit::enabled) {
+            Spec tbv;
+            if constexpr (grey) tbv = Spec::Ones();
+            else tbv = tb;
+            if constexpr (std::is_invocable_v<Visit&, float, const Coefficients<S>&, const Spec&, const Spec&,
+                                              const ChannelPathState<S, kEq>&, const ChannelEventDensities<Spec>&>)
+                visit(t, k, mu, tbv, st, d);
+            else
+                visit(t, k, mu, tbv, st);
         }
         // mu_c* > 0: free flight samples nothing where it is 0. In double: a denormal mu_c* made
         // float's 1 / mu_c* overflow (found by the fuzzer).

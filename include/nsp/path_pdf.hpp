@@ -185,8 +185,10 @@ struct ChannelPathState {
     /// estimator discards the sample and reports it (Status::NonFinite), as it does a non-finite
     /// estimate. Under independent tracking only channel c counts; the others, never estimated,
     /// are zeroed where they overflowed. `Dead` (zeroed) when no positive pdf is left.
+    /// Always inlined: it runs at every tentative collision, and GCC left it out of line in
+    /// per-channel BDPT's tracking (BM_ChromaticSky: 5% faster inlined).
     template <ChannelPolicy CP>
-    StateScale renormalize(int c) noexcept {
+    [[gnu::always_inline]] inline StateScale renormalize(int c) noexcept {
         float k = CP::mis_over_channels ? std::max(uni.maxCoeff(), nee.maxCoeff()) : uni[c];
         if constexpr (kEquiangular)
             if (CP::mis_over_channels) k = std::max(k, std::max(eq.vertex.maxCoeff(), eq.nee.maxCoeff()));

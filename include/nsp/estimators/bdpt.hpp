@@ -670,13 +670,15 @@ private:
         detail::DoubleSpectrum<Spec>* nulls;  // the product of the nulls before the last collision
         Spec* last_null;                      // the last collision's P_n,c, should it be a null
         Spec* last_event;                     // its mu_bar_c P_s,c, should it scatter
+        Spec* last_tbar;                      // its Tbar_c since the collision before
         bool* pending;
         template <class State>
-        void operator()(float, const Coefficients<S>& k, const Spec& mu, const Spec&, const State&) const {
+        void operator()(float, const Coefficients<S>&, const Spec& mu, const Spec& tbar, const State&,
+                        const ChannelEventDensities<Spec>& d) const {
             if (*pending) *nulls *= last_null->template cast<double>();
-            const ChannelEventDensities<Spec> d = channel_event_densities<A, S>(k, mu);
             *last_null = (mu > 0.f).select(d.null / mu, 0.f);
             *last_event = d.scatter;
+            *last_tbar = tbar;
             *pending = true;
         }
     };
@@ -700,14 +702,15 @@ private:
         float pdf_dir;
         float along;  // the segment technique's normaliser on this piece (0: it does not run)
         template <class State>
-        void operator()(float t, const Coefficients<S>& k, const Spec& mu, const Spec& tbar, const State& st) const {
-            null_visit(t, k, mu, tbar, st);
+        void operator()(float t, const Coefficients<S>& k, const Spec& mu, const Spec& tbar, const State& st,
+                        const ChannelEventDensities<Spec>& d) const {
+            null_visit(t, k, mu, tbar, st, d);
             if constexpr (!std::is_same_v<F, NoEmission>) {
                 const float p_here = st.uni[channel] * tbar[channel];
                 if (!(p_here > 0.f)) return;
                 (*emission)(path, count, medium, ray.at(t), k, mu, mu[channel], Spec(beta0 * st.f * tbar / p_here),
                             Spec(nulls * null_visit.nulls->template cast<float>()), pdf_dir,
-                            relative_to_largest<Spec>(path[count - 1].gamma * st.eq.vertex * tbar), nulls, along);
+                            relative_to_largest<Spec>(path[count - 1].gamma * st.nee * tbar), nulls, along);
             }
         }
     };
@@ -816,15 +819,17 @@ int BdptEstimator<Mis, H, A, MaxDepth, Ch>::walk(const Sc& sc, VertexT<Sc>* path
     P nulls = broadcast<P>(1.f);
     int crossings = 0;
     // Per channel: the segment's state since the last real vertex (f_c and p_c of channel c's
-    // tracking, and in its eq.vertex slot the factor every strategy shares, prod mu_bar_c(n_j)
-    // Tbar_c), and the throughput where the segment started (THEORY 5.3 with 5.5).
-    using State = std::conditional_t<kPerChannel, ChannelPathState<S, true>, NoGamma>;
+    // tracking, and in its nee slot the factor every strategy shares, prod mu_bar_c(n_j) Tbar_c:
+    // ratio tracking's pdf of the nulls, which the tracking kernel keeps there as NEE's
+    // alternative, times the real vertex's Tbar_c, multiplied in where it scatters), and the
+    // throughput where the segment started (THEORY 5.3 with 5.5).
+    using State = std::conditional_t<kPerChannel, ChannelPathState<S>, NoGamma>;
     [[maybe_unused]] State st{};
     [[maybe_unused]] Spectrum beta0 = beta;
-    if constexpr (kPerChannel) st.eq.vertex = Spectrum::Ones();
+    if constexpr (kPerChannel) st.nee = Spectrum::Ones();
     // The subpath's shared factors up to the segment's start, and to where it is now.
     auto gamma_here = [&]() {
-        if constexpr (kPerChannel) return relative_to_largest<Spectrum>(path[count - 1].gamma * st.eq.vertex);
+        if constexpr (kPerChannel) return relative_to_largest<Spectrum>(path[count - 1].gamma * st.nee);
         else return NoGamma{};
     };
     bool segment_start = true;
@@ -851,11 +856,11 @@ int BdptEstimator<Mis, H, A, MaxDepth, Ch>::walk(const Sc& sc, VertexT<Sc>* path
             if (sc.has_medium(medium)) {
                 const auto& m = sc.media[std::size_t(medium)];
                 detail::DoubleSpectrum<Spectrum> piece_nulls = detail::DoubleSpectrum<Spectrum>::Ones();
-                Spectrum last_null = Spectrum::Ones(), last_event = Spectrum::Ones();
+                Spectrum last_null = Spectrum::Ones(), last_event = Spectrum::Ones(), last_tbar = Spectrum::Ones();
                 bool pending = false;
                 const ChannelTrack seg = track_channels_delta_visiting<Ch, A>(
-                    m.medium, m.majorant, ray, hit.t, lambda, channel, st, false, rng, counter,
-                    ChannelWalkVisit<Sc, OnEmission>{{&piece_nulls, &last_null, &last_event, &pending},
+                    m.medium, m.majorant, ray, hit.t, lambda, channel, st, true, rng, counter,
+                    ChannelWalkVisit<Sc, OnEmission>{{&piece_nulls, &last_null, &last_event, &last_tbar, &pending},
                                                      &on_emission, path, count, medium, channel, ray, beta0, nulls,
                                                      pdf_dir, along});
                 if (const Status fs = flight_status(seg.end); fs != Status::Ok) {
@@ -873,6 +878,7 @@ int BdptEstimator<Mis, H, A, MaxDepth, Ch>::walk(const Sc& sc, VertexT<Sc>* path
                     v.p = ray.at(seg.t);
                     v.medium = medium;
                     v.event = last_event;
+                    st.nee *= last_tbar;  // the real vertex's Tbar_c (not a null's: no mu_bar_c)
                 }
             }
         } else if (sc.has_medium(medium)) {  // grey: one pdf for every channel
@@ -979,7 +985,7 @@ int BdptEstimator<Mis, H, A, MaxDepth, Ch>::walk(const Sc& sc, VertexT<Sc>* path
         if constexpr (kPerChannel) {
             beta0 = beta;
             st = State{};
-            st.eq.vertex = Spectrum::Ones();
+            st.nee = Spectrum::Ones();
         }
         crossings = 0;
         ray = Ray{cur.p, next.wi};
