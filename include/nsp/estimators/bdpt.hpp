@@ -827,6 +827,10 @@ int BdptEstimator<Mis, H, A, MaxDepth, Ch>::walk(const Sc& sc, VertexT<Sc>* path
     [[maybe_unused]] State st{};
     [[maybe_unused]] Spectrum beta0 = beta;
     if constexpr (kPerChannel) st.nee = Spectrum::Ones();
+    // Per channel: the product of the subpath's forward densities (the shared factors apart),
+    // relative to the largest channel's: with the vertex's gamma, every channel's density of the
+    // subpath, for roulette on the one-sample spectral MIS estimate of its throughput.
+    [[maybe_unused]] P prefix = broadcast<P>(1.f);
     // The subpath's shared factors up to the segment's start, and to where it is now.
     auto gamma_here = [&]() {
         if constexpr (kPerChannel) return relative_to_largest<Spectrum>(path[count - 1].gamma * st.nee);
@@ -956,8 +960,18 @@ int BdptEstimator<Mis, H, A, MaxDepth, Ch>::walk(const Sc& sc, VertexT<Sc>* path
         V& cur = path[count++];
         if (count >= max_vertices) return count;
         // Roulette on the throughput relative to the subpath's start (a light subpath starts at
-        // Le / pdf, not 1).
-        const float q = kernels_.survival(count - 1, beta / (beta_scale > 0.f ? beta_scale : 1.f));
+        // Le / pdf, not 1). Per channel on the estimate the one-sample MIS over channels makes of
+        // it, f / sum_c' q_c' p_c' = beta p_c / sum_c' q_c' p_c' (q_c' = 1 / C), as
+        // SpectralPathEstimator's roulette: on beta = f / p_c alone, the sampling channel's, the
+        // chromatic cloud under a sky (nsp_room, C1) had 1.2x the variance.
+        Spectrum rr_beta = beta;
+        if constexpr (kPerChannel) {
+            prefix = relative_to_largest<Spectrum>(prefix * cur.pdf_fwd);
+            const Spectrum pc = prefix * cur.gamma;
+            const float mean = pc.mean();
+            if (pc[channel] > 0.f && mean > 0.f) rr_beta *= pc[channel] / mean;
+        }
+        const float q = kernels_.survival(count - 1, rr_beta / (beta_scale > 0.f ? beta_scale : 1.f));
         if (q < 1.f) {
             if (!(rng.uniform() < q)) return count;
             beta /= q;
