@@ -20,6 +20,11 @@
 //   Rgb): uni + NEE MIS (with the emission segment technique) against BDPT with light tracing,
 //   with its segment technique and without; for BDPT the segment technique's contributions per
 //   sample.
+// - BM_ChromaticSky/<estimator>: one sample of nsp_render's C1 (the chromatic cloud under a white
+//   sky; Rgb, per-channel majorants) as a SurfaceScene through its camera, where tracking alone is
+//   the best technique: the spectral MIS path tracer against per-channel BDPT with light tracing
+//   at the counts its learner chooses there (NEE and light subpaths on 1/64 of the samples), so
+//   that the ratio is BDPT's bookkeeping along the camera subpath.
 // - BM_ChromaticRoom/<estimator>: one sample of the room around the chromatic cloud (Rgb,
 //   extinction 5, 20 and 80 per unit density: nsp_room's second table), spectral MIS + NEE and
 //   per-channel BDPT under per-channel majorants, grey BDPT under the grey one; the BDPT rows with
@@ -288,6 +293,34 @@ void BM_FlameSmoke(benchmark::State& state) {
     pinhole_samples(state, scene, estimator, [](const auto& pdfs) { return pdfs.kSegment; }, "segment/sample");
 }
 
+/// nsp_render's C1 (the chromatic cloud under a white sky; Rgb, per-channel 16^3 grid majorants) as
+/// a SurfaceScene, as nsp_room renders it; BDPT at the counts its learner chooses there (NEE and
+/// light subpaths on 1/64 of the samples), where tracking alone is the best technique.
+template <class E>
+void BM_ChromaticSky(benchmark::State& state) {
+    static const auto scene = [] {
+        const nsp_examples::SceneChoice c{nsp_examples::SceneKind::Chromatic, {}, nsp_examples::ChromaticSetup::Env};
+        auto medium = nsp_examples::DenseGridCloud::make<nsp::Rgb>(c);
+        const auto majorant = nsp_examples::ChannelMajorantPolicy::make(medium, nsp_examples::MajorantSettings{});
+        return nsp_examples::make_empty_space_scene(std::move(medium), majorant, nsp_examples::phase_g(c.kind),
+                                                    nsp_examples::scene_lights<nsp::Rgb>(c));
+    }();
+    static const E estimator = [] {
+        nsp::EstimatorOptions o = nsp::BdptEstimator<>::default_options();
+        if constexpr (requires { E::kMaxPath; }) {
+            o.nee_count = 1.f / 64.f;
+            return E(o, {}, 1.f / 64.f);
+        } else {
+            return E(o);
+        }
+    }();
+    pinhole_samples(state, scene, estimator, [](const auto&) { return 1; }, "nee/sample");
+}
+
+BENCHMARK_TEMPLATE(BM_ChromaticSky, nsp::SpectralPathEstimator<nsp::channels::SpectralMis, nsp::strategy::Unidirectional>)
+    ->Name("BM_ChromaticSky/unidirectional:spectral-mis");
+BENCHMARK_TEMPLATE(BM_ChromaticSky, nsp::SpectralBdptEstimator<nsp::mis::Balance>)
+    ->Name("BM_ChromaticSky/bdpt-null-mis:spectral-mis+light-tracing:counts-1/64");
 BENCHMARK_TEMPLATE(BM_FogLamp, nsp::PathEstimator<nsp::strategy::EquiangularMis, nsp::mis::Balance>)
     ->Name("BM_FogLamp/uni-nee-eq-mis:balance");
 BENCHMARK_TEMPLATE(BM_FogLamp, nsp::BdptEstimator<nsp::bdpt::NullScattering>, false)
