@@ -122,6 +122,10 @@ int main(int argc, char** argv) {
                    "nsp_render's other scenes, SA, F1-F3, C1, C2, P1, with BDPT)")
         ->check(CLI::IsMember({"grey", "rgb", "plume", "lantern", "lantern-rgb", "cloud", "sky", "empty"}))
         ->delimiter(',');
+    std::vector<std::string> empty_setups{"SA", "F1", "F2", "F3", "C1", "C2", "P1"};
+    app.add_option("--setups", empty_setups, "with --tables empty: which of nsp_render's set-ups to render (default: all)")
+        ->check(CLI::IsMember({"SA", "F1", "F2", "F3", "C1", "C2", "P1"}))
+        ->delimiter(',');
     CLI11_PARSE(app, argc, argv);
     auto want = [&](const char* t) { return std::find(tables.begin(), tables.end(), t) != tables.end(); };
 
@@ -148,12 +152,15 @@ int main(int argc, char** argv) {
     // probability learned for the image from a pilot of spp / 32 samples per pixel (2-16) at
     // counts 1 (THEORY 5.9, nsp::NeeCountLearner); the choice printed under the table.
     // `channels`: bdpt::Grey{}, or channels::SpectralMis{} (per-channel pdfs, SpectralBdptEstimator).
-    auto learned_render = [&](const auto& scene, const nsp::PinholeCamera& camera, const char* name, auto channels) {
+    // `roulette`: EstimatorOptions::russian_roulette.
+    auto learned_render = [&](const auto& scene, const nsp::PinholeCamera& camera, const char* name, auto channels,
+                              bool roulette = true) {
         using Channels = decltype(channels);
         nsp::TechniqueCounts chosen;
-        auto make = [](float nee, float light) {
+        auto make = [roulette](float nee, float light) {
             nsp::EstimatorOptions o = BdptEstimator<>::default_options();
             o.nee_count = nee;
+            o.russian_roulette = roulette;
             return BdptEstimator<bdpt::NullScattering, mis::Balance, absorption::Weight, 32, Channels>(o, {}, light);
         };
         const int pilot = nsp_examples::RenderRequest::pilot_spp(run_spp);
@@ -497,12 +504,21 @@ int main(int argc, char** argv) {
             }
             finish(c, mode, from, decltype(equiangular)::value ? 4 : 3);
         };
+        // Each set-up its own seeds (37 + 100 i, i its place in SA, F1-F3, C1, C2, P1), so that
+        // --setups renders a set-up as the whole table does.
+        auto setup_seed = [&](const SceneChoice& c) {
+            static constexpr const char* order[] = {"SA", "F1", "F2", "F3", "C1", "C2", "P1"};
+            const auto at = std::find_if(std::begin(order), std::end(order),
+                                         [&](const char* n) { return std::string(n) == c.name(); });
+            seed = 37 + 100 * std::uint64_t(at - std::begin(order)) + seed_offset;
+            return std::find(empty_setups.begin(), empty_setups.end(), c.name()) != empty_setups.end();
+        };
         // Grey: the sparse medium under set-up A's light, the fog under its lamp; grid majorants (16^3).
-        seed = 37 + seed_offset;
         for (const SceneChoice c : {SceneChoice{SceneKind::Sparse, nsp_examples::LightSetup::A},
                                     SceneChoice{SceneKind::Fog, {}, {}, nsp_examples::FogSetup::F1},
                                     SceneChoice{SceneKind::Fog, {}, {}, nsp_examples::FogSetup::F2},
                                     SceneChoice{SceneKind::Fog, {}, {}, nsp_examples::FogSetup::F3}}) {
+            if (!setup_seed(c)) continue;
             auto medium = nsp_examples::DenseGridCloud::make<Mono>(c);  // nsp_render's medium and majorant
             const auto majorant = nsp_examples::GridMajorantPolicy<>::make(medium, nsp_examples::MajorantSettings{});
             const auto sc = nsp_examples::make_empty_space_scene(std::move(medium), majorant, nsp_examples::phase_g(c.kind),
@@ -512,6 +528,7 @@ int main(int argc, char** argv) {
         // Chromatic: C1 (a white sky), C2 (set-up A's sphere light); Rgb, per-channel majorants.
         for (const SceneChoice c : {SceneChoice{SceneKind::Chromatic, {}, nsp_examples::ChromaticSetup::Env},
                                     SceneChoice{SceneKind::Chromatic, {}, nsp_examples::ChromaticSetup::Small}}) {
+            if (!setup_seed(c)) continue;
             auto medium = nsp_examples::DenseGridCloud::make<Rgb>(c);
             const auto majorant = nsp_examples::ChannelMajorantPolicy::make(medium, nsp_examples::MajorantSettings{});
             const auto sc = nsp_examples::make_empty_space_scene(std::move(medium), majorant, nsp_examples::phase_g(c.kind),
@@ -525,11 +542,19 @@ int main(int argc, char** argv) {
                            "uni-nee-mis_spectral-mis");
             pinhole_render(sc, camera, SpectralBdptEstimator<mis::Balance>{}, "bdpt_spectral-mis");
             learned_render(sc, camera, "bdpt_spectral-mis_learned", channels::SpectralMis{});
+            if (c.chromatic == nsp_examples::ChromaticSetup::Env) {
+                // C1 without roulette: under the sky every path that escapes carries its
+                // throughput, so roulette's survival on it adds more variance than it saves work.
+                EstimatorOptions no_rr = depth;
+                no_rr.russian_roulette = false;
+                pinhole_render(sc, camera, SpectralPathEstimator<channels::SpectralMis, strategy::Unidirectional>(no_rr),
+                               "unidirectional_spectral-mis_no-rr");
+                learned_render(sc, camera, "bdpt_spectral-mis_learned_no-rr", channels::SpectralMis{}, false);
+            }
             finish(c, "rgb, per-channel majorants", from, 3);
         }
         // The plume (an emissive medium, no other light); Rgb (its flame's colour), grid majorant.
-        {
-            const SceneChoice c{SceneKind::Plume};
+        if (const SceneChoice c{SceneKind::Plume}; setup_seed(c)) {
             auto medium = nsp_examples::EmissivePlume::make<Rgb>(c);
             const auto majorant = nsp_examples::GridMajorantPolicy<>::make(medium, nsp_examples::MajorantSettings{});
             const auto sc = nsp_examples::make_empty_space_scene(std::move(medium), majorant, nsp_examples::phase_g(c.kind),
