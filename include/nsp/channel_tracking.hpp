@@ -168,11 +168,10 @@ struct ChannelTrack {
 /// of the segment, without its density; THEORY 5.4).
 ///
 /// A visitor with `enabled` is called at every tentative collision before its event is chosen, as
-/// `visit(t, coefficients, mu, tbar, st)` with every channel's majorant, its Tbar since the last
-/// tentative collision (relative, as the state's; ones for a grey majorant) and the state before
-/// this collision (the collision estimator of emission, THEORY 5.7 with 5.3, uses it); a visitor
-/// that also takes `const ChannelEventDensities<Spectrum>&` gets every channel's event densities
-/// there as a sixth argument (the ones the event is chosen by), so it need not form them again.
+/// `visit(t, coefficients, mu, tbar, st, d)` with every channel's majorant, its Tbar since the last
+/// tentative collision (relative, as the state's; ones for a grey majorant), the state before
+/// this collision (the collision estimator of emission, THEORY 5.7 with 5.3, uses it) and every
+/// channel's event densities there (ChannelEventDensities, the ones the event is chosen by).
 template <ChannelPolicy CP, AbsorptionPolicy A, SpectralMode S, UniformRng R, class Rec, bool kEq = false,
           class Visit = NoVisit>
 struct ChannelDeltaCollision {
@@ -204,14 +203,8 @@ struct ChannelDeltaCollision {
             d = {Spec::Constant(mu_v * p.absorb), Spec::Constant(mu_v * p.scatter), Spec::Constant(mu_v * p.null)};
         }
         if constexpr (Visit::enabled) {
-            Spec tbv;
-            if constexpr (grey) tbv = Spec::Ones();
-            else tbv = tb;
-            if constexpr (std::is_invocable_v<Visit&, float, const Coefficients<S>&, const Spec&, const Spec&,
-                                              const ChannelPathState<S, kEq>&, const ChannelEventDensities<Spec>&>)
-                visit(t, k, mu, tbv, st, d);
-            else
-                visit(t, k, mu, tbv, st);
+            if constexpr (grey) visit(t, k, mu, Spec(Spec::Ones()), st, d);
+            else visit(t, k, mu, tb, st, d);
         }
         // mu_c* > 0: free flight samples nothing where it is 0. In double: a denormal mu_c* made
         // float's 1 / mu_c* overflow (found by the fuzzer).

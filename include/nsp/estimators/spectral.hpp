@@ -312,7 +312,8 @@ private:
         float along, dir_pdf;
 
         template <class State>
-        void operator()(float t, const Coefficients<S>& k, const Spec& mu, const Spec& tbar, const State& st) const {
+        void operator()(float t, const Coefficients<S>& k, const Spec& mu, const Spec& tbar, const State& st,
+                        const ChannelEventDensities<Spec>&) const {
             if (!(k.sigma_a > 0.f).any()) return;
             const Vec3 y = ray.at(t);
             const Spec le = scene.medium.emission(y, lambda);

@@ -44,7 +44,8 @@ struct ChannelPieceEmission {
     float along, select, walked;
 
     template <class State>
-    void operator()(float t, const Coefficients<S>& k, const Spec& mu, const Spec& tbar, const State& st) const {
+    void operator()(float t, const Coefficients<S>& k, const Spec& mu, const Spec& tbar, const State& st,
+                    const ChannelEventDensities<Spec>&) const {
         if (!(k.sigma_a > 0.f).any()) return;
         const Vec3 y = ray.at(t);
         const Spec le = medium.emission(y, lambda);
