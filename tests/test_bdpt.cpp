@@ -366,6 +366,19 @@ EstimatorOptions strategy_test_options() {
     return opts;
 }
 
+/// The estimate of a strategy alone against `reference`'s over the same paths (kSigmas combined
+/// SE) where the strategy draws them (`draws`), else exactly nothing.
+void check_alone(const Stat& alone, const Stat& reference, bool draws) {
+    CAPTURE(alone.mean);
+    CAPTURE(reference.mean);
+    if (!draws) {
+        CHECK(alone.mean == 0.0);
+        return;
+    }
+    CHECK(alone.mean > 0.0);
+    CHECK(std::abs(alone.mean - reference.mean) <= kSigmas * std::hypot(alone.se(), reference.se()));
+}
+
 /// The two checks on a record of paths of 0..3 interior vertices (see the test below): every
 /// (s, t) alone against NEE's estimate of the same path length, and the pdf symmetry over every
 /// pair of strategies, both within 5 combined SE. `hittable`: the lights can be hit (s = 0 draws
@@ -376,33 +389,17 @@ void check_strategies_alone_and_symmetric(StrategyRecord& rec, bool hittable = t
     for (int n = 1; n <= 3; ++n) {
         const Stat& nee = rec.alone[{1, n + 1}];
         for (int s = 0; s <= n + 1; ++s) {
-            const Stat& a = rec.alone[{s, n + 2 - s}];
             CAPTURE(n);
             CAPTURE(s);
-            CAPTURE(a.mean);
-            CAPTURE(nee.mean);
-            if (s == 0 && !hittable) {
-                CHECK(a.mean == 0.0);
-                continue;
-            }
-            CHECK(a.mean > 0.0);
-            CHECK(std::abs(a.mean - nee.mean) <= kSigmas * std::sqrt(a.se() * a.se() + nee.se() * nee.se()));
+            check_alone(rec.alone[{s, n + 2 - s}], nee, s != 0 || hittable);
         }
         // The equiangular strategy draws the paths whose x_1 is a medium vertex and x_0 a light's,
         // all of them: its estimate alone against NEE's over those paths (5 combined SE); where it
         // is off (no light with a target), nothing.
         const Stat& eq = rec.alone[{rec.eq, n + 1}];
-        const Stat& nee_medium = rec.alone_medium[{1, n + 1}];
         CAPTURE(n);
-        CAPTURE(eq.mean);
-        CAPTURE(nee_medium.mean);
-        if (!equiangular) {
-            CHECK(eq.mean == 0.0);
-            continue;
-        }
-        CHECK(eq.mean > 0.0);
-        CHECK(rec.alone_medium[{rec.eq, n + 1}].mean == eq.mean);
-        CHECK(std::abs(eq.mean - nee_medium.mean) <= kSigmas * std::sqrt(eq.se() * eq.se() + nee_medium.se() * nee_medium.se()));
+        check_alone(eq, rec.alone_medium[{1, n + 1}], equiangular);
+        if (equiangular) CHECK(rec.alone_medium[{rec.eq, n + 1}].mean == eq.mean);
     }
     // The segment technique draws every path whose x_0 lies in an emitting medium: its estimate
     // alone against NEE's over those paths (NEE toward the volume), 5 combined SE; seen from the
@@ -410,17 +407,9 @@ void check_strategies_alone_and_symmetric(StrategyRecord& rec, bool hittable = t
     // nothing.
     for (int n = 0; n <= 3; ++n) {
         const Stat& seg = rec.alone[{rec.seg, n + 2}];
-        const Stat& nee_volume = n == 0 ? rec.alone_volume[{0, 2}] : rec.alone_volume[{1, n + 1}];
         CAPTURE(n);
-        CAPTURE(seg.mean);
-        CAPTURE(nee_volume.mean);
-        if (!segment) {
-            CHECK(seg.mean == 0.0);
-            continue;
-        }
-        CHECK(seg.mean > 0.0);
-        CHECK(rec.alone_volume[{rec.seg, n + 2}].mean == seg.mean);
-        CHECK(std::abs(seg.mean - nee_volume.mean) <= kSigmas * std::hypot(seg.se(), nee_volume.se()));
+        check_alone(seg, n == 0 ? rec.alone_volume[{0, 2}] : rec.alone_volume[{1, n + 1}], segment);
+        if (segment) CHECK(rec.alone_volume[{rec.seg, n + 2}].mean == seg.mean);
     }
     CHECK(worst_share_asymmetry(rec, 3) <= kSigmas);
 }

@@ -524,6 +524,23 @@ ChannelStrategyRecord record_channel_strategies(const E& est, const Scene& sc, i
     return rec;
 }
 
+/// Per channel: the estimate of a strategy alone against `reference`'s over the same paths
+/// (kSigmas combined SE) where the strategy draws them (`draws`), else exactly nothing.
+void check_alone(const SpecStat<Rgb>& alone, const SpecStat<Rgb>& reference, bool draws) {
+    for (int c = 0; c < 3; ++c) {
+        CAPTURE(c);
+        CAPTURE(alone.ch[c].mean);
+        CAPTURE(reference.ch[c].mean);
+        if (!draws) {
+            CHECK(alone.ch[c].mean == 0.0);
+            continue;
+        }
+        CHECK(alone.ch[c].mean > 0.0);
+        CHECK(std::abs(alone.ch[c].mean - reference.ch[c].mean) <=
+              kSigmas * std::hypot(alone.ch[c].se(), reference.ch[c].se()));
+    }
+}
+
 /// The checks on a record of paths of 0..3 interior vertices (see the test below). `hittable`:
 /// the lights can be hit (s = 0 draws paths); else s = 0 must contribute exactly nothing.
 /// `equiangular`: the equiangular strategy draws every path whose x_1 is a medium vertex and x_0
@@ -535,67 +552,17 @@ void check_channel_strategies(ChannelStrategyRecord& rec, bool hittable = true, 
     for (int n = 1; n <= 3; ++n) {
         const SpecStat<Rgb>& nee = rec.alone[{1, n + 1}];
         for (int s = 0; s <= n + 1; ++s) {
-            const SpecStat<Rgb>& a = rec.alone[{s, n + 2 - s}];
-            for (int c = 0; c < 3; ++c) {
-                CAPTURE(n);
-                CAPTURE(s);
-                CAPTURE(c);
-                CAPTURE(a.ch[c].mean);
-                CAPTURE(nee.ch[c].mean);
-                if (s == 0 && !hittable) {
-                    CHECK(a.ch[c].mean == 0.0);
-                    continue;
-                }
-                CHECK(a.ch[c].mean > 0.0);
-                CHECK(std::abs(a.ch[c].mean - nee.ch[c].mean) <= kSigmas * std::hypot(a.ch[c].se(), nee.ch[c].se()));
-            }
-        }
-        const SpecStat<Rgb>& eq = rec.alone[{rec.eq, n + 1}];
-        const SpecStat<Rgb>& nee_medium = rec.alone_medium[{1, n + 1}];
-        for (int c = 0; c < 3; ++c) {
             CAPTURE(n);
-            CAPTURE(c);
-            CAPTURE(eq.ch[c].mean);
-            CAPTURE(nee_medium.ch[c].mean);
-            if (!equiangular) {
-                CHECK(eq.ch[c].mean == 0.0);
-                continue;
-            }
-            CHECK(eq.ch[c].mean > 0.0);
-            CHECK(std::abs(eq.ch[c].mean - nee_medium.ch[c].mean) <=
-                  kSigmas * std::hypot(eq.ch[c].se(), nee_medium.ch[c].se()));
+            CAPTURE(s);
+            check_alone(rec.alone[{s, n + 2 - s}], nee, s != 0 || hittable);
         }
-        const SpecStat<Rgb>& seg = rec.alone[{rec.seg, n + 2}];
-        const SpecStat<Rgb>& nee_volume = rec.alone_volume[{1, n + 1}];
-        for (int c = 0; c < 3; ++c) {
-            CAPTURE(n);
-            CAPTURE(c);
-            CAPTURE(seg.ch[c].mean);
-            CAPTURE(nee_volume.ch[c].mean);
-            if (!segment) {
-                CHECK(seg.ch[c].mean == 0.0);
-                continue;
-            }
-            CHECK(seg.ch[c].mean > 0.0);
-            CHECK(std::abs(seg.ch[c].mean - nee_volume.ch[c].mean) <=
-                  kSigmas * std::hypot(seg.ch[c].se(), nee_volume.ch[c].se()));
-        }
+        CAPTURE(n);
+        check_alone(rec.alone[{rec.eq, n + 1}], rec.alone_medium[{1, n + 1}], equiangular);
+        check_alone(rec.alone[{rec.seg, n + 2}], rec.alone_volume[{1, n + 1}], segment);
     }
     // Seen from the camera (no interior vertex): the segment technique alone against the
     // collision estimator alone over the paths whose x_0 lies in the volume.
-    const SpecStat<Rgb>& seg0 = rec.alone[{rec.seg, 2}];
-    const SpecStat<Rgb>& collision0 = rec.alone_volume[{0, 2}];
-    for (int c = 0; c < 3; ++c) {
-        CAPTURE(c);
-        CAPTURE(seg0.ch[c].mean);
-        CAPTURE(collision0.ch[c].mean);
-        if (!segment) {
-            CHECK(seg0.ch[c].mean == 0.0);
-            continue;
-        }
-        CHECK(seg0.ch[c].mean > 0.0);
-        CHECK(std::abs(seg0.ch[c].mean - collision0.ch[c].mean) <= kSigmas * std::hypot(seg0.ch[c].se(), collision0.ch[c].se()));
-    }
+    check_alone(rec.alone[{rec.seg, 2}], rec.alone_volume[{0, 2}], segment);
     auto worst_asymmetry = [&rec](std::map<std::pair<int, int>, std::map<int, Stat>>& share) {
         double worst = 0.0;
         for (int n = 0; n <= 3; ++n) {
