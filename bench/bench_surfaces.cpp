@@ -269,10 +269,8 @@ template <class E, bool kEquiangular = true>
 void BM_FogLamp(benchmark::State& state) {
     static const auto scene = [] {
         const nsp_examples::SceneChoice c{nsp_examples::SceneKind::Fog, {}, {}, nsp_examples::FogSetup::F2};
-        auto medium = nsp_examples::DenseGridCloud::make<nsp::Mono>(c);
-        const auto majorant = nsp_examples::GridMajorantPolicy<>::make(medium, nsp_examples::MajorantSettings{});
-        return nsp_examples::make_empty_space_scene(std::move(medium), majorant, nsp_examples::phase_g(c.kind),
-                                                    nsp_examples::scene_lights<nsp::Mono>(c));
+        return nsp_examples::make_setup_surface_scene<nsp::Mono, nsp_examples::DenseGridCloud,
+                                                      nsp_examples::GridMajorantPolicy<>>(c);
     }();
     const E estimator = with_bdpt_depth<E>([](nsp::EstimatorOptions& o) { o.bdpt_equiangular = kEquiangular; });
     pinhole_samples(state, scene, estimator, [](const auto& pdfs) { return pdfs.kEquiangular; }, "equiangular/sample");
@@ -284,10 +282,8 @@ template <class E, bool kSegment = true>
 void BM_FlameSmoke(benchmark::State& state) {
     static const auto scene = [] {
         const nsp_examples::SceneChoice c{nsp_examples::SceneKind::Plume};
-        auto medium = nsp_examples::EmissivePlume::make<nsp::Rgb>(c);
-        const auto majorant = nsp_examples::GridMajorantPolicy<>::make(medium, nsp_examples::MajorantSettings{});
-        return nsp_examples::make_empty_space_scene(std::move(medium), majorant, nsp_examples::phase_g(c.kind),
-                                                    nsp_examples::scene_lights<nsp::Rgb>(c));
+        return nsp_examples::make_setup_surface_scene<nsp::Rgb, nsp_examples::EmissivePlume,
+                                                      nsp_examples::GridMajorantPolicy<>>(c);
     }();
     const E estimator = with_bdpt_depth<E>([](nsp::EstimatorOptions& o) { o.emission_along_segments = kSegment; });
     pinhole_samples(state, scene, estimator, [](const auto& pdfs) { return pdfs.kSegment; }, "segment/sample");
@@ -300,10 +296,8 @@ template <class E>
 void BM_ChromaticSky(benchmark::State& state) {
     static const auto scene = [] {
         const nsp_examples::SceneChoice c{nsp_examples::SceneKind::Chromatic, {}, nsp_examples::ChromaticSetup::Env};
-        auto medium = nsp_examples::DenseGridCloud::make<nsp::Rgb>(c);
-        const auto majorant = nsp_examples::ChannelMajorantPolicy::make(medium, nsp_examples::MajorantSettings{});
-        return nsp_examples::make_empty_space_scene(std::move(medium), majorant, nsp_examples::phase_g(c.kind),
-                                                    nsp_examples::scene_lights<nsp::Rgb>(c));
+        return nsp_examples::make_setup_surface_scene<nsp::Rgb, nsp_examples::DenseGridCloud,
+                                                      nsp_examples::ChannelMajorantPolicy>(c);
     }();
     static const E estimator = [] {
         nsp::EstimatorOptions o = nsp::BdptEstimator<>::default_options();

@@ -504,9 +504,9 @@ int main(int argc, char** argv) {
             }
             finish(c, mode, from, decltype(equiangular)::value ? 4 : 3);
         };
-        // Each set-up its own seeds (37 + 100 i, i its place in SA, F1-F3, C1, C2, P1), so that
-        // --setups renders a set-up as the whole table does.
-        auto setup_seed = [&](const SceneChoice& c) {
+        // Starts set-up c: its own seeds (37 + 100 i, i its place in SA, F1-F3, C1, C2, P1), so that
+        // --setups renders a set-up as the whole table does; whether --setups asks for it.
+        auto start_setup = [&](const SceneChoice& c) {
             static constexpr const char* order[] = {"SA", "F1", "F2", "F3", "C1", "C2", "P1"};
             const auto at = std::find_if(std::begin(order), std::end(order),
                                          [&](const char* n) { return std::string(n) == c.name(); });
@@ -518,21 +518,17 @@ int main(int argc, char** argv) {
                                     SceneChoice{SceneKind::Fog, {}, {}, nsp_examples::FogSetup::F1},
                                     SceneChoice{SceneKind::Fog, {}, {}, nsp_examples::FogSetup::F2},
                                     SceneChoice{SceneKind::Fog, {}, {}, nsp_examples::FogSetup::F3}}) {
-            if (!setup_seed(c)) continue;
-            auto medium = nsp_examples::DenseGridCloud::make<Mono>(c);  // nsp_render's medium and majorant
-            const auto majorant = nsp_examples::GridMajorantPolicy<>::make(medium, nsp_examples::MajorantSettings{});
-            const auto sc = nsp_examples::make_empty_space_scene(std::move(medium), majorant, nsp_examples::phase_g(c.kind),
-                                                                 nsp_examples::scene_lights<Mono>(c));
+            if (!start_setup(c)) continue;
+            const auto sc = nsp_examples::make_setup_surface_scene<Mono, nsp_examples::DenseGridCloud,
+                                                                   nsp_examples::GridMajorantPolicy<>>(c);
             grey_rows(sc, c, "mono, grid majorant", std::true_type{});
         }
         // Chromatic: C1 (a white sky), C2 (set-up A's sphere light); Rgb, per-channel majorants.
         for (const SceneChoice c : {SceneChoice{SceneKind::Chromatic, {}, nsp_examples::ChromaticSetup::Env},
                                     SceneChoice{SceneKind::Chromatic, {}, nsp_examples::ChromaticSetup::Small}}) {
-            if (!setup_seed(c)) continue;
-            auto medium = nsp_examples::DenseGridCloud::make<Rgb>(c);
-            const auto majorant = nsp_examples::ChannelMajorantPolicy::make(medium, nsp_examples::MajorantSettings{});
-            const auto sc = nsp_examples::make_empty_space_scene(std::move(medium), majorant, nsp_examples::phase_g(c.kind),
-                                                                 nsp_examples::scene_lights<Rgb>(c));
+            if (!start_setup(c)) continue;
+            const auto sc = nsp_examples::make_setup_surface_scene<Rgb, nsp_examples::DenseGridCloud,
+                                                                   nsp_examples::ChannelMajorantPolicy>(c);
             const std::size_t from = rows.size();
             pinhole_render(sc, camera, SpectralPathEstimator<channels::SpectralMis, strategy::Unidirectional>(depth),
                            "unidirectional_spectral-mis");
@@ -554,11 +550,9 @@ int main(int argc, char** argv) {
             finish(c, "rgb, per-channel majorants", from, 3);
         }
         // The plume (an emissive medium, no other light); Rgb (its flame's colour), grid majorant.
-        if (const SceneChoice c{SceneKind::Plume}; setup_seed(c)) {
-            auto medium = nsp_examples::EmissivePlume::make<Rgb>(c);
-            const auto majorant = nsp_examples::GridMajorantPolicy<>::make(medium, nsp_examples::MajorantSettings{});
-            const auto sc = nsp_examples::make_empty_space_scene(std::move(medium), majorant, nsp_examples::phase_g(c.kind),
-                                                                 nsp_examples::scene_lights<Rgb>(c));
+        if (const SceneChoice c{SceneKind::Plume}; start_setup(c)) {
+            const auto sc = nsp_examples::make_setup_surface_scene<Rgb, nsp_examples::EmissivePlume,
+                                                                   nsp_examples::GridMajorantPolicy<>>(c);
             grey_rows(sc, c, "rgb, grid majorant", std::false_type{}, 1.f / 64.f);  // P1: + light subpaths on 1/64
         }
     }

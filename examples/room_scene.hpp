@@ -11,6 +11,7 @@
 #include <nsp/nsp.hpp>
 
 #include "default_scene.hpp"
+#include "scene_choice.hpp"
 #include "host/shapes.hpp"
 
 namespace nsp_examples {
@@ -151,6 +152,17 @@ EmptySpaceScene<M, Maj> make_empty_space_scene(M medium, Maj majorant, float g, 
                                    EmptySpaceLights<S>(nsp::LightSelection::Uniform, 4.f, std::move(spheres), std::move(points),
                                                        std::move(environments)),
                                    -1);
+}
+
+/// nsp_render's set-up `c` as a SurfaceScene (make_empty_space_scene) in spectral mode S: its
+/// medium made by `Medium` (a medium of combinations.hpp: DenseGridCloud, EmissivePlume), its
+/// majorant by the policy `Majorant` at nsp_render's default MajorantSettings, its phase and
+/// lights.
+template <nsp::SpectralMode S, class Medium, class Majorant>
+auto make_setup_surface_scene(const SceneChoice& c) {
+    auto medium = Medium::template make<S>(c);
+    const auto majorant = Majorant::make(medium, MajorantSettings{});
+    return make_empty_space_scene(std::move(medium), majorant, phase_g(c.kind), scene_lights<S>(c));
 }
 
 /// The main job's cloud scene (default_scene.hpp, set-up A or B) as a SurfaceScene
