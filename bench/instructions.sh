@@ -1,0 +1,74 @@
+#!/usr/bin/env bash
+# The before/after check in work alone (bench/run.sh's step 3, without its timed steps):
+# bench/work_count.cpp compiled with one command against the working tree's include/ and
+# examples/ and against commit BEFORE's, each run under valgrind's callgrind, and a table of
+# instructions per kernel, new / old, with the kernels' lookups and checksums (equal checksums:
+# the same paths were sampled, so the ratio is the code's alone).
+#
+#   bench/instructions.sh [BEFORE]     (default: HEAD; needs valgrind)
+#
+# The instruction count is deterministic for a given binary and input, so one run suffices on a
+# noisy machine. The whole run takes about four minutes on 2 cores (two compiles, two runs under
+# callgrind). Output: the table on stdout; the raw files in ${NSP_INSTRUCTIONS_DIR:-build-instructions}.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+before=${1:-HEAD}
+want=$(git rev-parse --verify "$before^{commit}")
+command -v valgrind >/dev/null || { echo "instructions.sh: valgrind is needed (apt-get install valgrind)" >&2; exit 2; }
+out=${NSP_INSTRUCTIONS_DIR:-build-instructions}
+mkdir -p "$out"
+cxx=${CXX:-c++}
+# One compiler command for both sides (the Release flags of CMake).
+work_cc() { "$cxx" -O3 -DNDEBUG -std=gnu++20 -I"$1/examples" -I"$1/include" -isystem /usr/include/eigen3 \
+                bench/work_count.cpp -o "$2"; }
+
+src=$(cd "$out" && pwd)/before-src
+git worktree remove --force "$src" 2>/dev/null || true
+git worktree prune
+git worktree add --detach "$src" "$want" >/dev/null
+trap 'git worktree remove --force "$src"' EXIT
+echo "instructions.sh: compiling bench/work_count.cpp against $(git rev-parse --short "$want") and the working tree" >&2
+# The harness is the working tree's on both sides: only the library and the example scenes differ.
+work_cc "$src" "$out/work-old" &
+work_cc . "$out/work-new" &
+wait %1 && wait %2
+git worktree remove --force "$src"
+trap - EXIT
+
+for side in old new; do
+    echo "instructions.sh: running the $side build under callgrind" >&2
+    rm -f "$out/cg-$side" "$out/cg-$side".*
+    valgrind --tool=callgrind --instr-atstart=no --callgrind-out-file="$out/cg-$side" "$out/work-$side" \
+        >"$out/work-$side.txt" 2>"$out/valgrind-$side.log"
+    for f in "$out/cg-$side".*; do
+        sed -n -e 's/^desc: Trigger: Client Request: //p' -e 's/^summary: //p' "$f" | paste -sd' '
+    done >"$out/ir-$side.txt"
+    rm -f "$out/cg-$side" "$out/cg-$side".*
+done
+
+python3 - "$out" "$(git rev-parse --short "$want")" <<'EOF'
+import sys
+out, before = sys.argv[1], sys.argv[2]
+def load(side):
+    ir = {}
+    for line in open(f"{out}/ir-{side}.txt"):
+        name, n = line.split()[0], int(line.split()[-1])
+        ir[name] = n
+    work = {}
+    for line in open(f"{out}/work-{side}.txt"):
+        name, calls, lookups, checksum = line.split()
+        work[name] = (int(calls), int(lookups), checksum)
+    return ir, work
+ir_old, w_old = load("old")
+ir_new, w_new = load("new")
+print(f"Instructions per kernel: the working tree against {before} (callgrind; new / old)\n")
+print(f"| kernel | calls | instructions old | instructions new | new / old | lookups | same paths |")
+print(f"|---|---|---|---|---|---|---|")
+for name in w_new:
+    if name not in w_old or name not in ir_old or name not in ir_new:
+        print(f"| {name} | {w_new[name][0]} | - | {ir_new.get(name, '-')} | - | {w_new[name][1]} | new kernel |")
+        continue
+    same = "yes" if w_old[name][1:] == w_new[name][1:] else f"no (lookups {w_old[name][1]} -> {w_new[name][1]})"
+    print(f"| {name} | {w_new[name][0]} | {ir_old[name]} | {ir_new[name]} | {ir_new[name] / ir_old[name]:.4f} | "
+          f"{w_new[name][1]} | {same} |")
+EOF
