@@ -186,6 +186,35 @@ TEST_CASE("bdpt: the furnace of six emitting walls around a medium of albedo 1 (
     }
 }
 
+TEST_CASE("bdpt: an unusable camera ray (not unit length, NaN, infinite) gives InvalidInput and no estimate") {
+    const Sc sc = cube_over_floor(true);
+    const PinholeCamera camera = cube_pinhole();
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    const std::vector<std::pair<const char*, Ray>> bad{
+        {"|d| = 2", Ray{Vec3(0.f, 0.3f, -4.5f), Vec3(0.f, 0.f, 2.f)}},
+        {"zero direction", Ray{Vec3(0.f, 0.3f, -4.5f), Vec3(0.f)}},
+        {"NaN origin", Ray{Vec3(nan, 0.3f, -4.5f), Vec3(0.f, 0.f, 1.f)}},
+        {"infinite direction", Ray{Vec3(0.f, 0.3f, -4.5f), Vec3(0.f, kInf, 0.f)}}};
+    for_each_bdpt([&](const auto& est, const char* name) {
+        CAPTURE(std::string(name));
+        Pcg32 rng(21, 1);
+        LookupCount lookups;
+        for (const auto& [what, ray] : bad) {
+            CAPTURE(std::string(what));
+            const auto r = est.radiance(sc, ray, {}, rng, lookups);
+            CHECK(r.status == Status::InvalidInput);
+            CHECK(r.value[0] == 0.f);
+        }
+        // sample() at image coordinates whose ray is NaN: nothing splatted either.
+        int splats = 0;
+        const auto r = est.sample(sc, camera, nan, 0.5f, {}, rng, lookups, [&](float, float, const auto&) { ++splats; });
+        CHECK(r.status == Status::InvalidInput);
+        CHECK(r.value[0] == 0.f);
+        CHECK(splats == 0);
+        CHECK(lookups.count() == 0);
+    });
+}
+
 TEST_CASE("bdpt: nested media behind null interfaces, the camera outside and inside") {
     // L = exp(-0.5 - 1) from z = -3 toward the light; exp(-0.75) from the sphere's centre.
     Sc sc = nested_media();

@@ -39,8 +39,9 @@ void check_transmittance(const TrCase<S, M>& c) {
         constexpr int n = 2000;
         int out_of_range = 0, non_finite = 0;
         for (int i = 0; i < n; ++i) {
-            const auto t = ratio ? transmittance_ratio(c.medium, maj, c.ray, c.tmax, typename S::Wavelengths{}, rng, lookups)
-                                 : transmittance_delta(c.medium, maj, c.ray, c.tmax, typename S::Wavelengths{}, rng, lookups);
+            const auto t = (ratio ? transmittance_ratio(c.medium, maj, c.ray, c.tmax, typename S::Wavelengths{}, rng, lookups)
+                                  : transmittance_delta(c.medium, maj, c.ray, c.tmax, typename S::Wavelengths{}, rng, lookups))
+                               .value;
             non_finite += !all_finite(t);
             // Spectral delta tracking (channels driven by their mean) has per-sample weights
             // above 1 on chromatic media; its mean is checked below instead.

@@ -58,7 +58,6 @@ TEST_CASE("geometry: distances and outward normals of the example shapes") {
     CHECK(!t.intersect(Ray{Vec3(0.8f, 0.8f, 0.f), Vec3(0.f, 0.f, 1.f)}, kInf).found());  // outside the edge
 
     CHECK(!NoSurfaces{}.intersect(ray, kInf).found());
-    CHECK(!NoSurfaces{}.occluded(ray, kInf));
 }
 
 /// The media a ray passes through, boundary by boundary, starting in `start`.
@@ -93,6 +92,39 @@ TEST_CASE("geometry: media across boundaries: leaving and re-entering, nested me
     CHECK(s.occluded(Ray{Vec3(-1.f, 0.f, 0.f), x}, 10.f));
     CHECK(!s.occluded(Ray{Vec3(-1.f, 0.f, 0.f), x}, 7.5f));  // the quad at distance 8 is beyond
     static_assert(Geometry<Shapes> && Geometry<NoSurfaces>);
+}
+
+TEST_CASE("geometry: MediumBox reports a medium's box as null interfaces; nearer picks the closer hit") {
+    const MediumBox fog{nsp::Box{Vec3(-1.f), Vec3(2.f, 1.f, 1.f)}, 4, 2};
+    // From outside along +x: the face x = -1, outward normal -x, into medium 4.
+    const Ray in{Vec3(-3.f, 0.25f, 0.5f), Vec3(1.f, 0.f, 0.f)};
+    SurfaceHit h = fog.intersect(in, kInf);
+    REQUIRE(h.found());
+    CHECK(h.t == doctest::Approx(2.f));
+    CHECK(h.ng == Vec3(-1.f, 0.f, 0.f));
+    CHECK(h.passes_through());
+    CHECK(h.medium_left(in.d) == 2);
+    CHECK(h.medium_entered(in.d) == 4);
+    // From that face, unoffset: the face it starts on is skipped, the far face x = 2 is next.
+    h = fog.intersect(Ray{h.p, in.d}, kInf);
+    REQUIRE(h.found());
+    CHECK(h.t == doctest::Approx(3.f));
+    CHECK(h.ng == Vec3(1.f, 0.f, 0.f));
+    CHECK(h.medium_entered(in.d) == 2);
+    // Along -y from inside: the face y = -1, outward normal -y, leaving medium 4.
+    h = fog.intersect(Ray{Vec3(0.f), Vec3(0.f, -1.f, 0.f)}, kInf);
+    CHECK(h.t == doctest::Approx(1.f));
+    CHECK(h.ng == Vec3(0.f, -1.f, 0.f));
+    CHECK(h.medium_left(Vec3(0.f, -1.f, 0.f)) == 4);
+    // Beyond t_max, a miss beside the box, and a ray leaving it from outside: nothing.
+    CHECK(!fog.intersect(in, 1.5f).found());
+    CHECK(!fog.intersect(Ray{Vec3(-3.f, 5.f, 0.f), Vec3(1.f, 0.f, 0.f)}, kInf).found());
+    CHECK(!fog.intersect(Ray{Vec3(-3.f, 0.f, 0.f), Vec3(-1.f, 0.f, 0.f)}, kInf).found());
+    // Beside a host's own surface: the nearer of the two.
+    Shapes wall;
+    wall.quads.push_back({Vec3(-2.f, -5.f, -5.f), Vec3(0.f, 10.f, 0.f), Vec3(0.f, 0.f, 10.f), {0, -1, -1, -1}});
+    CHECK(nearer(wall.intersect(in, kInf), fog.intersect(in, kInf)).t == doctest::Approx(1.f));
+    CHECK(nearer(fog.intersect(in, kInf), SurfaceHit{}).t == doctest::Approx(2.f));
 }
 
 }  // namespace

@@ -214,8 +214,7 @@ TEST_CASE("spectral surfaces: a bad hit gives Status::InvalidInput and 0") {
             h.t = std::numeric_limits<float>::quiet_NaN();
             return h;
         }
-        bool occluded(const Ray&, float) const noexcept { return false; }
-    };
+        };
     using M = HomogeneousMedium<Rgb>;
     using E = SpectralPathEstimator<channels::SpectralMis, strategy::NullScatteringMis, mis::Balance>;
     const M m(Box{Vec3(-1.f), Vec3(1.f)}, Rgb::Spectrum::Constant(0.1f), Rgb::Spectrum::Constant(1.f));

@@ -249,7 +249,6 @@ TEST_CASE("surface estimators: single scattering from two point lights in a cube
 struct FixedHit {
     SurfaceHit hit;
     SurfaceHit intersect(const Ray&, float) const noexcept { return hit; }
-    bool occluded(const Ray&, float) const noexcept { return false; }
 };
 
 TEST_CASE("surface estimators: bad host input gives Status::InvalidInput and 0, never a NaN") {

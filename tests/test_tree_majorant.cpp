@@ -250,9 +250,9 @@ TEST_CASE_TEMPLATE("tracking through a volume of constant blocks matches the clo
         const auto want = exact(y, z);
         SpecStat<S> ratio_g, delta_g, ratio_low;
         for (int i = 0; i < 40000; ++i) {
-            ratio_g.add(transmittance_ratio(medium, grey_tree, r, kInf, {}, rng, lookups));
-            delta_g.add(transmittance_delta(medium, grey_tree, r, kInf, {}, rng, lookups));
-            ratio_low.add(transmittance_ratio(medium, low_tree, r, kInf, {}, rng, lookups));
+            ratio_g.add(transmittance_ratio(medium, grey_tree, r, kInf, {}, rng, lookups).value);
+            delta_g.add(transmittance_delta(medium, grey_tree, r, kInf, {}, rng, lookups).value);
+            ratio_low.add(transmittance_ratio(medium, low_tree, r, kInf, {}, rng, lookups).value);
         }
         for (int c = 0; c < S::channels; ++c) {
             CAPTURE(c);

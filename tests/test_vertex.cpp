@@ -341,15 +341,17 @@ TEST_CASE("vertex kernels: bad host input gives weight 0 and a status, never NaN
     Pcg32 rng(1, 1);
     NoLookupCount counter;
     const Ray good{Vec3(0.f, 0.f, -3.f), Vec3(0.f, 0.f, 1.f)};
-    // A NaN or negative distance, a NaN or zero direction, an infinite origin: nothing tracked.
+    // A NaN or negative distance, a NaN, zero or not unit direction, an infinite origin: nothing
+    // tracked, and the status says the input was bad.
     for (const auto& [ray, t] : {std::pair{good, nan}, std::pair{good, -1.f}, std::pair{Ray{good.o, Vec3(nan, 0.f, 1.f)}, 5.f},
-                                 std::pair{Ray{good.o, Vec3(0.f)}, 5.f}, std::pair{Ray{Vec3(kInf, 0.f, 0.f), good.d}, 5.f}}) {
+                                 std::pair{Ray{good.o, Vec3(0.f)}, 5.f}, std::pair{Ray{Vec3(kInf, 0.f, 0.f), good.d}, 5.f},
+                                 std::pair{Ray{good.o, Vec3(0.f, 0.f, 2.f)}, 5.f}, std::pair{Ray{good.o, Vec3(0.f, 0.f, 0.5f)}, 5.f}}) {
         const auto seg = k.track(medium, majorant, ray, t, {}, rng, counter);
         CHECK(seg.end == SegmentEnd::InvalidInput);
-        CHECK(flight_status(seg.end) == Status::NonFinite);
+        CHECK(flight_status(seg.end) == Status::InvalidInput);
         CHECK(seg.weight[0] == 0.f);
         const auto sh = k.shadow(medium, majorant, ray, t, {}, rng, counter);
-        CHECK(sh.status == Status::NonFinite);
+        CHECK(sh.status == Status::InvalidInput);
         CHECK(sh.transmittance[0] == 0.f);
     }
     CHECK(k.track(medium, majorant, good, kInf, {}, rng, counter).end != SegmentEnd::InvalidInput);  // no surface: fine
@@ -362,6 +364,31 @@ TEST_CASE("vertex kernels: bad host input gives weight 0 and a status, never NaN
     CHECK(k.light_weight(1.f, nan, 1.f, 1.f, false) == 0.f);
     CHECK(k.light_weight(1.f, 1.f, nan, 1.f, false) == 0.f);
     CHECK(k.light_weight(1.f, 1.f, 1.f, -2.f, false) == 0.f);
+}
+
+TEST_CASE("BSDF models: OneSided scatters only paths arriving on the normal's side, and is black behind") {
+    const LambertianBsdf<S> lambert(Spectrum::Constant(0.6f));
+    const OneSided<S, LambertianBsdf<S>> front{lambert};
+    const Vec3 n(0.f, 1.f, 0.f);
+    const Vec3 down = glm::normalize(Vec3(0.3f, -1.f, 0.1f)), up = -down;  // arriving from above / below
+    const Vec3 wi_up = glm::normalize(Vec3(-0.2f, 1.f, 0.4f));
+    // From the front: the wrapped model, value for value.
+    CHECK(front.eval(down, wi_up, n, {})[0] == lambert.eval(down, wi_up, n, {})[0]);
+    CHECK(front.pdf(down, wi_up, n) == lambert.pdf(down, wi_up, n));
+    const auto s = front.sample(down, n, 0.3f, 0.7f, {});
+    const auto t = lambert.sample(down, n, 0.3f, 0.7f, {});
+    CHECK(s.pdf == t.pdf);
+    CHECK(s.wi == t.wi);
+    CHECK(s.pdf > 0.f);
+    // From behind (the two-sided model reflects there): nothing.
+    CHECK(lambert.pdf(up, -wi_up, n) > 0.f);
+    CHECK(front.eval(up, -wi_up, n, {})[0] == 0.f);
+    CHECK(front.pdf(up, -wi_up, n) == 0.f);
+    CHECK(front.sample(up, n, 0.3f, 0.7f, {}).pdf == 0.f);
+    // Delta-ness and null interfaces pass through the adapter.
+    CHECK(OneSided<S, MirrorBsdf<S>>::is_delta);
+    CHECK(!OneSided<S, LambertianBsdf<S>>::is_delta);
+    CHECK(OneSided<S, NullInterface<S>>::passes_through);
 }
 
 TEST_CASE("BSDF models: sampling matches eval and pdf; Lambertian reflects albedo; validation") {

@@ -383,8 +383,8 @@ TEST_CASE("tracking through OpenVDB's constant tiles matches the closed-form tra
             Stat ratio, delta;
             LookupCount c;
             for (int n = 0; n < 20000; ++n) {
-                ratio.add(transmittance_ratio(medium, maj, r, kInf, {}, rng, c)[0]);
-                delta.add(transmittance_delta(medium, maj, r, kInf, {}, rng, c)[0]);
+                ratio.add(transmittance_ratio(medium, maj, r, kInf, {}, rng, c).value[0]);
+                delta.add(transmittance_delta(medium, maj, r, kInf, {}, rng, c).value[0]);
             }
             CAPTURE(j);
             CAPTURE(want);

@@ -63,7 +63,7 @@ int main() {
     const int n = 100000;
     double sum = 0.0;
     for (int i = 0; i < n; ++i)
-        sum += nsp::transmittance_ratio(medium, majorant, ray, 10.f, {}, rng, counter)[0];
+        sum += nsp::transmittance_ratio(medium, majorant, ray, 10.f, {}, rng, counter).value[0];
     const double estimate = sum / n, exact = std::exp(-1.0);
     std::printf("consumer: T = %.4f, exact %.4f\n", estimate, exact);
     // Ratio tracking here has per-sample standard deviation < 0.5, so the SE is < 0.0016; 0.01 is > 6 SE.

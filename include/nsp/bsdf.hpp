@@ -48,6 +48,13 @@ concept Bsdf = SpectralMode<S> && requires(const B& b, const Vec3& w, float u, c
 };
 
 namespace detail {
+/// Whether BSDF model B says every lobe is a delta lobe (its optional `is_delta`).
+template <class B>
+inline constexpr bool bsdf_delta_v = [] {
+    if constexpr (requires { B::is_delta; }) return bool(B::is_delta);
+    else return false;
+}();
+
 /// The unit normal on the side of the surface the path arrived from (opposite to wo).
 inline Vec3 facing(const Vec3& wo, const Vec3& n) noexcept { return glm::dot(wo, n) > 0.f ? -n : n; }
 }  // namespace detail
@@ -69,7 +76,7 @@ public:
     BsdfSample<S> sample(const Vec3& wo, const Vec3& n, float u1, float u2,
                          const typename S::Wavelengths& lambda = {}) const noexcept {
         const Vec3 up = detail::facing(wo, n);
-        if (!(std::abs(glm::dot(up, up) - 1.f) < 1e-3f)) return BsdfSample<S>{};  // a NaN or non-unit normal: no sample
+        if (!unit_length(up)) return BsdfSample<S>{};  // a NaN or non-unit normal: no sample
         const float cos_theta = std::sqrt(std::max(0.f, 1.f - u1));  // p(cos) = 2 cos: cosine-weighted
         BsdfSample<S> s;
         s.wi = direction_around(up, cos_theta, 2.f * kPi * u2);
@@ -107,7 +114,7 @@ public:
     BsdfSample<S> sample(const Vec3& wo, const Vec3& n, float, float,
                          const typename S::Wavelengths& lambda = {}) const noexcept {
         BsdfSample<S> s;
-        if (!(std::abs(glm::dot(n, n) - 1.f) < 1e-3f)) return s;  // a NaN or non-unit normal: no sample
+        if (!unit_length(n)) return s;  // a NaN or non-unit normal: no sample
         s.wi = wo - 2.f * glm::dot(wo, n) * n;
         s.pdf = 1.f;
         s.value = S::sample(reflectance_, lambda);
@@ -121,6 +128,32 @@ public:
 
 private:
     typename S::Coefficient reflectance_;
+};
+
+/// Any BSDF made one-sided: it scatters only paths that arrive on the side the normal points to
+/// (wo . n < 0, wo the direction the path travelled) and is black from behind (eval and pdf 0, no
+/// sample), as Mitsuba's diffuse and conductor models are by default. nsp's models are two-sided
+/// (they scatter on whichever side the path arrives); a host matching a one-sided renderer wraps
+/// them, `nsp::OneSided<S, nsp::LambertianBsdf<S>>{nsp::LambertianBsdf<S>(albedo)}`, and reports
+/// the shading normal on the front side of each surface.
+template <SpectralMode S, class B>
+    requires Bsdf<B, S>
+struct OneSided {
+    static constexpr bool passes_through = B::passes_through;
+    static constexpr bool is_delta = detail::bsdf_delta_v<B>;
+    B bsdf;
+
+    BsdfSample<S> sample(const Vec3& wo, const Vec3& n, float u1, float u2,
+                         const typename S::Wavelengths& lambda = {}) const noexcept {
+        return glm::dot(wo, n) < 0.f ? bsdf.sample(wo, n, u1, u2, lambda) : BsdfSample<S>{};
+    }
+    typename S::Spectrum eval(const Vec3& wo, const Vec3& wi, const Vec3& n,
+                              const typename S::Wavelengths& lambda = {}) const noexcept {
+        return glm::dot(wo, n) < 0.f ? bsdf.eval(wo, wi, n, lambda) : typename S::Spectrum(S::Spectrum::Zero());
+    }
+    float pdf(const Vec3& wo, const Vec3& wi, const Vec3& n) const noexcept {
+        return glm::dot(wo, n) < 0.f ? bsdf.pdf(wo, wi, n) : 0.f;
+    }
 };
 
 /// The boundary of a medium between index-matched sides: the path goes straight on (wi = wo,
@@ -138,5 +171,8 @@ struct NullInterface {
     }
     float pdf(const Vec3&, const Vec3&, const Vec3&) const noexcept { return 0.f; }
 };
+
+static_assert(Bsdf<LambertianBsdf<Mono>, Mono> && Bsdf<MirrorBsdf<Rgb>, Rgb> && Bsdf<NullInterface<Mono>, Mono> &&
+              Bsdf<OneSided<Rgb, LambertianBsdf<Rgb>>, Rgb> && Bsdf<OneSided<Mono, MirrorBsdf<Mono>>, Mono>);
 
 }  // namespace nsp

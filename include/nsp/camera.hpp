@@ -34,7 +34,6 @@ public:
     /// view direction, a field of view outside (0, 180) degrees or an aspect that is not > 0.
     PinholeCamera(const Vec3& eye, const Vec3& target, const Vec3& up, float vfov_degrees, float aspect = 1.f)
         : eye_(eye) {
-        auto finite = [](const Vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
         if (!finite(eye) || !finite(target) || !finite(up))
             detail::fail("PinholeCamera: a non-finite eye, target or up vector is not allowed");
         const Vec3 d = target - eye;

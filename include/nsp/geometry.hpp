@@ -6,6 +6,7 @@
 // keep the record trivially copyable and the same on a GPU.
 #pragma once
 
+#include <algorithm>
 #include <concepts>
 
 #include "core/math.hpp"
@@ -33,21 +34,76 @@ struct SurfaceHit {
 };
 
 /// A host's geometry: `intersect(ray, t_max)` is the closest surface on (0, t_max) (t = kInf if
-/// none), `occluded(ray, t_max)` whether a surface that is not a pass-through boundary lies on
-/// (0, t_max): what a shadow ray asks (index-matched boundaries do not block it; the media on its
-/// way are the host's to track, one VertexKernels::shadow per medium).
+/// none), the only query nsp makes: paths and shadow rays alike walk from surface to surface,
+/// crossing null interfaces (where the medium changes) and stopping at anything else. The ray
+/// starts on the surface it leaves, unoffset: `intersect` must not report that surface again (an
+/// epsilon, or the primitive's id), as every renderer's own does. A host's occlusion (any-hit)
+/// query is its own business: nsp needs the closest hit, since a shadow ray is tracked through
+/// every medium up to the blocker or the light.
 template <class G>
 concept Geometry = requires(const G& g, const Ray& r, float t) {
     { g.intersect(r, t) } -> std::same_as<SurfaceHit>;
-    { g.occluded(r, t) } -> std::same_as<bool>;
 };
 
 /// A scene without surfaces: media in empty space. Every query is answered at no cost.
 struct NoSurfaces {
     SurfaceHit intersect(const Ray&, float) const noexcept { return {}; }
-    bool occluded(const Ray&, float) const noexcept { return false; }
 };
 
 static_assert(Geometry<NoSurfaces>);
+
+/// The faces of a medium's box as null interfaces (THEORY 5.8), for a host's `intersect` to
+/// report beside its own surfaces: the medium `inside` fills `box`, `outside` surrounds it. Hits
+/// closer than `epsilon` (in the scene's units) are the face a ray starts on and are not reported.
+/// A host whose medium is bounded by its own meshes reports those instead.
+///
+///     SurfaceHit intersect(const Ray& r, float t_max) const {
+///         return nsp::nearer(my_bvh.intersect(r, t_max), fog_box.intersect(r, t_max));
+///     }
+struct MediumBox {
+    Box box;
+    int inside = 0;        ///< the medium in the box (an index into the scene's media)
+    int outside = -1;      ///< the medium around it (-1: vacuum)
+    float epsilon = 1e-4f;
+
+    /// The first face on (epsilon, t_max), a null interface (no material, no light), its outward
+    /// normal as ng and ns; t = kInf if none.
+    SurfaceHit intersect(const Ray& r, float t_max) const noexcept {
+        float t0 = -kInf, t1 = kInf;
+        int a0 = 0, a1 = 0;
+        for (int a = 0; a < 3; ++a) {
+            if (r.d[a] == 0.f) {
+                if (r.o[a] < box.lo[a] || r.o[a] > box.hi[a]) return {};
+                continue;
+            }
+            float ta = (box.lo[a] - r.o[a]) / r.d[a], tb = (box.hi[a] - r.o[a]) / r.d[a];
+            if (ta > tb) std::swap(ta, tb);
+            if (ta > t0) t0 = ta, a0 = a;
+            if (tb < t1) t1 = tb, a1 = a;
+        }
+        if (!(t0 <= t1)) return {};
+        float t;
+        int axis;
+        if (t0 > epsilon) t = t0, axis = a0;
+        else if (t1 > epsilon) t = t1, axis = a1;
+        else return {};
+        if (!(t < t_max)) return {};
+        SurfaceHit h;
+        h.t = t;
+        h.p = r.at(t);
+        // The outward normal of the face: against the ray where it enters, along it where it leaves.
+        Vec3 n(0.f);
+        n[axis] = (t == t0) == (r.d[axis] > 0.f) ? -1.f : 1.f;
+        h.ng = h.ns = n;
+        h.medium_front = outside;
+        h.medium_back = inside;
+        return h;
+    }
+};
+
+static_assert(Geometry<MediumBox>);
+
+/// The nearer of two hits (a host's own and a MediumBox's, say).
+inline SurfaceHit nearer(const SurfaceHit& a, const SurfaceHit& b) noexcept { return b.t < a.t ? b : a; }
 
 }  // namespace nsp

@@ -19,6 +19,7 @@
 #include "majorants/grid.hpp"
 #include "majorants/tree.hpp"
 #include "majorants/choose.hpp"
+#include "majorants/crossing.hpp"
 #include "media/blackbody.hpp"
 #include "media/emissive.hpp"
 #include "media/exponential.hpp"

@@ -3,10 +3,13 @@
 // Samplers report their pdfs as running ratios (tracking.hpp). These functions recompute the
 // absolute pdf of a given set of vertices from scratch, from the majorant and the medium, so
 // tests can check that what a sampler reports is what it did, and hosts can weight paths that
-// another strategy produced.
+// another strategy produced. No sampler produces vertices on a ray that is not usable_ray (a
+// non-finite origin, a direction that is not unit length) or up to a NaN distance: the log pdfs of
+// such a ray are -inf.
 #pragma once
 
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <type_traits>
 #include <span>
@@ -87,6 +90,7 @@ template <AbsorptionPolicy A, Medium M, MajorantPolicy<M> Maj>
 double delta_segment_log_pdf(const M& medium, const Maj& majorant, const Ray& ray, float tmax,
                              const typename M::Spectral::Wavelengths& lambda,
                              std::span<const float> nulls, SegmentEnd end, float t_end) {
+    if (!usable_ray(ray) || std::isnan(tmax)) return -std::numeric_limits<double>::infinity();
     double lp = 0.0;
     float prev = 0.f;
     for (const float t : nulls) {
@@ -108,6 +112,7 @@ template <Medium M, MajorantPolicy<M> Maj>
 double ratio_segment_log_pdf(const M&, const Maj& majorant, const Ray& ray, float tmax,
                              const typename M::Spectral::Wavelengths& lambda,
                              std::span<const float> nulls) {
+    if (!usable_ray(ray) || std::isnan(tmax)) return -std::numeric_limits<double>::infinity();
     double lp = 0.0;
     float prev = 0.f;
     for (const float t : nulls) {
@@ -143,6 +148,7 @@ template <AbsorptionPolicy A, Medium M, MajorantPolicy<M> Maj>
 double channel_delta_segment_log_pdf(const M& medium, const Maj& majorant, const Ray& ray, float tmax,
                                      const typename M::Spectral::Wavelengths& lambda, int c,
                                      std::span<const float> nulls, SegmentEnd end, float t_end) {
+    if (!usable_ray(ray) || std::isnan(tmax)) return -std::numeric_limits<double>::infinity();
     double lp = 0.0;
     float prev = 0.f;
     auto vertex = [&](float t, SegmentEnd e) {
@@ -163,6 +169,7 @@ template <Medium M, MajorantPolicy<M> Maj>
 double channel_ratio_segment_log_pdf(const Maj& majorant, const Ray& ray, float tmax,
                                      const typename M::Spectral::Wavelengths& lambda, int c,
                                      std::span<const float> nulls) {
+    if (!usable_ray(ray) || std::isnan(tmax)) return -std::numeric_limits<double>::infinity();
     double lp = 0.0;
     float prev = 0.f;
     for (const float t : nulls) {

@@ -7,6 +7,7 @@
 
 #include "light.hpp"
 #include "majorant.hpp"
+#include "majorants/crossing.hpp"
 #include "medium.hpp"
 #include "phase.hpp"
 
@@ -26,14 +27,17 @@ struct Scene {
     P phase;
     Lights<Spectral> lights;
 
-    /// Throws InvalidArgument if the sphere light overlaps the medium's bounds, or if a majorant
+    /// Throws InvalidArgument if the sphere light overlaps the medium's bounds, if a majorant
     /// with one value (GlobalMajorant) has a value its bound policy forbids for this medium (e.g. one
-    /// built for another, less dense medium under bound::Guaranteed).
+    /// built for another, less dense medium under bound::Guaranteed), or if a flight through the
+    /// medium would take more than kMaxFlightCollisions tentative collisions under the majorant
+    /// (majorants/crossing.hpp: a render that would run away).
     Scene(M m, Maj maj, P p, Lights<Spectral> l)
         : medium(std::move(m)), majorant(std::move(maj)), phase(std::move(p)), lights(std::move(l)) {
         if constexpr (requires(const Maj& j) { { j.value() } -> std::convertible_to<float>; })
             detail::require_majorant_value<bound_policy_t<Maj>>(majorant.value(), medium.max_extinction(),
                                                                 "Scene: the majorant value", " of the scene's medium");
+        detail::require_trackable(medium, majorant, "Scene");
         if (const auto& s = lights.sphere()) {
             const Box b = medium.bounds();
             const Vec3 nearest = glm::clamp(s->center, b.lo, b.hi);

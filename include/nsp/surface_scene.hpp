@@ -29,19 +29,12 @@
 #include "geometry.hpp"
 #include "light_sampler.hpp"
 #include "majorant.hpp"
+#include "majorants/crossing.hpp"
 #include "medium.hpp"
 #include "media/emissive.hpp"
 #include "phase.hpp"
 
 namespace nsp {
-
-namespace detail {
-template <class B>
-constexpr bool bsdf_is_delta() noexcept {
-    if constexpr (requires { B::is_delta; }) return bool(B::is_delta);
-    else return false;
-}
-}  // namespace detail
 
 /// A table of BSDFs of the model types Bs..., one vector per type (no virtual calls). A
 /// material is named by its index in the order the constructor got them, vector by vector.
@@ -82,7 +75,7 @@ public:
     /// Whether every lobe of the material is a delta lobe (light sampling cannot reach its paths).
     bool is_delta(int material) const noexcept {
         bool d = false;
-        visit(material, [&](const auto& b) { d = detail::bsdf_is_delta<std::decay_t<decltype(b)>>(); });
+        visit(material, [&](const auto& b) { d = detail::bsdf_delta_v<std::decay_t<decltype(b)>>; });
         return d;
     }
 
@@ -124,7 +117,9 @@ struct SurfaceScene {
     int camera_medium = -1;
 
     /// Throws InvalidArgument if `camera_medium` is not -1 or an index into `media`, if a
-    /// medium's single-valued majorant (GlobalMajorant) has a value its bound policy forbids, or
+    /// medium's single-valued majorant (GlobalMajorant) has a value its bound policy forbids, if a
+    /// flight through a medium would take more than kMaxFlightCollisions tentative collisions under
+    /// its majorant (majorants/crossing.hpp: a render that would run away), or
     /// if the lights have a BoundingSphere (light subpaths from infinity) that a medium's bounds
     /// do not lie inside (the geometry must lie inside it too; the host's is not checked).
     SurfaceScene(G g, std::vector<SceneMedium<M, Maj, P>> m, Mats mats, Ls l, int camera = -1)
@@ -133,11 +128,13 @@ struct SurfaceScene {
         if (camera_medium < -1 || camera_medium >= int(media.size()))
             detail::fail("SurfaceScene camera_medium = ", camera_medium, " is not allowed: it must be -1 (vacuum) or "
                          "an index into the ", media.size(), " media");
-        for (const auto& s : media)
+        for (const auto& s : media) {
             if constexpr (requires(const Maj& j) { { j.value() } -> std::convertible_to<float>; })
                 detail::require_majorant_value<bound_policy_t<Maj>>(s.majorant.value(), s.medium.max_extinction(),
                                                                     "SurfaceScene: a medium's majorant value",
                                                                     " of that medium");
+            detail::require_trackable(s.medium, s.majorant, "SurfaceScene");
+        }
         if constexpr (requires(const Ls& x) { x.bounding_sphere(); })
             if (lights.emits_from_infinity()) check_inside(lights.bounding_sphere());
         build_emission_selection();

@@ -16,6 +16,7 @@
 
 #include "core/counter.hpp"
 #include "core/rng.hpp"
+#include "core/status.hpp"
 #include "majorant.hpp"
 #include "medium.hpp"
 
@@ -153,10 +154,11 @@ struct SegmentRecord {
 template <class V = float>
 struct FlightEnd {
     bool stopped = false;   ///< the callback stopped at `t`; otherwise the ray passed tmax
-    bool aborted = false;   ///< gave up after `max_collisions` tentative collisions, or rejected
+    bool aborted = false;   ///< gave up after `max_collisions` tentative collisions, rejected, or invalid
     bool rejected = false;  ///< bound::Reject found mu_t > mu_bar at `t` (then `aborted` is set too)
     float t = 0.f;          ///< the stopping distance
     V tau_tail{};           ///< majorant optical depth from the last collision to tmax if passed
+    bool invalid = false;   ///< the ray was not usable_ray or tmin / tmax NaN: nothing was tracked (`aborted` is set too)
 };
 
 /// The default limit on tentative collisions in one flight. It only matters where a majorant is
@@ -218,7 +220,9 @@ struct StepReport {
 /// (THEORY 5.3). The majorant's bound policy acts on each lookup before the callback sees it
 /// (bound::Clamp clamps it, bound::Reject ends the flight with `rejected`). Counts one density
 /// lookup per tentative collision, and the DDA steps of a grid majorant if the counter records
-/// them. Never throws.
+/// them. A ray that is not usable_ray (a non-finite origin, a direction that is not unit length) or
+/// a NaN tmin or tmax ends the flight at once with `invalid` (and `aborted`): nothing is tracked.
+/// Never throws.
 template <Medium M, MajorantPolicy<M> Maj, UniformRng R, LookupCounter C, class F>
     requires CollisionCallback<F, typename M::Spectral, MajorantValue<Maj, M>>
 FlightEnd<MajorantValue<Maj, M>> free_flight(const M& medium, const Maj& majorant, const Ray& ray, float tmin,
@@ -229,6 +233,11 @@ FlightEnd<MajorantValue<Maj, M>> free_flight(const M& medium, const Maj& majoran
     using V = MajorantValue<Maj, M>;
     using B = bound_policy_t<Maj>;
     constexpr bool grey = std::is_same_v<V, float>;
+    if (!usable_ray(ray) || std::isnan(tmin) || std::isnan(tmax)) [[unlikely]] {
+        FlightEnd<V> bad{false, true, false, 0.f, V{}, true};
+        if constexpr (!grey) bad.tau_tail.setZero();
+        return bad;
+    }
     auto segments = majorant.iterate(ray, tmin, tmax, lambda);
     const detail::StepReport<decltype(segments), C> report{segments, counter};
     V tau{};                    // majorant optical depth since the last tentative collision
@@ -298,13 +307,26 @@ enum class SegmentEnd : std::uint8_t {
     Aborted,     ///< the collision limit was reached; the estimate is discarded (weight 0)
     Rejected,    ///< bound::Reject met mu_t > mu_bar; the estimate is discarded (weight 0)
     Overflowed,  ///< per-channel tracking: a contribution or pdf left float's range; the estimate is discarded (weight 0)
-    InvalidInput,  ///< VertexKernels: the host's ray or distance was NaN, infinite or negative; nothing was tracked (weight 0)
+    InvalidInput,  ///< the ray was not usable_ray, or its distance NaN (negative, for VertexKernels); nothing was tracked (weight 0)
 };
 
-/// How an aborted flight ends a segment: Rejected (bound::Reject) or Aborted (collision limit).
+/// How an aborted flight ends a segment: InvalidInput, Rejected (bound::Reject) or Aborted
+/// (collision limit).
 template <class V>
 SegmentEnd aborted_end(const FlightEnd<V>& f) noexcept {
-    return f.rejected ? SegmentEnd::Rejected : SegmentEnd::Aborted;
+    return f.invalid ? SegmentEnd::InvalidInput : f.rejected ? SegmentEnd::Rejected : SegmentEnd::Aborted;
+}
+
+/// The status of a path one of whose flights ended with `end`: Aborted, Rejected and InvalidInput
+/// as themselves, Overflowed as NonFinite, everything else Ok.
+inline Status flight_status(SegmentEnd end) noexcept {
+    switch (end) {
+        case SegmentEnd::Aborted: return Status::Aborted;
+        case SegmentEnd::Rejected: return Status::Rejected;
+        case SegmentEnd::Overflowed: return Status::NonFinite;
+        case SegmentEnd::InvalidInput: return Status::InvalidInput;
+        default: return Status::Ok;
+    }
 }
 
 /// The outcome of delta tracking one segment.
@@ -479,25 +501,33 @@ RatioTrack<typename M::Spectral> track_ratio(const M& medium, const Maj& majoran
     return cb.finish();
 }
 
-/// Ratio-tracking transmittance estimate between two points (Novak et al. 2014).
+/// A transmittance estimate and its status: `value` 0 unless the status is Ok.
+template <SpectralMode S>
+struct TransmittanceSample {
+    typename S::Spectrum value;
+    Status status = Status::Ok;
+};
+
+/// Ratio-tracking transmittance estimate between two points (Novak et al. 2014) along `ray` over
+/// [0, tmax]; status InvalidInput (value 0) for a ray that is not usable_ray or a NaN tmax, Aborted
+/// or Rejected where the flight failed.
 template <Medium M, MajorantPolicy<M> Maj, UniformRng R, LookupCounter C>
-typename M::Spectral::Spectrum transmittance_ratio(const M& medium, const Maj& majorant,
-                                                   const Ray& ray, float tmax,
-                                                   const typename M::Spectral::Wavelengths& lambda,
-                                                   R& rng, C& counter) {
-    return track_ratio<absorption::Event, false>(medium, majorant, ray, tmax, lambda, rng, counter)
-        .transmittance;
+TransmittanceSample<typename M::Spectral> transmittance_ratio(const M& medium, const Maj& majorant, const Ray& ray,
+                                                              float tmax, const typename M::Spectral::Wavelengths& lambda,
+                                                              R& rng, C& counter) {
+    const auto r = track_ratio<absorption::Event, false>(medium, majorant, ray, tmax, lambda, rng, counter);
+    return {r.transmittance, flight_status(r.end)};
 }
 
-/// Delta-tracking transmittance estimate: the null weight if the ray passes tmax, else 0.
+/// Delta-tracking transmittance estimate: the null weight if the ray passes tmax, else 0; the
+/// status as transmittance_ratio's.
 template <Medium M, MajorantPolicy<M> Maj, UniformRng R, LookupCounter C>
-typename M::Spectral::Spectrum transmittance_delta(const M& medium, const Maj& majorant,
-                                                   const Ray& ray, float tmax,
-                                                   const typename M::Spectral::Wavelengths& lambda,
-                                                   R& rng, C& counter) {
+TransmittanceSample<typename M::Spectral> transmittance_delta(const M& medium, const Maj& majorant, const Ray& ray,
+                                                              float tmax, const typename M::Spectral::Wavelengths& lambda,
+                                                              R& rng, C& counter) {
     const auto d = track_delta<absorption::Event>(medium, majorant, ray, tmax, lambda, rng, counter);
     using Spec = typename M::Spectral::Spectrum;
-    return d.end == SegmentEnd::Passed ? d.weight : Spec(Spec::Zero());
+    return {d.end == SegmentEnd::Passed ? d.weight : Spec(Spec::Zero()), flight_status(d.end)};
 }
 
 }  // namespace nsp

@@ -210,10 +210,10 @@ public:
     /// Delta-tracks `ray` through `medium` up to `t_max` (the host's surface distance, kInf for
     /// none): Scattered at a real vertex seg.t, Passed at t_max, Absorbed (absorption::Event), or
     /// a failed flight (flight_status(seg.end) says which). seg.weight multiplies the throughput;
-    /// seg.null_pdf_product multiplies the path's product since its last real vertex. A ray with a
-    /// non-finite origin or direction, a zero direction, or a NaN or negative t_max ends
-    /// SegmentEnd::InvalidInput (flight_status: NonFinite) with weight 0: bad host input is never
-    /// tracked as if it were a ray.
+    /// seg.null_pdf_product multiplies the path's product since its last real vertex. A ray that is
+    /// not usable_ray (a non-finite origin, a direction that is not unit length) or a NaN or
+    /// negative t_max ends SegmentEnd::InvalidInput (flight_status: Status::InvalidInput) with
+    /// weight 0: bad host input is never tracked as if it were a ray.
     template <Medium M, MajorantPolicy<M> Maj, UniformRng R, LookupCounter C>
     DeltaTrack<typename M::Spectral> track(const M& medium, const Maj& majorant, const Ray& ray, float t_max,
                                            const typename M::Spectral::Wavelengths& lambda, R& rng, C& counter) const {
@@ -236,16 +236,16 @@ public:
     /// The transmittance of a shadow ray through `medium` up to `distance` (ratio tracking), and
     /// the product of the null probabilities delta tracking with policy A would have had at its
     /// nulls (only where St weighs by null-scattering pdfs; 1 otherwise). Never throws; bad input
-    /// as for track() gives transmittance 0 and Status::NonFinite.
+    /// as for track() gives transmittance 0 and Status::InvalidInput.
     template <Medium M, MajorantPolicy<M> Maj, UniformRng R, LookupCounter C>
     ShadowTransmittance<typename M::Spectral> shadow(const M& medium, const Maj& majorant, const Ray& ray,
                                                      float distance, const typename M::Spectral::Wavelengths& lambda,
                                                      R& rng, C& counter) const {
-        if (!valid_ray(ray, distance)) return {M::Spectral::Spectrum::Zero(), 1.f, Status::NonFinite};
+        if (!valid_ray(ray, distance)) return {M::Spectral::Spectrum::Zero(), 1.f, Status::InvalidInput};
         const auto tr = track_ratio<A, St::null_pdfs>(medium, majorant, ray, distance, lambda, rng, counter);
         ShadowTransmittance<typename M::Spectral> s;
-        if (tr.end == SegmentEnd::Aborted || tr.end == SegmentEnd::Rejected) {
-            s.status = flight_status(tr.end);
+        if (const Status fs = flight_status(tr.end); fs != Status::Ok) {
+            s.status = fs;
             return s;
         }
         if (tr.end == SegmentEnd::Terminated) return s;  // every channel below float's range: 0
@@ -323,9 +323,7 @@ public:
 
 private:
     static bool valid_ray(const Ray& r, float t_max) noexcept {
-        const bool finite = std::isfinite(r.o.x) && std::isfinite(r.o.y) && std::isfinite(r.o.z) &&
-                            std::isfinite(r.d.x) && std::isfinite(r.d.y) && std::isfinite(r.d.z);
-        return finite && t_max >= 0.f && glm::dot(r.d, r.d) > 0.f;  // a NaN t_max fails the comparison
+        return usable_ray(r) && t_max >= 0.f;  // a NaN t_max fails the comparison
     }
     static bool valid(float survival, float direction_pdf, float null_pdf_product, float light_pdf) noexcept {
         return survival >= 0.f && direction_pdf >= 0.f && null_pdf_product >= 0.f && light_pdf >= 0.f;

@@ -14,7 +14,11 @@
 //   SpectralMis (Weight, with equiangular slots), recorded and re-evaluated with
 //   channel_delta_segment_log_pdf; on grey majorants also SpectralTrackingAverage (Event) and
 //   SpectralTrackingMax (Weight);
-// - one of seven path estimators (a representative subset, see kEstimators below).
+// - one of seven path estimators (a representative subset, see kEstimators below);
+// - last (its bytes are read after everything else, so the corpus keeps its meaning): a ray
+//   that is not usable_ray (a direction of length 0.5, 1.01 or 2, a zero, NaN or infinite
+//   direction, a NaN or infinite origin) or a NaN distance, at every public tracking entry and at
+//   both path estimators: each must answer InvalidInput and no estimate (0), never a number.
 //
 // Work is bounded: a case whose majorant optical depth across the medium's box exceeds kBudget
 // is skipped, paths are at most 8 real vertices deep, and free_flight's own calls stop after 64
@@ -747,8 +751,14 @@ void drive_grey(FuzzRng& rng, const M& medium, const Maj& maj, const Ray& ray, f
     }
     if constexpr (A::as_event) {
         g_context = "transmittance_ratio / transmittance_delta";
-        const auto tr = transmittance_ratio(medium, maj, ray, tmax, lambda, rng, counter);
-        const auto td = transmittance_delta(medium, maj, ray, tmax, lambda, rng, counter);
+        const auto trs = transmittance_ratio(medium, maj, ray, tmax, lambda, rng, counter);
+        const auto tds = transmittance_delta(medium, maj, ray, tmax, lambda, rng, counter);
+        // A failed flight (or an unusable ray) reports its status and no estimate.
+        NSP_FUZZ_CHECK(trs.status == Status::Ok || (trs.value == 0.f).all());
+        NSP_FUZZ_CHECK(tds.status == Status::Ok || (tds.value == 0.f).all());
+        NSP_FUZZ_CHECK((trs.status == Status::InvalidInput) == !usable_ray(ray));
+        const auto& tr = trs.value;
+        const auto& td = tds.value;
         if constexpr (kSigned) {
             NSP_FUZZ_CHECK(no_nan(tr) && no_nan(td));
         } else {
@@ -1053,6 +1063,83 @@ void run_estimator_any(Input& in, FuzzRng& rng, const Base& base, const Box& box
      ...);
 }
 
+
+/// A ray the kernels must refuse, from a usable one (see usable_ray), or a NaN distance.
+struct BadRay {
+    Ray ray;
+    float tmax;
+};
+
+BadRay make_unusable(Input& in, Ray r, float tmax) {
+    constexpr float nan = std::numeric_limits<float>::quiet_NaN();
+    switch (in.pick(9)) {
+        case 0: r.d *= 0.5f; break;
+        case 1: r.d *= 1.01f; break;  // |d|^2 = 1.0201: outside kUnitTolerance
+        case 2: r.d *= 2.f; break;
+        case 3: r.d = Vec3(0.f); break;
+        case 4: r.d.y = nan; break;
+        case 5: r.d = Vec3(kInf, 0.f, 0.f); break;
+        case 6: r.o.x = nan; break;
+        case 7: r.o.z = -kInf; break;
+        default: tmax = nan;
+    }
+    return {r, tmax};
+}
+
+/// Every public tracking entry and both path estimators on an unusable ray (see the header):
+/// InvalidInput, no lookup and no estimate.
+template <SpectralMode S, class M, class Lambda>
+void run_unusable(Input& in, FuzzRng& rng, const M& medium, const std::array<int, 3>& res, const Lambda& lambda) {
+    if (!in.flag()) return;  // also where the input has ended: the stage is new, the corpus predates it
+    g_context = "unusable rays";
+    using Spec = typename S::Spectrum;
+    std::optional<GlobalMajorant<M>> maj;
+    try {
+        maj.emplace(medium);
+    } catch (const InvalidArgument&) {
+        return;
+    }
+    const Box b = medium.bounds();
+    const BadRay bad = make_unusable(in, make_ray(in, b, res), make_tmax(in, b));
+    const Ray& r = bad.ray;
+    const float tmax = bad.tmax;
+    LookupCount counter;
+    auto none = [](float, const auto&, const auto&, const auto&) { return true; };
+    const auto f = free_flight(medium, *maj, r, 0.f, tmax, lambda, rng, counter, none);
+    NSP_FUZZ_CHECK(f.invalid && f.aborted && !f.stopped);
+    const auto d = track_delta<absorption::Weight>(medium, *maj, r, tmax, lambda, rng, counter);
+    NSP_FUZZ_CHECK(d.end == SegmentEnd::InvalidInput && (d.weight == 0.f).all());
+    const auto t = track_ratio<absorption::Event, true>(medium, *maj, r, tmax, lambda, rng, counter);
+    NSP_FUZZ_CHECK(t.end == SegmentEnd::InvalidInput && (t.transmittance == 0.f).all());
+    for (const auto& sample : {transmittance_ratio(medium, *maj, r, tmax, lambda, rng, counter),
+                               transmittance_delta(medium, *maj, r, tmax, lambda, rng, counter)})
+        NSP_FUZZ_CHECK(sample.status == Status::InvalidInput && (sample.value == 0.f).all());
+    ChannelPathState<S> st;
+    const auto cd = track_channels_delta<channels::SpectralMis, absorption::Weight>(medium, *maj, r, tmax, lambda, 0, st,
+                                                                                    true, rng, counter);
+    NSP_FUZZ_CHECK(cd.end == SegmentEnd::InvalidInput);
+    const auto cr = track_channels_ratio<channels::SpectralMis, absorption::Weight>(medium, *maj, r, tmax, lambda, 0,
+                                                                                    Spec::Ones(), true, rng, counter);
+    NSP_FUZZ_CHECK(cr.end == SegmentEnd::InvalidInput && (cr.f == 0.f).all());
+    const VertexKernels<strategy::NullScatteringMis, mis::Balance> k;
+    NSP_FUZZ_CHECK(k.track(medium, *maj, r, tmax, lambda, rng, counter).end == SegmentEnd::InvalidInput);
+    NSP_FUZZ_CHECK(k.shadow(medium, *maj, r, tmax, lambda, rng, counter).status == Status::InvalidInput);
+    NSP_FUZZ_CHECK(counter.count() == 0);
+    if (std::isnan(tmax)) return;  // the estimators take a camera ray alone
+    std::optional<Scene<M, GlobalMajorant<M>, IsotropicPhase>> scene;
+    try {
+        scene.emplace(medium, *maj, IsotropicPhase{}, Lights<S>{});
+    } catch (const InvalidArgument&) {
+        return;  // a majorant under which flights would run away (majorants/crossing.hpp)
+    }
+    const RadianceSample<S> p =
+        PathEstimator<strategy::NullScatteringMis, mis::Balance>{}.radiance(*scene, r, lambda, rng, counter);
+    NSP_FUZZ_CHECK(p.status == Status::InvalidInput && (p.value == 0.f).all());
+    const RadianceSample<S> c = SpectralPathEstimator<channels::SpectralMis, strategy::NullScatteringMis, mis::Balance>{}
+                                    .radiance(*scene, r, lambda, rng, counter);
+    NSP_FUZZ_CHECK(c.status == Status::InvalidInput && (c.value == 0.f).all());
+}
+
 // ---------------------------------------------------------------------------------------------
 
 template <SpectralMode S>
@@ -1076,6 +1163,7 @@ void run(Input& in) {
     if constexpr (is_hero_v<S>) lambda = S::Wavelengths::sample(in.unit());
     run_tracking_any<S>(in, rng, *medium, res, lambda);
     run_estimator_any<S>(in, rng, *medium, b.box, lambda, std::make_index_sequence<std::tuple_size_v<kEstimators>>{});
+    run_unusable<S>(in, rng, *medium, res, lambda);
 }
 
 }  // namespace

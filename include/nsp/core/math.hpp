@@ -17,13 +17,30 @@ inline constexpr float kPi = 3.14159265358979323846f;
 inline constexpr float kInv4Pi = 0.07957747154594767f;
 inline constexpr float kInf = std::numeric_limits<float>::infinity();
 
-/// A ray `o + t d`; `d` is unit length wherever nsp creates one.
+/// A ray `o + t d`. Every kernel takes `d` of unit length, so that t is a distance (the optical
+/// depth of a stretch is mu_bar times its t-length); nsp creates only such rays and rejects the
+/// others (usable_ray).
 struct Ray {
     Vec3 o;
     Vec3 d;
     /// The point at parameter t.
     Vec3 at(float t) const noexcept { return o + t * d; }
 };
+
+/// How far |d|^2 may lie from 1 for a direction nsp accepts as unit length: 1e-3, so that a
+/// distance is off by at most 0.05%. A float normalisation is within a few 1e-7 of 1.
+inline constexpr float kUnitTolerance = 1e-3f;
+
+/// True when every component of v is finite.
+inline bool finite(const Vec3& v) noexcept { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+/// True when v has unit length within kUnitTolerance (false for NaN and infinite components).
+inline bool unit_length(const Vec3& v) noexcept { return std::abs(glm::dot(v, v) - 1.f) <= kUnitTolerance; }
+
+/// Whether the kernels can track `r`: a finite origin and a unit direction (unit_length). Every
+/// public kernel entry checks its rays with this and answers a ray that fails it with an
+/// InvalidInput status and no estimate, never with a number computed from it.
+inline bool usable_ray(const Ray& r) noexcept { return finite(r.o) && unit_length(r.d); }
 
 /// A parametric interval [t0, t1] along a ray.
 struct Interval {

@@ -555,7 +555,8 @@ public:
     const EstimatorOptions& options() const noexcept { return kernels_.options(); }
 
     /// An estimate of the radiance arriving at `ray.o` from direction -ray.d: every strategy
-    /// (s, t >= 2) of one camera subpath and one light subpath, MIS-weighted. Never throws.
+    /// (s, t >= 2) of one camera subpath and one light subpath, MIS-weighted. A camera ray that is
+    /// not usable_ray gives 0 and Status::InvalidInput. Never throws.
     template <class Sc, UniformRng R, LookupCounter C>
     RadianceSample<typename Sc::Spectral> radiance(const Sc& scene, const Ray& camera_ray,
                                                    const typename Sc::Spectral::Wavelengths& lambda, R& rng,
@@ -581,7 +582,8 @@ public:
     /// (u, v), and calls `splat(u', v', value)` for each light-tracing contribution, which the host
     /// adds to the pixel at (u', v'). Every pixel's value is then the sum of its samples' returns
     /// and of the splats it received, divided by its own number of samples (the same for every
-    /// pixel: the light subpaths are one per camera sample over the whole image). Never throws.
+    /// pixel: the light subpaths are one per camera sample over the whole image). A (u, v) whose
+    /// camera ray is not usable_ray (NaN) gives 0 and Status::InvalidInput. Never throws.
     template <class Sc, Camera Cam, UniformRng R, LookupCounter C, class Splat>
     RadianceSample<typename Sc::Spectral> sample(const Sc& sc, const Cam& camera, float u, float v,
                                                  const typename Sc::Spectral::Wavelengths& lambda, R& rng, C& counter,
@@ -1020,6 +1022,7 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
     using V = VertexT<Sc>;
     using P = PdfType<Ch, typename Sc::Spectral>;
     using PathPdfsT = PdfsFor<typename Sc::Spectral>;
+    if (!usable_ray(camera_ray)) return {Spectrum::Zero(), Status::InvalidInput};
     const int depth = kernels_.options().max_depth;
     Spectrum L = Spectrum::Zero();
     Status status = Status::Ok;
@@ -1319,7 +1322,7 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
             const auto sh = detail::channel_shadow_through<Ch, A>(sc, r, distance, start, lambda, channel,
                                                                   Spectrum::Ones(), true, rng, counter, end_medium);
             if (sh.end != SegmentEnd::Passed) {
-                out.status = detail::shadow_status(sh.end);
+                out.status = flight_status(sh.end);
                 return out;
             }
             // A sampling channel's density below float's range beside another's: its weight is 0.
@@ -1641,7 +1644,7 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
             const auto sh = detail::channel_emission_shadow<Ch, A>(sc, r, distance, start, target, seg_on, lambda,
                                                                    channel, Spectrum::Ones(), rng, counter);
             if (sh.end != SegmentEnd::Passed) {
-                out.status = detail::shadow_status(sh.end);
+                out.status = flight_status(sh.end);
                 return out;
             }
             if (!sh.reached || !(sh.f != 0.f).any() || !(sh.nee[channel] > 0.f)) return out;

@@ -9,6 +9,7 @@
 #include <type_traits>
 
 #include "../core/error.hpp"
+#include "../core/status.hpp"
 #include "../counts.hpp"
 #include "../equiangular.hpp"
 #include "../light.hpp"
@@ -122,28 +123,6 @@ struct EstimatorOptions {
     /// sampling by their strategy instead.
     bool bdpt_equiangular = true;
 };
-
-/// How a radiance estimate ended.
-enum class Status : std::uint8_t {
-    Ok,         ///< a finite estimate
-    Aborted,    ///< a flight hit the collision limit; that flight contributed 0 (rare, biased)
-    NonFinite,  ///< the estimate was NaN or Inf and has been replaced by 0
-    Rejected,   ///< bound::Reject met mu_t > mu_bar on a flight; that flight contributed 0 (biased)
-    InvalidInput,  ///< the host's geometry reported a hit nsp cannot use (a NaN or negative distance, a
-                   ///< non-unit normal, a handle outside its tables); the path stopped there
-};
-
-/// The status of a path one of whose flights ended with `end` (Ok unless Aborted, Rejected,
-/// Overflowed or InvalidInput, the last two reported as NonFinite).
-inline Status flight_status(SegmentEnd end) noexcept {
-    switch (end) {
-        case SegmentEnd::Aborted: return Status::Aborted;
-        case SegmentEnd::Rejected: return Status::Rejected;
-        case SegmentEnd::Overflowed:
-        case SegmentEnd::InvalidInput: return Status::NonFinite;
-        default: return Status::Ok;
-    }
-}
 
 /// A radiance estimate and its status.
 template <SpectralMode S>

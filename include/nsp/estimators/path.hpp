@@ -67,7 +67,8 @@ public:
 
     /// An estimate of the radiance arriving at `ray.o` from direction -ray.d, in a Scene (media
     /// in empty space) or a SurfaceScene (the host's surfaces, media and lights; the loop of
-    /// estimators/surface_path.hpp). Never throws.
+    /// estimators/surface_path.hpp). A camera ray that is not usable_ray (a non-finite origin, a
+    /// direction that is not unit length) gives 0 and Status::InvalidInput. Never throws.
     template <class Sc, UniformRng R, LookupCounter C>
     RadianceSample<typename Sc::Spectral> radiance(const Sc& scene, const Ray& camera_ray,
                                                    const typename Sc::Spectral::Wavelengths& lambda,
@@ -75,6 +76,7 @@ public:
         static_assert(!is_per_channel_majorant_v<typename Sc::MajorantType, typename Sc::MediumType>,
                       "nsp::PathEstimator drives every channel with one pdf and needs a grey majorant "
                       "(GlobalMajorant or GridMajorant); per-channel majorants go with nsp::SpectralPathEstimator");
+        if (!usable_ray(camera_ray)) return {Sc::Spectrum::Zero(), Status::InvalidInput};
         if constexpr (is_surface_scene_v<Sc>) return detail::surface_radiance(kernels_, scene, camera_ray, lambda, rng, counter);
         else return media_radiance(scene, camera_ray, lambda, rng, counter);
     }

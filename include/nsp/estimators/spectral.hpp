@@ -67,7 +67,8 @@ public:
     const EstimatorOptions& options() const noexcept { return opts_; }
 
     /// An estimate of the radiance arriving at `ray.o` from -ray.d, every channel, with the
-    /// sampling channel chosen uniformly. Never throws.
+    /// sampling channel chosen uniformly. A camera ray that is not usable_ray gives 0 and
+    /// Status::InvalidInput. Never throws.
     template <class Sc, UniformRng R, LookupCounter C>
     RadianceSample<typename Sc::Spectral> radiance(const Sc& scene, const Ray& camera_ray,
                                                    const typename Sc::Spectral::Wavelengths& lambda, R& rng,
@@ -86,6 +87,7 @@ public:
         static_assert(CP::own_pdfs || !is_per_channel_majorant_v<Maj, M>,
                       "nsp::SpectralPathEstimator: spectral tracking shares one pdf over channels and needs a "
                       "grey majorant bounding every channel (GlobalMajorant)");
+        if (!usable_ray(camera_ray)) return {Sc::Spectrum::Zero(), Status::InvalidInput};
         if constexpr (is_surface_scene_v<Sc>)
             return detail::spectral_surface_radiance<CP, St, A>(opts_, scene, camera_ray, lambda, selection, rng, counter);
         else

@@ -216,7 +216,7 @@ Status channel_emission_event(const EstimatorOptions& opts, const Sc& sc, const 
     const bool with_along = St::combines && opts.emission_along_segments;
     const auto sh = channel_emission_shadow<CP, A>(sc, Ray{x, wi}, dist, start_medium(wi), i, with_along, lambda, c,
                                                    st.f, rng, counter);
-    if (sh.end != SegmentEnd::Passed) return shadow_status(sh.end);
+    if (sh.end != SegmentEnd::Passed) return flight_status(sh.end);
     if (!sh.reached || !(sh.f != 0.f).any()) return Status::Ok;
     const auto k = lookup_untracked(m.medium, m.majorant, sh.last, sh.t_last, lambda, counter);
     if (!k) return Status::Rejected;

@@ -107,7 +107,7 @@ Status channel_light_event(const Sc& sc, const SceneVertex& v, const Vec3& x, co
     const auto sh = channel_shadow_through<CP, A>(sc, Ray{x, fv.wi}, ls.sample.distance,
                                                   start_medium(fv.wi), lambda, c, f_x, uni_alternative, rng, counter);
     record_shadow_walk(counter, before, !eq_drawn);
-    if (sh.end != SegmentEnd::Passed) return shadow_status(sh.end);
+    if (sh.end != SegmentEnd::Passed) return flight_status(sh.end);
     if (!(sh.f != 0.f).any()) return Status::Ok;
     // Tracking + NEE (its expected count), tracking + hit, and equiangular + NEE (count 1)
     // (THEORY 5.4 with 5.1, 5.3, 5.9); p_eq is 0 without equiangular sampling.

@@ -27,9 +27,7 @@ template <class Sc>
 bool usable_hit(const Sc& sc, const SurfaceHit& h) noexcept {
     if (std::isnan(h.t) || h.t < 0.f) return false;
     if (!h.found()) return true;
-    auto finite = [](const Vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
-    auto unit = [](const Vec3& v) { return std::abs(glm::dot(v, v) - 1.f) < 1e-3f; };
-    if (!finite(h.p) || !unit(h.ng) || !unit(h.ns)) return false;
+    if (!finite(h.p) || !unit_length(h.ng) || !unit_length(h.ns)) return false;
     if (h.material != -1 && !sc.materials.contains(h.material)) return false;
     if (h.light != -1 && !(h.light >= 0 && h.light < sc.lights.count())) return false;
     auto medium_ok = [&](int m) { return m == -1 || sc.has_medium(m); };
@@ -142,9 +140,5 @@ ShadowTransmittance<typename Sc::Spectral> shadow_through(const K& k, const Sc& 
     return {Sp::Spectrum::Zero(), 1.f, Status::InvalidInput};
 }
 
-/// The status of a path one of whose shadow rays ended with `end`.
-inline Status shadow_status(SegmentEnd end) noexcept {
-    return end == SegmentEnd::InvalidInput ? Status::InvalidInput : flight_status(end);
-}
 
 }  // namespace nsp::detail
