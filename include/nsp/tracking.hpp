@@ -233,7 +233,7 @@ FlightEnd<MajorantValue<Maj, M>> free_flight(const M& medium, const Maj& majoran
     using V = MajorantValue<Maj, M>;
     using B = bound_policy_t<Maj>;
     constexpr bool grey = std::is_same_v<V, float>;
-    if (!usable_ray(ray) || std::isnan(tmin) || std::isnan(tmax)) [[unlikely]] {
+    if (!usable_ray(ray) || tmin != tmin || tmax != tmax) [[unlikely]] {  // NaN != NaN
         FlightEnd<V> bad{false, true, false, 0.f, V{}, true};
         if constexpr (!grey) bad.tau_tail.setZero();
         return bad;
