@@ -17,6 +17,7 @@
 // values; a difference in instructions is then the library's code alone (bench/report.py).
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <string>
 #include <vector>
 
@@ -79,6 +80,8 @@ std::vector<nsp::Ray> camera_rays(const M& medium) {
 /// Runs `body(i)` for i in [0, n) as one kernel: instructions counted from here to the dump.
 template <class F>
 void kernel(const char* name, int n, const nsp::LookupCount& counter, F&& body) {
+    // NSP_WORK_ONLY=<prefix> runs only the kernels whose names start with it (a quicker look).
+    if (const char* only = std::getenv("NSP_WORK_ONLY"); only && std::string(name).rfind(only, 0) != 0) return;
     const std::uint64_t before = counter.count();
     double checksum = 0.0;
     CALLGRIND_ZERO_STATS;
