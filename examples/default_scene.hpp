@@ -350,7 +350,7 @@ nsp::Emissive<nsp::DenseGridMedium<S>> make_plume_medium() {
 /// for an image of aspect = width / height.
 inline nsp::Ray camera_ray(float u, float v, float aspect) {
     const float tan_half = std::tan(0.5f * kFovY * nsp::kPi / 180.f);
-    const nsp::Vec3 d((2.f * u - 1.f) * tan_half * aspect, (2.f * v - 1.f) * tan_half, 1.f);
+    const nsp::Vec3 d((1.f - 2.f * u) * tan_half * aspect, (2.f * v - 1.f) * tan_half, 1.f);  // right-handed: u = 0 left (+x)
     return {nsp::Vec3(kEye[0], kEye[1], kEye[2]), glm::normalize(d)};
 }
 

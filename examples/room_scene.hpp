@@ -112,8 +112,8 @@ RoomScene<M, Maj> make_lantern_scene(M medium, Maj majorant) {
 inline nsp::Ray room_camera_ray(float u, float v, float aspect) {
     const nsp::Vec3 eye(0.f, 0.6f, -5.6f), target(0.f, -0.15f, 0.f);
     const nsp::Vec3 f = glm::normalize(target - eye);
-    const nsp::Vec3 r = glm::normalize(glm::cross(nsp::Vec3(0.f, 1.f, 0.f), f));
-    const nsp::Vec3 up = glm::cross(f, r);
+    const nsp::Vec3 r = glm::normalize(glm::cross(f, nsp::Vec3(0.f, 1.f, 0.f)));  // right-handed, as nsp::PinholeCamera
+    const nsp::Vec3 up = glm::cross(r, f);
     const float tan_half = std::tan(0.5f * 42.f * nsp::kPi / 180.f);
     return {eye, glm::normalize(f + (2.f * u - 1.f) * tan_half * aspect * r + (2.f * v - 1.f) * tan_half * up)};
 }

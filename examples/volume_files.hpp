@@ -172,8 +172,8 @@ struct VolumeFraming {
                                        nsp::constant_coefficient<S>(250.f)});
         eye = centre + radius * nsp::Vec3(0.f, 0.6f, -2.1f);
         f = glm::normalize(centre - eye);
-        r = glm::normalize(glm::cross(nsp::Vec3(0.f, 1.f, 0.f), f));
-        up = glm::cross(f, r);
+        r = glm::normalize(glm::cross(f, nsp::Vec3(0.f, 1.f, 0.f)));  // right-handed, as nsp::PinholeCamera
+        up = glm::cross(r, f);
     }
     nsp::Ray operator()(float u, float v) const {
         return nsp::Ray{eye, glm::normalize(f + (2.f * u - 1.f) * tan_half * r + (2.f * v - 1.f) * tan_half * up)};

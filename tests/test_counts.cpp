@@ -205,7 +205,7 @@ TEST_CASE("NEE counts: surfaces: the white furnace (L = 1) and the lit cube over
                     Ls(LightSelection::Power, 4.f, {lamp}, {EnvironmentLight<S>{Spectrum::Constant(0.05f)}}), -1);
         auto camera = [](Pcg32& rng) {
             const float u = rng.uniform(), v = rng.uniform();
-            return Ray{Vec3(0.f, 0.3f, -4.5f), glm::normalize(Vec3(0.7f * (2.f * u - 1.f), 0.7f * (1.f - 2.f * v), 1.f))};
+            return Ray{Vec3(0.f, 0.3f, -4.5f), glm::normalize(Vec3(0.7f * (1.f - 2.f * u), 0.7f * (1.f - 2.f * v), 1.f))};
         };
         const Stat ref = estimate(PathEstimator<strategy::NullScatteringMis, mis::Balance>{}, sc, 40000, 521, camera);
         CHECK(ref.mean > 0.05);

@@ -141,7 +141,7 @@ float radiance(const Kernels& k, const World& w, nsp::Ray ray, nsp::Pcg32& rng) 
 /// The camera ray through (u, v) in [0, 1)^2 of the image (pinhole, 40 degrees).
 nsp::Ray camera(float u, float v) {
     const float s = std::tan(0.5f * 40.f * nsp::kPi / 180.f);
-    return {nsp::Vec3(0.f, 0.3f, -4.5f), glm::normalize(nsp::Vec3((2.f * u - 1.f) * s, (1.f - 2.f * v) * s, 1.f))};
+    return {nsp::Vec3(0.f, 0.3f, -4.5f), glm::normalize(nsp::Vec3((1.f - 2.f * u) * s, (1.f - 2.f * v) * s, 1.f))};
 }
 
 /// A rendered image and the mean and standard error of all its samples.

@@ -28,6 +28,9 @@ concept Camera = requires(const Cam& c, float u, const Vec3& w, float& out) {
 
 /// A pinhole camera at `eye` looking at `target`, `up` roughly up, vertical field of view
 /// `vfov_degrees`, width / height `aspect`: an image plane at distance 1 of size 2 tan_x x 2 tan_y.
+/// In a right-handed world: u = 0 is the image's left column and v = 0 its bottom row as a viewer
+/// at `eye` sees them (looking along +z with +y up, +x is on the left), as Mitsuba's and OpenGL's;
+/// a host writes the sample at (u, v) to column u x width, row (1 - v) x height from the top.
 class PinholeCamera {
 public:
     /// Throws InvalidArgument on a non-finite eye or target, eye == target, `up` parallel to the
@@ -43,10 +46,11 @@ public:
         if (!(aspect > 0.f) || !std::isfinite(aspect))
             detail::fail("PinholeCamera aspect = ", aspect, " is not allowed: it must be finite and > 0");
         forward_ = glm::normalize(d);
-        const Vec3 r = glm::cross(up, forward_);
+        // Right-handed: the viewer's right is forward x up (looking along +z with +y up, -x).
+        const Vec3 r = glm::cross(forward_, up);
         if (!(glm::dot(r, r) > 1e-12f)) detail::fail("PinholeCamera: up is parallel to the view direction");
         right_ = glm::normalize(r);
-        up_ = glm::cross(forward_, right_);
+        up_ = glm::cross(right_, forward_);
         tan_y_ = std::tan(0.5f * vfov_degrees * kPi / 180.f);
         tan_x_ = tan_y_ * aspect;
         inv_area_ = 1.f / (4.f * tan_x_ * tan_y_);
@@ -74,7 +78,7 @@ public:
     }
 
 private:
-    Vec3 eye_, forward_{0.f, 0.f, 1.f}, right_{1.f, 0.f, 0.f}, up_{0.f, 1.f, 0.f};
+    Vec3 eye_, forward_{0.f, 0.f, 1.f}, right_{-1.f, 0.f, 0.f}, up_{0.f, 1.f, 0.f};
     float tan_x_ = 1.f, tan_y_ = 1.f, inv_area_ = 0.25f;
 };
 

@@ -91,7 +91,7 @@ inline Sc cube_over_floor(bool sky, float lamp_size = 1.2f, bool tight_majorant 
 
 inline Ray cube_camera(Pcg32& rng) {
     const float u = rng.uniform(), v = rng.uniform();
-    return Ray{Vec3(0.f, 0.3f, -4.5f), glm::normalize(Vec3(0.7f * (2.f * u - 1.f), 0.7f * (1.f - 2.f * v), 1.f))};
+    return Ray{Vec3(0.f, 0.3f, -4.5f), glm::normalize(Vec3(0.7f * (1.f - 2.f * u), 0.7f * (1.f - 2.f * v), 1.f))};
 }
 
 /// The cube's camera as a PinholeCamera: cube_camera(u, v) is its ray(u, 1 - v).
