@@ -1,7 +1,9 @@
 // nsp/io/nanovdb.hpp: media from NanoVDB density grids (fog volumes), and .nvdb files.
 //
-// Optional: needs NanoVDB's headers (Debian: libnanovdb-dev; header-only, no library to link).
-// `nsp/nsp.hpp` does not include it. A NanoVdbMedium is a float density grid, looked up with
+// Optional: needs NanoVDB's headers (Debian: libnanovdb-dev; header-only). Compressed .nvdb files
+// need NanoVDB's codecs, which its IO.h compiles only with NANOVDB_USE_ZIP (zlib) and
+// NANOVDB_USE_BLOSC (c-blosc) defined and those libraries linked: CMake's nsp::nanovdb target does
+// both when it finds zlib1g-dev and libblosc-dev. `nsp/nsp.hpp` does not include it. A NanoVdbMedium is a float density grid, looked up with
 // NanoVDB's own trilinear sampler (values at integer index coordinates, the grid's background 0
 // beyond them), scaled per channel by a coefficient per unit density as DenseGridMedium is. It is
 // a RegionBoundedMedium (so it takes every grid majorant) and a TreeLayoutMedium: TreeMajorant
@@ -330,6 +332,32 @@ inline void require_readable(const std::string& path) {
         nsp::detail::fail("cannot open '", path, "': no such file, or it cannot be read");
 }
 
+/// True when this build reads and writes .nvdb files compressed with `codec`.
+constexpr bool codec_compiled(nanovdb::io::Codec codec) noexcept {
+    switch (codec) {
+    case nanovdb::io::Codec::NONE: return true;
+#ifdef NANOVDB_USE_ZIP
+    case nanovdb::io::Codec::ZIP: return true;
+#endif
+#ifdef NANOVDB_USE_BLOSC
+    case nanovdb::io::Codec::BLOSC: return true;
+#endif
+    default: return false;
+    }
+}
+
+/// Why this build cannot take `codec`, and what would make it (for messages).
+inline std::string codec_missing(nanovdb::io::Codec codec) {
+    const unsigned c = unsigned(codec);
+    if (codec == nanovdb::io::Codec::ZIP)
+        return "NanoVDB's ZIP codec is not compiled into this build: build with nsp::nanovdb (CMake), which "
+               "defines NANOVDB_USE_ZIP and links zlib when it finds it (Debian: zlib1g-dev)";
+    if (codec == nanovdb::io::Codec::BLOSC)
+        return "NanoVDB's Blosc codec is not compiled into this build: build with nsp::nanovdb (CMake), which "
+               "defines NANOVDB_USE_BLOSC and links c-blosc when it finds it (Debian: libblosc-dev)";
+    return "codec " + std::to_string(c) + " is not one of NanoVDB's (0 none, 1 ZIP, 2 Blosc)";
+}
+
 /// "'a', 'b'" or "none".
 inline std::string list_names(const std::vector<std::string>& names) {
     if (names.empty()) return "none";
@@ -352,14 +380,31 @@ inline std::vector<std::string> nvdb_grid_names(const std::string& path) {
     return names;
 }
 
-/// Loads the float fog volume `grid` from a .nvdb file and validates it (its checksum too).
+/// Loads the float fog volume `grid` from a .nvdb file, uncompressed or compressed with a codec
+/// this build has (detail_nvdb::codec_compiled), and validates it (its checksum too).
 /// Throws InvalidArgument naming the file on a missing or unreadable file, one that is not
-/// NanoVDB, no grid of that name (the message lists the grids there are), a truncated or
-/// corrupted grid, or any check of NanoDensityGrid.
+/// NanoVDB, no grid of that name (the message lists the grids there are), a codec this build
+/// lacks (the message says which package adds it), a truncated or corrupted grid, or any check
+/// of NanoDensityGrid.
 inline std::shared_ptr<const NanoDensityGrid> load_nvdb(const std::string& path, const std::string& grid = "density") {
-    const std::vector<std::string> names = nvdb_grid_names(path);
-    if (std::find(names.begin(), names.end(), grid) == names.end())
+    detail_nvdb::require_readable(path);
+    std::vector<nanovdb::io::GridMetaData> meta;
+    try {
+        meta = nanovdb::io::readGridMetaData(path);
+    } catch (const std::exception& e) {
+        nsp::detail::fail("'", path, "' is not a NanoVDB file nsp can read: ", e.what());
+    }
+    std::vector<std::string> names;
+    const nanovdb::io::GridMetaData* info = nullptr;
+    for (const auto& m : meta) {
+        names.push_back(m.gridName);
+        if (!info && m.gridName == grid) info = &m;
+    }
+    if (!info)
         nsp::detail::fail("'", path, "' has no grid named '", grid, "'; its grids are ", detail_nvdb::list_names(names));
+    if (!detail_nvdb::codec_compiled(info->codec))
+        nsp::detail::fail("cannot read grid '", grid, "' of '", path, "': it is stored compressed, and ",
+                          detail_nvdb::codec_missing(info->codec));
     NanoHandle handle;
     try {
         handle = nanovdb::io::readGrid<nanovdb::HostBuffer>(path, grid);
@@ -406,20 +451,26 @@ inline NanoHandle to_nanovdb(const VoxelGrid& g, int channel = 0, const std::str
     return builder.getHandle<nanovdb::AbsDiff>(map, name);
 }
 
-/// Writes a NanoVDB grid as a .nvdb file (no compression). Throws InvalidArgument if it cannot.
-inline void write_nvdb(const std::string& path, const NanoHandle& handle) {
+/// Writes a NanoVDB grid as a .nvdb file, uncompressed or with `codec` (ZIP or BLOSC, if this
+/// build has it: detail_nvdb::codec_compiled). Throws InvalidArgument if it cannot.
+inline void write_nvdb(const std::string& path, const NanoHandle& handle,
+                       nanovdb::io::Codec codec = nanovdb::io::Codec::NONE) {
+    if (!detail_nvdb::codec_compiled(codec)) nsp::detail::fail("cannot write '", path, "': ", detail_nvdb::codec_missing(codec));
     try {
-        nanovdb::io::writeGrid(path, handle);
+        nanovdb::io::writeGrid(path, handle, codec);
     } catch (const std::exception& e) {
         nsp::detail::fail("cannot write '", path, "': ", e.what());
     }
     if (!std::filesystem::exists(path)) nsp::detail::fail("cannot write '", path, "'");
 }
 
-/// Writes several NanoVDB grids (e.g. density and temperature) into one .nvdb file.
-inline void write_nvdb(const std::string& path, const std::vector<NanoHandle>& handles) {
+/// Writes several NanoVDB grids (e.g. density and temperature) into one .nvdb file, uncompressed
+/// or with `codec`.
+inline void write_nvdb(const std::string& path, const std::vector<NanoHandle>& handles,
+                       nanovdb::io::Codec codec = nanovdb::io::Codec::NONE) {
+    if (!detail_nvdb::codec_compiled(codec)) nsp::detail::fail("cannot write '", path, "': ", detail_nvdb::codec_missing(codec));
     try {
-        nanovdb::io::writeGrids<nanovdb::HostBuffer, std::vector>(path, handles);
+        nanovdb::io::writeGrids<nanovdb::HostBuffer, std::vector>(path, handles, codec);
     } catch (const std::exception& e) {
         nsp::detail::fail("cannot write '", path, "': ", e.what());
     }
