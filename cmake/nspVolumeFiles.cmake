@@ -66,8 +66,9 @@ function(_nsp_find_blosc out)
 endfunction()
 
 # nsp_find_openvdb(): looks for OpenVDB with its find module (Debian installs it off CMake's
-# module path). Sets NSP_OPENVDB_FOUND, and NSP_OPENVDB_CODECS: what OpenVDB's own library reads
-# (its Blosc and zlib support is compiled into libopenvdb; nsp adds nothing for .vdb files).
+# module path). Sets NSP_OPENVDB_FOUND, and NSP_OPENVDB_CODECS for the configure output: the
+# version and the codecs libopenvdb was built with (they are compiled into it, so nsp adds nothing
+# for compressed .vdb files; Debian's has Blosc and zlib).
 function(nsp_find_openvdb)
     set(saved_module_path ${CMAKE_MODULE_PATH})
     list(APPEND CMAKE_MODULE_PATH /usr/lib/${CMAKE_LIBRARY_ARCHITECTURE}/cmake/OpenVDB /usr/local/lib/cmake/OpenVDB)
@@ -76,16 +77,19 @@ function(nsp_find_openvdb)
     set(NSP_OPENVDB_FOUND ${OpenVDB_FOUND} PARENT_SCOPE)
     if(OpenVDB_FOUND)
         set(codecs "")
-        foreach(codec BLOSC ZLIB)
-            if(OpenVDB_USES_${codec})
-                list(APPEND codecs ${codec})
-            endif()
-        endforeach()
-        if(NOT codecs)
-            set(codecs "none")
+        if(OpenVDB_USES_BLOSC)
+            list(APPEND codecs Blosc)
         endif()
-        string(REPLACE ";" ", " codecs "${codecs}")
-        set(NSP_OPENVDB_CODECS "OpenVDB ${OpenVDB_VERSION}, compressed .vdb through libopenvdb: ${codecs}" PARENT_SCOPE)
+        if(OpenVDB_USES_ZLIB)
+            list(APPEND codecs zlib)
+        endif()
+        if(codecs)
+            string(REPLACE ";" " and " codecs "${codecs}")
+            set(codecs "libopenvdb reads .vdb files compressed with ${codecs}")
+        else()
+            set(codecs "libopenvdb reads uncompressed .vdb files only")
+        endif()
+        set(NSP_OPENVDB_CODECS "OpenVDB ${OpenVDB_VERSION} found (${codecs})" PARENT_SCOPE)
     endif()
 endfunction()
 
