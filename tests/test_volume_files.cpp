@@ -317,6 +317,92 @@ TEST_CASE("a temperature grid from a file: blackbody emission equals the dense g
     CHECK(temperature->active_voxels() <= density->active_voxels());  // hot only where there is smoke
 }
 
+TEST_CASE("a damaged .nvdb is rejected before NanoVDB's reader or validator follows its damaged fields") {
+    // NanoVDB's reader trusts a grid name's terminating 0 and a Blosc chunk's own header, and its
+    // checksum and validator walk the node arrays the grid's header points to: nsp checks the file's
+    // framing (detail_nvdb::check_file) and the grid's layout (detail_nvdb::checked_grid) first.
+    // File layout: a 16-byte segment header (magic 0-7, version 8-11, grid count 12-13, codec 14-15),
+    // 176 bytes of metadata (grid size 16-23, file size 24-31, ..., name size at 16 + 136), the name
+    // ("density" and its 0: bytes 192-199), then the grid: GridData (672 bytes), TreeData, ...
+    const nsp::io::NanoHandle handle = nsp::io::to_nanovdb(nsp_examples::cloud_voxels());
+    const std::string plain = temp_path("frame_none.nvdb"), bad = temp_path("frame_bad.nvdb");
+    nsp::io::write_nvdb(plain, handle);
+    const std::vector<char> bytes = read_bytes(plain);
+    auto rejects = [&](const std::vector<char>& b, const std::string& message) {
+        write_bytes(bad, b);
+        CAPTURE(message);
+        CHECK_THROWS_WITH_AS(nsp::io::load_nvdb(bad), Contains(message.c_str()), InvalidArgument);
+    };
+    rejects(with(bytes, 14, std::uint16_t(7)), "the segment header at byte 0 has codec 7");
+    rejects(with(bytes, 12, std::uint16_t(0)), "the segment header at byte 0 lists no grid");
+    rejects(with(bytes, 199, 'x'), "the grid name at byte 192 does not end in a 0 byte");
+    rejects(with(bytes, 16 + 136, std::uint32_t(1u << 31)), "a grid's name at byte 192 takes 2147483648 bytes");
+    rejects(with(bytes, 24, std::uint64_t(bytes.size())), "run past the end of the file");
+    rejects(with(bytes, 24, std::uint64_t(bytes.size() - 300)), "takes " + std::to_string(bytes.size() - 300) + " bytes, but its size is");
+    // The grid's layout (GridData at byte 200, TreeData at 872: node offsets 872-903, counts 904-915).
+    rejects(with(bytes, 200 + 24, std::uint32_t(5)), "its header says grid 5 of 1");
+    rejects(with(bytes, 200 + 636, std::uint32_t(99)), "holds unknown (corrupted?) values");
+    rejects(with(bytes, 200 + 20, std::uint32_t(0)), "its nodes are not laid out breadth-first");
+    rejects(with(bytes, 872 + 24, std::uint64_t(1) << 40), "its root node (");
+    rejects(with(bytes, 904, std::uint32_t(1u << 30)), "its leaf array");
+    rejects(with(bytes, 904 + 4, std::uint32_t(1000)), "its lower node array");
+    for (const auto codec : {nanovdb::io::Codec::ZIP, nanovdb::io::Codec::BLOSC}) {
+        if (!nsp::io::detail_nvdb::codec_compiled(codec)) continue;
+        const std::string name = nanovdb::io::toStr(codec), path = temp_path("frame_" + name + ".nvdb");
+        CAPTURE(name);
+        nsp::io::write_nvdb(path, handle, codec);
+        const std::vector<char> packed = read_bytes(path);
+        const auto length = *reinterpret_cast<const std::uint64_t*>(packed.data() + 200);  // the first chunk's length
+        const bool zip = codec == nanovdb::io::Codec::ZIP;
+        rejects(with(packed, 200, length + 1), zip ? "the ZIP chunk at byte 200 says" : "the Blosc chunk at byte 200 holds");
+        rejects(with(packed, 24, std::uint64_t(packed.size() - 200 - 1)),
+                zip ? "the ZIP chunk at byte 200 says" : "the Blosc chunk at byte 200 runs past its grid's bytes");
+        if (codec == nanovdb::io::Codec::BLOSC) {
+            // The Blosc buffer's own header, after the 8-byte length: its compressed size (bytes 12-15).
+            rejects(with(packed, 208 + 12, std::uint32_t(length + 64)), "the Blosc chunk at byte 200 holds");
+            rejects(with(packed, 208 + 4, std::uint32_t(1000)), "the Blosc chunk at byte 200 holds 1000 bytes");
+        }
+        // Every truncation is rejected by the framing check or the reader, and never read as a grid.
+        for (int k = 1; k < 20; ++k) {
+            write_bytes(bad, std::vector<char>(packed.begin(), packed.begin() + std::ptrdiff_t(packed.size() * std::size_t(k) / 20)));
+            CHECK_THROWS_AS(nsp::io::load_nvdb(bad), InvalidArgument);
+        }
+    }
+}
+
+TEST_CASE("a NanoVDB grid whose child offsets or node origins are damaged is rejected before any lookup") {
+    // A grid without a full checksum (other tools write partial ones, or none) is not verified by
+    // its checksum: lookups follow child offsets, so NanoDensityGrid checks every one of them.
+    auto damaged = [](auto&& edit) {
+        nsp::io::NanoHandle h = nsp::io::to_nanovdb(nsp_examples::cloud_voxels());
+        edit(*h.grid<float>());
+        return nsp::io::NanoDensityGrid(std::move(h), "grid 'density' of 'x.nvdb'");
+    };
+    CHECK_NOTHROW(damaged([](nanovdb::FloatGrid&) {}));
+    CHECK_THROWS_WITH_AS(damaged([](nanovdb::FloatGrid& g) {
+                             auto* lower = g.tree().getFirstNode<1>()->data();
+                             for (std::uint32_t n = 0; n < 4096; ++n)
+                                 if (lower->mChildMask.isOn(n)) {
+                                     lower->mTable[n].child += 4;
+                                     break;
+                                 }
+                         }),
+                         Contains("the lower internal node at index (0, 0, 0) has a child offset"), InvalidArgument);
+    CHECK_THROWS_WITH_AS(damaged([](nanovdb::FloatGrid& g) {
+                             auto* upper = g.tree().getFirstNode<2>()->data();
+                             for (std::uint32_t n = 0; n < 32768; ++n)
+                                 if (upper->mChildMask.isOn(n)) {
+                                     upper->mTable[n].child = std::int64_t(1) << 40;
+                                     break;
+                                 }
+                         }),
+                         Contains("the upper internal node at index (0, 0, 0) has a child offset (1099511627776)"), InvalidArgument);
+    CHECK_THROWS_WITH_AS(damaged([](nanovdb::FloatGrid& g) { g.tree().root().data()->tile(0)->child = -8; }),
+                         Contains("the root tile at index (0, 0, 0) has a child offset (-8)"), InvalidArgument);
+    CHECK_THROWS_WITH_AS(damaged([](nanovdb::FloatGrid& g) { g.tree().getFirstNode<0>()->data()->mBBoxMin[1] = 2000000000; }),
+                         Contains("2000000000, 24) lies more than 2^30 voxels from the index origin"), InvalidArgument);
+}
+
 TEST_CASE("NanoVDB grids nsp cannot render are rejected, naming the problem") {
     auto build = [](float value, nanovdb::GridClass cls, float background = 0.f) {
         nanovdb::GridBuilder<float> b(background, cls);
