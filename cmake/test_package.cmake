@@ -69,6 +69,7 @@ function(configure_components name must_succeed)
     execute_process(COMMAND ${CMAKE_COMMAND} -S ${WORK_DIR}/components -B ${dir} -G ${GENERATOR}
         -DCMAKE_PREFIX_PATH=${WORK_DIR}/prefix -DCMAKE_IGNORE_PATH=/usr/include ${ARGN}
         RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE out)
+    string(REGEX REPLACE "[ \t\r\n]+" " " out "${out}")  # CMake wraps the message's lines
     set(out "${out}" PARENT_SCOPE)
     if(must_succeed AND NOT rc EQUAL 0)
         message(FATAL_ERROR "components '${name}': configure failed (${rc}):\n${out}")
