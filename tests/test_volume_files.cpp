@@ -352,7 +352,8 @@ TEST_CASE("a damaged .nvdb is rejected before NanoVDB's reader or validator foll
         CAPTURE(name);
         nsp::io::write_nvdb(path, handle, codec);
         const std::vector<char> packed = read_bytes(path);
-        const auto length = *reinterpret_cast<const std::uint64_t*>(packed.data() + 200);  // the first chunk's length
+        std::uint64_t length = 0;  // the first chunk's length
+        std::memcpy(&length, packed.data() + 200, sizeof length);
         const bool zip = codec == nanovdb::io::Codec::ZIP;
         rejects(with(packed, 200, length + 1), zip ? "the ZIP chunk at byte 200 says" : "the Blosc chunk at byte 200 holds");
         rejects(with(packed, 24, std::uint64_t(packed.size() - 200 - 1)),
