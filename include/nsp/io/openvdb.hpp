@@ -10,8 +10,9 @@
 // checked cheaply from the format without reading the grids: the header (magic number, file
 // version, flags, UUID), the file's metadata, and each grid descriptor's offsets against the file's
 // size and against each other, with the grid's compression flags, metadata and transform type.
-// Damage inside a grid's topology or leaf buffers passes those checks. `.nvdb` files (a checksum
-// over the whole grid) are the hardened path: nanovdb_convert or nsp_volume --export-* convert.
+// Damage inside a grid's topology or leaf buffers passes those checks, and a .vdb has no checksum.
+// `.nvdb` files (a checksum over the whole grid) are the hardened path: convert once with
+// NanoVDB's nanovdb_convert, or nanovdb::openToNanoVDB and write_nvdb.
 #pragma once
 
 #include <algorithm>
