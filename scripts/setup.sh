@@ -10,7 +10,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 scripts/install-packages.sh setup cmake ninja-build g++ libglm-dev libeigen3-dev libopenexr-dev doctest-dev libbenchmark-dev libcli11-dev libstb-dev \
-    libnanovdb-dev libopenvdb-dev libboost-iostreams-dev
+    libnanovdb-dev zlib1g-dev libblosc-dev libopenvdb-dev libboost-iostreams-dev
 
 generator=()
 command -v ninja >/dev/null && generator=(-G Ninja)

@@ -1,7 +1,9 @@
 // nsp/io/nanovdb.hpp: media from NanoVDB density grids (fog volumes), and .nvdb files.
 //
-// Optional: needs NanoVDB's headers (Debian: libnanovdb-dev; header-only, no library to link).
-// `nsp/nsp.hpp` does not include it. A NanoVdbMedium is a float density grid, looked up with
+// Optional: needs NanoVDB's headers (Debian: libnanovdb-dev; header-only). Compressed .nvdb files
+// need NanoVDB's codecs, which its IO.h compiles only with NANOVDB_USE_ZIP (zlib) and
+// NANOVDB_USE_BLOSC (c-blosc) defined and those libraries linked: CMake's nsp::nanovdb target does
+// both when it finds zlib1g-dev and libblosc-dev. `nsp/nsp.hpp` does not include it. A NanoVdbMedium is a float density grid, looked up with
 // NanoVDB's own trilinear sampler (values at integer index coordinates, the grid's background 0
 // beyond them), scaled per channel by a coefficient per unit density as DenseGridMedium is. It is
 // a RegionBoundedMedium (so it takes every grid majorant) and a TreeLayoutMedium: TreeMajorant
@@ -44,6 +46,67 @@ namespace nsp::io {
 
 using NanoHandle = nanovdb::GridHandle<nanovdb::HostBuffer>;
 
+namespace detail_nvdb {
+
+/// True when `n` bytes from byte `at` lie inside `size` bytes (no overflow).
+constexpr bool inside(std::uint64_t at, std::uint64_t n, std::uint64_t size) noexcept { return at <= size && n <= size - at; }
+
+/// The float grid at the start of `handle`'s buffer, once its layout is checked against the
+/// buffer: NanoVDB's own checksum and validator walk the node arrays and the root table that the
+/// grid's header points to, and trust those offsets, so a damaged header could send them outside
+/// the buffer. Checks the magic number, that it is the buffer's first grid and fits it, that it
+/// holds float values, that its nodes are laid out breadth-first (the node arrays nsp scans), and
+/// that the root, its tile table and each level's node array lie inside the grid, aligned.
+/// Throws InvalidArgument naming `what` otherwise. (Child offsets are checked by NanoDensityGrid.)
+inline const nanovdb::FloatGrid* checked_grid(const NanoHandle& handle, const std::string& what) {
+    using GridData = nanovdb::GridData;
+    using TreeData = nanovdb::NanoTree<float>::DataType;
+    using RootData = nanovdb::NanoRoot<float>::DataType;
+    const std::uint64_t size = handle.size();
+    if (handle.empty() || size < sizeof(GridData) + sizeof(TreeData))
+        nsp::detail::fail(what, " holds no grid, or is truncated: ", size, " bytes, fewer than a grid's header (",
+                          sizeof(GridData) + sizeof(TreeData), ")");
+    const auto* data = reinterpret_cast<const GridData*>(handle.data());
+    if (data->mMagic != NANOVDB_MAGIC_NUMBER) nsp::detail::fail(what, " is corrupted: its grid does not start with NanoVDB's magic number");
+    if (data->mGridIndex != 0 || data->mGridCount == 0 || data->mGridSize > size || data->mGridSize < sizeof(GridData) + sizeof(TreeData))
+        nsp::detail::fail(what, " is corrupted: its header says grid ", data->mGridIndex, " of ", data->mGridCount, ", ",
+                          data->mGridSize, " bytes, in a buffer of ", size, " bytes");
+    if (data->mGridType != nanovdb::GridType::Float) {
+        const auto type = data->mGridType;
+        nsp::detail::fail(what, " holds ", type < nanovdb::GridType::End ? nanovdb::toStr(type) : "unknown (corrupted?)",
+                          " values; nsp reads float density grids (fog volumes)");
+    }
+    const auto* grid = reinterpret_cast<const nanovdb::FloatGrid*>(data);
+    if (!grid->isBreadthFirst())
+        nsp::detail::fail(what, " is corrupted, or its nodes are not laid out breadth-first (as every NanoVDB writer "
+                          "lays them out): nsp reads the node arrays of breadth-first grids");
+    const std::uint64_t end = data->mGridSize, tree = sizeof(GridData);
+    const auto* t = reinterpret_cast<const TreeData*>(reinterpret_cast<const char*>(data) + tree);
+    auto fail_layout = [&](const char* part, std::uint64_t at, std::uint64_t bytes) {
+        nsp::detail::fail(what, " is corrupted: its ", part, " (", bytes, " bytes at byte ", at, ") lies outside its ", end,
+                          " bytes or is misaligned");
+    };
+    const std::uint64_t root = tree + t->mNodeOffset[3];
+    if (t->mNodeOffset[3] < sizeof(TreeData) || root % NANOVDB_DATA_ALIGNMENT != 0 || !inside(root, sizeof(RootData), end))
+        fail_layout("root node", root, sizeof(RootData));
+    const auto table = std::uint64_t(reinterpret_cast<const RootData*>(reinterpret_cast<const char*>(data) + root)->mTableSize);
+    if (!inside(root + sizeof(RootData), table * sizeof(typename RootData::Tile), end))
+        fail_layout("root table", root + sizeof(RootData), table * sizeof(typename RootData::Tile));
+    const std::uint64_t node_bytes[3] = {sizeof(nanovdb::NanoLeaf<float>), sizeof(nanovdb::NanoLower<float>),
+                                         sizeof(nanovdb::NanoUpper<float>)};
+    const char* node_names[3] = {"leaf array", "lower node array", "upper node array"};
+    for (int level = 0; level < 3; ++level) {
+        const std::uint64_t count = t->mNodeCount[level], first = tree + t->mNodeOffset[level];
+        if (count == 0) continue;
+        if (t->mNodeOffset[level] < sizeof(TreeData) || first % NANOVDB_DATA_ALIGNMENT != 0 ||
+            !inside(first, count * node_bytes[level], end))
+            fail_layout(node_names[level], first, count * node_bytes[level]);
+    }
+    return grid;
+}
+
+}  // namespace detail_nvdb
+
 /// A validated NanoVDB float fog volume and what nsp precomputes over it: the box outside which
 /// its density is 0, the largest value and each leaf's largest value (for density bounds).
 class NanoDensityGrid {
@@ -52,19 +115,19 @@ public:
     /// "grid 'density' of 'smoke.nvdb'"). Throws InvalidArgument unless it is a float grid of
     /// class fog volume (or unknown), with background 0, an axis-aligned transform (positive
     /// voxel sizes, no rotation or shear), at least one active voxel, and every value (voxels,
-    /// inactive ones included, and tiles) finite and >= 0.
+    /// inactive ones included, and tiles) finite and >= 0; and unless its layout is sound, so
+    /// that no lookup leaves its buffer whatever its bytes: the header, root and node arrays
+    /// inside the buffer (detail_nvdb::checked_grid), every child offset on a node of the level
+    /// below, and node origins within +-2^30 voxels of the index origin.
     NanoDensityGrid(NanoHandle handle, std::string what) : handle_(std::move(handle)), what_(std::move(what)) {
-        if (handle_.empty()) nsp::detail::fail(what_, " holds no grid");
-        grid_ = handle_.grid<float>();
-        if (!grid_)
-            nsp::detail::fail(what_, " holds ", nanovdb::toStr(handle_.gridType()),
-                         " values; nsp reads float density grids (fog volumes)");
+        grid_ = detail_nvdb::checked_grid(handle_, what_);
         const nanovdb::GridClass cls = grid_->gridClass();
         if (cls == nanovdb::GridClass::LevelSet)
             nsp::detail::fail(what_, " is a level set (a signed distance field), not a fog volume; convert it to a fog "
                          "volume (e.g. OpenVDB's sdfToFogVolume) first");
         if (cls != nanovdb::GridClass::FogVolume && cls != nanovdb::GridClass::Unknown)
-            nsp::detail::fail(what_, " has grid class ", nanovdb::toStr(cls), ", not a fog volume");
+            nsp::detail::fail(what_, " has grid class ", cls < nanovdb::GridClass::End ? nanovdb::toStr(cls) : "unknown (corrupted?)",
+                              ", not a fog volume");
         const float background = grid_->tree().background();
         if (background != 0.f)
             nsp::detail::fail(what_, " has background value ", background,
@@ -193,6 +256,23 @@ private:
                 nsp::detail::fail(what_, ": the value ", v, " of the ", kind, " at index (", ijk[0], ", ", ijk[1], ", ", ijk[2],
                              ") is not allowed: densities must be finite and >= 0");
         };
+        // Index arithmetic (a node's origin plus up to 4095) stays far inside int32.
+        constexpr int kMaxOrigin = 1 << 30;
+        auto check_origin = [&](const nanovdb::Coord& o, const char* kind) {
+            for (int a = 0; a < 3; ++a)
+                if (o[a] < -kMaxOrigin || o[a] > kMaxOrigin)
+                    nsp::detail::fail(what_, " is corrupted or too large: the ", kind, " at index (", o[0], ", ", o[1], ", ",
+                                      o[2], ") lies more than 2^30 voxels from the index origin, where nsp reads grids");
+        };
+        // A child offset must land on a node of the array below: lookups follow them unchecked,
+        // and a checksum (which covers them) may be partial or absent in files from other tools.
+        auto check_child = [&](const void* parent, std::int64_t offset, const void* first, std::uint32_t count,
+                               std::size_t bytes, const char* kind, const nanovdb::Coord& o) {
+            const std::uintptr_t at = std::uintptr_t(parent) + std::uint64_t(offset), begin = std::uintptr_t(first);
+            if (!first || at < begin || (at - begin) % bytes != 0 || (at - begin) / bytes >= count)
+                nsp::detail::fail(what_, " is corrupted: the ", kind, " at index (", o[0], ", ", o[1], ", ", o[2],
+                                  ") has a child offset (", offset, ") that does not point at a node of the level below");
+        };
         auto extend = [&](const nanovdb::Coord& lo, int dim) {
             for (int a = 0; a < 3; ++a) {
                 nz_lo_[a] = std::min(nz_lo_[a], lo[a]);
@@ -203,6 +283,7 @@ private:
         leaf_max_.assign(leaves, 0.f);
         for (std::uint32_t i = 0; i < leaves; ++i) {
             const auto& leaf = tree.getFirstLeaf()[i];
+            check_origin(leaf.origin(), "leaf");
             float m = 0.f;
             for (std::uint32_t n = 0; n < 512; ++n) {
                 const float v = leaf.getValue(n);
@@ -213,28 +294,46 @@ private:
             leaf_max_[i] = m;
             max_ = std::max(max_, m);
         }
-        auto tiles = [&](const auto* nodes, std::uint32_t count, std::uint32_t size, int dim, const char* kind) {
-            for (std::uint32_t i = 0; i < count; ++i)
+        auto tiles = [&](const auto* nodes, std::uint32_t count, std::uint32_t size, int dim, const char* kind, const char* node,
+                         const auto* children, std::uint32_t child_count) {
+            for (std::uint32_t i = 0; i < count; ++i) {
+                check_origin(nodes[i].origin(), node);
                 for (std::uint32_t n = 0; n < size; ++n) {
-                    if (nodes[i].data()->isChild(n)) continue;
+                    if (nodes[i].data()->isChild(n)) {
+                        check_child(nodes[i].data(), nodes[i].data()->mTable[n].child, children, child_count, sizeof(*children), node,
+                                    nodes[i].origin());
+                        continue;
+                    }
                     const float v = nodes[i].data()->getValue(n);
                     check(v, nodes[i].offsetToGlobalCoord(n), kind);
                     if (v > 0.f) extend(nodes[i].offsetToGlobalCoord(n), dim);
                     max_ = std::max(max_, v);
                 }
+            }
         };
-        if (tree.nodeCount(1) > 0) tiles(tree.getFirstLower(), tree.nodeCount(1), 16 * 16 * 16, 8, "tile (8^3 voxels)");
-        if (tree.nodeCount(2) > 0) tiles(tree.getFirstUpper(), tree.nodeCount(2), 32 * 32 * 32, 128, "tile (128^3 voxels)");
+        if (tree.nodeCount(1) > 0)
+            tiles(tree.getFirstLower(), tree.nodeCount(1), 16 * 16 * 16, 8, "tile (8^3 voxels)", "lower internal node",
+                  tree.getFirstLeaf(), leaves);
+        if (tree.nodeCount(2) > 0)
+            tiles(tree.getFirstUpper(), tree.nodeCount(2), 32 * 32 * 32, 128, "tile (128^3 voxels)", "upper internal node",
+                  tree.getFirstLower(), tree.nodeCount(1));
         const auto& root = tree.root();
         for (std::uint32_t i = 0; i < root.tileCount(); ++i) {
             const auto* tile = root.data()->tile(i);
-            if (tile->isChild()) continue;
+            check_origin(tile->origin(), "root tile");
+            if (tile->isChild()) {
+                check_child(root.data(), tile->child, tree.getFirstUpper(), tree.nodeCount(2), sizeof(nanovdb::NanoUpper<float>),
+                            "root tile", tile->origin());
+                continue;
+            }
             check(tile->value, tile->origin(), "tile (4096^3 voxels)");
             if (tile->value > 0.f) extend(tile->origin(), 4096);
             max_ = std::max(max_, tile->value);
         }
         if (!(max_ > 0.f)) {  // every value 0: an empty medium over the active voxels' box
             const auto& b = tree.bbox();
+            check_origin(b.min(), "bounding box corner");
+            check_origin(b.max(), "bounding box corner");
             for (int a = 0; a < 3; ++a) nz_lo_[a] = b.min()[a], nz_hi_[a] = b.max()[a];
         }
         for (int a = 0; a < 3; ++a) {
@@ -330,6 +429,124 @@ inline void require_readable(const std::string& path) {
         nsp::detail::fail("cannot open '", path, "': no such file, or it cannot be read");
 }
 
+/// True when this build reads and writes .nvdb files compressed with `codec`.
+constexpr bool codec_compiled(nanovdb::io::Codec codec) noexcept {
+    switch (codec) {
+    case nanovdb::io::Codec::NONE: return true;
+#ifdef NANOVDB_USE_ZIP
+    case nanovdb::io::Codec::ZIP: return true;
+#endif
+#ifdef NANOVDB_USE_BLOSC
+    case nanovdb::io::Codec::BLOSC: return true;
+#endif
+    default: return false;
+    }
+}
+
+/// Why this build cannot take `codec`, and what would make it (for messages).
+inline std::string codec_missing(nanovdb::io::Codec codec) {
+    const unsigned c = unsigned(codec);
+    if (codec == nanovdb::io::Codec::ZIP)
+        return "NanoVDB's ZIP codec is not compiled into this build: build with nsp::nanovdb (CMake), which "
+               "defines NANOVDB_USE_ZIP and links zlib when it finds it (Debian: zlib1g-dev)";
+    if (codec == nanovdb::io::Codec::BLOSC)
+        return "NanoVDB's Blosc codec is not compiled into this build: build with nsp::nanovdb (CMake), which "
+               "defines NANOVDB_USE_BLOSC and links c-blosc when it finds it (Debian: libblosc-dev)";
+    return "codec " + std::to_string(c) + " is not one of NanoVDB's (0 none, 1 ZIP, 2 Blosc)";
+}
+
+/// Checks a .nvdb file's framing before NanoVDB's reader runs, from the layout io/IO.h documents:
+/// segments of a 16-byte header (magic number, version, grid count, codec), per grid 176 bytes of
+/// metadata and its name, then each grid's bytes. NanoVDB's reader trusts those fields: a name
+/// without its terminating 0 is read past its end, and a Blosc chunk whose own header claims more
+/// bytes than the file holds is decompressed from past its buffer. Checks the magic numbers, the
+/// codec, each name (inside the file, ending in its 0), that the grids' bytes lie inside the file,
+/// and each grid's compressed framing: uncompressed, its bytes are its size; ZIP, one chunk whose
+/// length field matches; Blosc, chunks of at most 1 GiB whose lengths and Blosc headers (the
+/// uncompressed and compressed sizes) agree with the grid's size and the file. Throws
+/// InvalidArgument naming the file, the field and its byte offset.
+inline void check_file(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::error_code ec;
+    const std::uint64_t size = std::filesystem::file_size(path, ec);
+    if (ec || !in) nsp::detail::fail("cannot open '", path, "': no such file, or it cannot be read");
+    std::uint64_t at = 0;
+    auto read = [&](void* out, std::uint64_t n, std::uint64_t limit, const char* what) {
+        if (!inside(at, n, limit))
+            nsp::detail::fail("'", path, "' is damaged or truncated: ", what, " at byte ", at, " takes ", n,
+                              " bytes and would end past byte ", limit, " (the file has ", size, ")");
+        in.seekg(std::streamoff(at));
+        in.read(static_cast<char*>(out), std::streamsize(n));
+        if (!in) nsp::detail::fail("'", path, "' cannot be read at byte ", at);
+        at += n;
+    };
+    auto damaged = [&](const auto&... parts) { nsp::detail::fail("'", path, "' is damaged or truncated: ", parts...); };
+    constexpr std::uint64_t kChunk = std::uint64_t(1) << 30;  // NanoVDB's Blosc chunk (io::Internal::MAX_SIZE)
+    for (int segment = 0; size - at >= sizeof(nanovdb::io::Header); ++segment) {  // NanoVDB stops at fewer bytes, too
+        const std::uint64_t header_at = at;
+        nanovdb::io::Header h;
+        read(&h, sizeof h, size, "a segment header");
+        if (h.magic != NANOVDB_MAGIC_NUMBER) {
+            if (segment == 0) nsp::detail::fail("'", path, "' is not a NanoVDB file nsp can read: it does not start with NanoVDB's magic number");
+            damaged("the segment header at byte ", header_at, " has no NanoVDB magic number");
+        }
+        if (h.version.getMajor() != NANOVDB_MAJOR_VERSION_NUMBER)
+            damaged("the segment header at byte ", header_at, " has NanoVDB version ", h.version.getMajor(), "; this build reads ",
+                    NANOVDB_MAJOR_VERSION_NUMBER, " (convert the file with this NanoVDB's tools)");
+        if (std::uint16_t(h.codec) > std::uint16_t(nanovdb::io::Codec::BLOSC))
+            damaged("the segment header at byte ", header_at, " has codec ", std::uint16_t(h.codec), "; NanoVDB's are 0 (none), 1 (ZIP) and 2 (Blosc)");
+        if (h.gridCount == 0) damaged("the segment header at byte ", header_at, " lists no grid");
+        std::vector<nanovdb::io::MetaData> meta(h.gridCount);
+        for (auto& m : meta) {
+            const std::uint64_t meta_at = at;
+            read(&m, sizeof m, size, "a grid's metadata");
+            if (m.nameSize == 0) damaged("the grid metadata at byte ", meta_at, " has a name of 0 bytes (it ends in a 0 byte)");
+            std::string name(m.nameSize, '\0');
+            read(name.data(), m.nameSize, size, "a grid's name");
+            if (name.back() != '\0') damaged("the grid name at byte ", at - m.nameSize, " does not end in a 0 byte");
+        }
+        for (const auto& m : meta) {
+            const std::uint64_t grid_at = at, grid_end = at + m.fileSize;
+            if (!inside(at, m.fileSize, size))
+                damaged("a grid's ", m.fileSize, " bytes from byte ", at, " run past the end of the file (", size, " bytes)");
+            if (h.codec == nanovdb::io::Codec::NONE && m.fileSize != m.gridSize)
+                damaged("the uncompressed grid at byte ", grid_at, " takes ", m.fileSize, " bytes, but its size is ", m.gridSize);
+            if (h.codec == nanovdb::io::Codec::ZIP) {
+                std::uint64_t n = 0;
+                read(&n, sizeof n, grid_end, "a ZIP chunk's length");
+                if (n != m.fileSize - sizeof n)
+                    damaged("the ZIP chunk at byte ", grid_at, " says it takes ", n, " bytes, the grid's ", m.fileSize - sizeof n);
+            }
+            if (h.codec == nanovdb::io::Codec::BLOSC) {
+                std::uint64_t residual = m.gridSize;
+                do {
+                    const std::uint64_t chunk = std::min(residual, kChunk), chunk_at = at;
+                    std::uint64_t n = 0;
+                    read(&n, sizeof n, grid_end, "a Blosc chunk's length");
+                    // A Blosc buffer's own header: version, format, flags, type size, then the
+                    // uncompressed, block and compressed sizes (32-bit, little-endian).
+                    unsigned char blosc[16];
+                    if (n < sizeof blosc) damaged("the Blosc chunk at byte ", chunk_at, " says it takes ", n, " bytes, less than its header");
+                    read(blosc, sizeof blosc, grid_end, "a Blosc chunk's header");
+                    auto u32 = [&](int i) {
+                        return std::uint32_t(blosc[i]) | std::uint32_t(blosc[i + 1]) << 8 | std::uint32_t(blosc[i + 2]) << 16 |
+                               std::uint32_t(blosc[i + 3]) << 24;
+                    };
+                    if (u32(4) != chunk || u32(12) != n)
+                        damaged("the Blosc chunk at byte ", chunk_at, " holds ", u32(4), " bytes compressed to ", u32(12),
+                                "; the file says ", chunk, " compressed to ", n);
+                    at += n - sizeof blosc;
+                    if (at > grid_end) damaged("the Blosc chunk at byte ", chunk_at, " runs past its grid's bytes");
+                    residual -= chunk;
+                } while (residual > 0);
+                if (at != grid_end)
+                    damaged("the Blosc chunks of the grid at byte ", grid_at, " take ", at - grid_at, " bytes, the grid's ", m.fileSize);
+            }
+            at = grid_end;
+        }
+    }
+}
+
 /// "'a', 'b'" or "none".
 inline std::string list_names(const std::vector<std::string>& names) {
     if (names.empty()) return "none";
@@ -343,6 +560,7 @@ inline std::string list_names(const std::vector<std::string>& names) {
 /// a NanoVDB file.
 inline std::vector<std::string> nvdb_grid_names(const std::string& path) {
     detail_nvdb::require_readable(path);
+    detail_nvdb::check_file(path);
     std::vector<std::string> names;
     try {
         for (const auto& m : nanovdb::io::readGridMetaData(path)) names.push_back(m.gridName);
@@ -352,14 +570,34 @@ inline std::vector<std::string> nvdb_grid_names(const std::string& path) {
     return names;
 }
 
-/// Loads the float fog volume `grid` from a .nvdb file and validates it (its checksum too).
+/// Loads the float fog volume `grid` from a .nvdb file, uncompressed or compressed with a codec
+/// this build has (detail_nvdb::codec_compiled), and validates it: the file's framing before
+/// NanoVDB reads it (detail_nvdb::check_file), the grid's layout before NanoVDB validates it
+/// (its checksum too), then NanoDensityGrid's checks.
 /// Throws InvalidArgument naming the file on a missing or unreadable file, one that is not
-/// NanoVDB, no grid of that name (the message lists the grids there are), a truncated or
-/// corrupted grid, or any check of NanoDensityGrid.
+/// NanoVDB, no grid of that name (the message lists the grids there are), a codec this build
+/// lacks (the message says which package adds it), a truncated or corrupted grid, or any check
+/// of NanoDensityGrid.
 inline std::shared_ptr<const NanoDensityGrid> load_nvdb(const std::string& path, const std::string& grid = "density") {
-    const std::vector<std::string> names = nvdb_grid_names(path);
-    if (std::find(names.begin(), names.end(), grid) == names.end())
+    detail_nvdb::require_readable(path);
+    detail_nvdb::check_file(path);
+    std::vector<nanovdb::io::GridMetaData> meta;
+    try {
+        meta = nanovdb::io::readGridMetaData(path);
+    } catch (const std::exception& e) {
+        nsp::detail::fail("'", path, "' is not a NanoVDB file nsp can read: ", e.what());
+    }
+    std::vector<std::string> names;
+    const nanovdb::io::GridMetaData* info = nullptr;
+    for (const auto& m : meta) {
+        names.push_back(m.gridName);
+        if (!info && m.gridName == grid) info = &m;
+    }
+    if (!info)
         nsp::detail::fail("'", path, "' has no grid named '", grid, "'; its grids are ", detail_nvdb::list_names(names));
+    if (!detail_nvdb::codec_compiled(info->codec))
+        nsp::detail::fail("cannot read grid '", grid, "' of '", path, "': it is stored compressed, and ",
+                          detail_nvdb::codec_missing(info->codec));
     NanoHandle handle;
     try {
         handle = nanovdb::io::readGrid<nanovdb::HostBuffer>(path, grid);
@@ -368,7 +606,8 @@ inline std::shared_ptr<const NanoDensityGrid> load_nvdb(const std::string& path,
     }
     const std::string what = "grid '" + grid + "' of '" + path + "'";
     if (handle.empty()) nsp::detail::fail("cannot read ", what, ": the file ends before the grid does (truncated)");
-    if (const auto* g = handle.grid<float>(); g && !nanovdb::isValid(*g, true, false))
+    // The layout first: NanoVDB's validation follows the offsets in the grid's header.
+    if (!nanovdb::isValid(*detail_nvdb::checked_grid(handle, what), true, false))
         nsp::detail::fail(what, " is corrupted or truncated: it fails NanoVDB's validation (checksum or layout)");
     return std::make_shared<const NanoDensityGrid>(std::move(handle), what);
 }
@@ -406,20 +645,26 @@ inline NanoHandle to_nanovdb(const VoxelGrid& g, int channel = 0, const std::str
     return builder.getHandle<nanovdb::AbsDiff>(map, name);
 }
 
-/// Writes a NanoVDB grid as a .nvdb file (no compression). Throws InvalidArgument if it cannot.
-inline void write_nvdb(const std::string& path, const NanoHandle& handle) {
+/// Writes a NanoVDB grid as a .nvdb file, uncompressed or with `codec` (ZIP or BLOSC, if this
+/// build has it: detail_nvdb::codec_compiled). Throws InvalidArgument if it cannot.
+inline void write_nvdb(const std::string& path, const NanoHandle& handle,
+                       nanovdb::io::Codec codec = nanovdb::io::Codec::NONE) {
+    if (!detail_nvdb::codec_compiled(codec)) nsp::detail::fail("cannot write '", path, "': ", detail_nvdb::codec_missing(codec));
     try {
-        nanovdb::io::writeGrid(path, handle);
+        nanovdb::io::writeGrid(path, handle, codec);
     } catch (const std::exception& e) {
         nsp::detail::fail("cannot write '", path, "': ", e.what());
     }
     if (!std::filesystem::exists(path)) nsp::detail::fail("cannot write '", path, "'");
 }
 
-/// Writes several NanoVDB grids (e.g. density and temperature) into one .nvdb file.
-inline void write_nvdb(const std::string& path, const std::vector<NanoHandle>& handles) {
+/// Writes several NanoVDB grids (e.g. density and temperature) into one .nvdb file, uncompressed
+/// or with `codec`.
+inline void write_nvdb(const std::string& path, const std::vector<NanoHandle>& handles,
+                       nanovdb::io::Codec codec = nanovdb::io::Codec::NONE) {
+    if (!detail_nvdb::codec_compiled(codec)) nsp::detail::fail("cannot write '", path, "': ", detail_nvdb::codec_missing(codec));
     try {
-        nanovdb::io::writeGrids<nanovdb::HostBuffer, std::vector>(path, handles);
+        nanovdb::io::writeGrids<nanovdb::HostBuffer, std::vector>(path, handles, codec);
     } catch (const std::exception& e) {
         nsp::detail::fail("cannot write '", path, "': ", e.what());
     }
