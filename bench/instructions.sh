@@ -1,11 +1,12 @@
 #!/usr/bin/env bash
 # The before/after check in work alone (bench/run.sh's step 3, without its timed steps):
-# bench/work_count.cpp compiled with one command against the working tree's include/ and
-# examples/ and against commit BEFORE's, each run under valgrind's callgrind, and a table of
-# instructions per kernel, new / old, with the kernels' lookups and checksums (equal checksums:
-# the same paths were sampled, so the ratio is the code's alone).
+# bench/work_count.cpp compiled with one command against commit BEFORE's include/ and examples/
+# and against AFTER's (default: the working tree's), each run under valgrind's callgrind, and a
+# table of instructions per kernel, new / old, with the kernels' lookups and checksums (equal
+# checksums: the same paths were sampled, so the ratio is the code's alone). The harness itself
+# is the working tree's on both sides.
 #
-#   bench/instructions.sh [BEFORE]     (default: HEAD; needs valgrind)
+#   bench/instructions.sh [BEFORE [AFTER]]     (BEFORE default: HEAD; needs valgrind)
 #
 # The instruction count is deterministic for a given binary and input, so one run suffices on a
 # noisy machine. The whole run takes about four minutes on 2 cores (two compiles, two runs under
@@ -13,6 +14,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 before=${1:-HEAD}
+after=${2:-}
 want=$(git rev-parse --verify "$before^{commit}")
 command -v valgrind >/dev/null || { echo "instructions.sh: valgrind is needed (apt-get install valgrind)" >&2; exit 2; }
 out=${NSP_INSTRUCTIONS_DIR:-build-instructions}
@@ -23,16 +25,23 @@ work_cc() { "$cxx" -O3 -DNDEBUG -std=gnu++20 -I"$1/examples" -I"$1/include" -isy
                 bench/work_count.cpp -o "$2"; }
 
 src=$(cd "$out" && pwd)/before-src
-git worktree remove --force "$src" 2>/dev/null || true
+new_src=.
+trees=("$src")
+if [ -n "$after" ]; then
+    new_src=$(cd "$out" && pwd)/after-src
+    trees+=("$new_src")
+fi
+cleanup() { for t in "${trees[@]}"; do git worktree remove --force "$t" 2>/dev/null || true; done; }
+cleanup
 git worktree prune
 git worktree add --detach "$src" "$want" >/dev/null
-trap 'git worktree remove --force "$src"' EXIT
-echo "instructions.sh: compiling bench/work_count.cpp against $(git rev-parse --short "$want") and the working tree" >&2
-# The harness is the working tree's on both sides: only the library and the example scenes differ.
+[ -z "$after" ] || git worktree add --detach "$new_src" "$(git rev-parse --verify "$after^{commit}")" >/dev/null
+trap cleanup EXIT
+echo "instructions.sh: compiling bench/work_count.cpp against $(git rev-parse --short "$want") and ${after:-the working tree}" >&2
 work_cc "$src" "$out/work-old" &
-work_cc . "$out/work-new" &
+work_cc "$new_src" "$out/work-new" &
 wait %1 && wait %2
-git worktree remove --force "$src"
+cleanup
 trap - EXIT
 
 for side in old new; do
@@ -46,9 +55,9 @@ for side in old new; do
     rm -f "$out/cg-$side" "$out/cg-$side".*
 done
 
-python3 - "$out" "$(git rev-parse --short "$want")" <<'EOF'
+python3 - "$out" "$(git rev-parse --short "$want")" "${after:-the working tree}" <<'EOF'
 import sys
-out, before = sys.argv[1], sys.argv[2]
+out, before, after = sys.argv[1], sys.argv[2], sys.argv[3]
 def load(side):
     ir = {}
     for line in open(f"{out}/ir-{side}.txt"):
@@ -61,7 +70,7 @@ def load(side):
     return ir, work
 ir_old, w_old = load("old")
 ir_new, w_new = load("new")
-print(f"Instructions per kernel: the working tree against {before} (callgrind; new / old)\n")
+print(f"Instructions per kernel: {after} against {before} (callgrind; new / old)\n")
 print(f"| kernel | calls | instructions old | instructions new | new / old | lookups | same paths |")
 print(f"|---|---|---|---|---|---|---|")
 for name in w_new:
