@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <memory>
+#include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
@@ -118,11 +119,13 @@ public:
                 ++nee[std::size_t(nsp::NeeCountLearner::candidate_index(c.nee))];
                 ++segment[std::size_t(nsp::NeeCountLearner::candidate_index(c.emission_segment))];
             }
-            row.note = "learned counts (" + name + ", a " + std::to_string(pilot) +
-                       "-spp pilot at counts 1 per 16x16 tile), tiles at 1, 1/2, .., 1/64: NEE";
-            for (const int n : nee) row.note += " " + std::to_string(n);
-            row.note += "; emission segment";
-            for (const int n : segment) row.note += " " + std::to_string(n);
+            std::ostringstream note;  // not "(" + std::to_string(..): GCC 12 warns (-Wrestrict, bug 105329)
+            note << "learned counts (" << name << ", a " << pilot
+                 << "-spp pilot at counts 1 per 16x16 tile), tiles at 1, 1/2, .., 1/64: NEE";
+            for (const int n : nee) note << ' ' << n;
+            note << "; emission segment";
+            for (const int n : segment) note << ' ' << n;
+            row.note = note.str();
             return row;
         });
     }
