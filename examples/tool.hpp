@@ -105,15 +105,12 @@ void require_regular_file(const std::string& path, std::string_view what);
 /// `path` is not a directory; else throws UsageError.
 void require_writable_file(std::string_view flag, const std::string& path);
 
-/// Runs body() as a tool's main and returns its exit code: UsageError -> "nsp_<tool>: what" (and
-/// the --help hint where it has one), kExitUsage; any other std::exception -> "nsp_<tool>: what",
-/// kExitRuntime. `tool` is the program's name, e.g. "nsp_room".
-template <class Body>
-int run_tool(const char* tool, Body&& body) noexcept;
-
 /// Prints a usage error's or a runtime error's line(s) on stderr (run_tool's reporting).
 void report_error(const char* tool, const std::exception& e, bool help_hint);
 
+/// Runs body() as a tool's main and returns its exit code: UsageError -> "nsp_<tool>: what" (and
+/// the --help hint where it has one), kExitUsage; any other std::exception -> "nsp_<tool>: what",
+/// kExitRuntime. `tool` is the program's name, e.g. "nsp_room".
 template <class Body>
 int run_tool(const char* tool, Body&& body) noexcept {
     try {
