@@ -1,15 +1,17 @@
 // examples/progress.hpp: the progress lines of nsp_render, nsp_room and nsp_volume on stderr, one
 // per finished render, "  [k/N] name: T s (about R left)", and the estimate of the time left.
 //
-// The estimate: a render's seconds per sample are modelled as a factor of its table (the scene,
-// its size and mode: what every row of the table pays) times a factor of its kind (the row's
-// estimator, which recurs across tables: BDPT costs several path tracers' time per sample in
-// every scene), both fitted to the renders done so far (least squares on the logarithms). A
-// render still to come is estimated from its samples times both factors: the kind's where that
-// kind was rendered before (in another table, or an earlier run of the same row), else the mean
-// kind's; the table's where that table has begun, else the mean table's. Costs per sample differ
-// by 20x between rows of one table (unidirectional against BDPT) and between scenes; a rate per
-// table alone (the estimate before) was off by up to 2x either way.
+// The estimate: costs per sample differ by up to 10x between the rows of one table (unidirectional
+// against BDPT, a global against a grid majorant) and by 16x between the tables of a run
+// (nsp_render's fog against its chromatic cloud), so no rate measured on the renders done so far
+// predicts a table not rendered yet. A rate per scene (the estimate before) was 0.70-2.73x the time
+// actually left over nsp_render's default run, and a factor per table times one per row name,
+// fitted as the run goes, no better (0.70-4.4x). So each render is timed first with a pilot: the
+// same render at 1/64 of its spp (calibrate(); about 3% of the run, most of it building scenes). A
+// render still to come is its pilot's seconds per sample times its samples, times the ratio of
+// actual to pilot-predicted seconds of the renders done so far (what the pilots miss: the time
+// outside a render's sample loop); over the same run that was 0.91-1.08x the time left at every
+// render. A render without a pilot is estimated from the seconds per sample of the renders done.
 #pragma once
 
 #include <cstddef>
@@ -20,16 +22,19 @@ namespace nsp_examples {
 
 class Progress {
 public:
-    /// Plans a render: `table` groups the renders of one table, `kind` names its estimator the
-    /// same way in every table (the row's name), `samples` is width x height x spp. Returns its
-    /// id for done(). Plan every render before the first done(): N is the count planned.
-    std::size_t add(std::string table, std::string kind, double samples);
+    /// Plans a render of `samples` samples (width x height x spp); returns its id for
+    /// calibrate() and done(). Plan every render before the first done(): N is the count planned.
+    std::size_t add(double samples);
 
-    /// Render `id` took `seconds`: prints "  [k/N] name: T s (about R left)" on stderr, k the
-    /// renders done so far (nothing about the time left when none is left).
+    /// Render `id`'s pilot rendered `samples` samples in `seconds`.
+    void calibrate(std::size_t id, double samples, double seconds);
+
+    /// Render `id` took `seconds` (all of it, outside its sample loop too): prints
+    /// "  [k/N] name: T s (about R left)" on stderr, k the renders done so far (nothing about the
+    /// time left when none is left).
     void done(std::size_t id, const std::string& name, double seconds);
 
-    /// The seconds the renders not yet done should take; 0 when none is left or nothing was done.
+    /// The seconds the renders not yet done should take (0 when nothing can be estimated yet).
     double seconds_left() const;
 
     std::size_t planned() const { return items_.size(); }
@@ -40,11 +45,15 @@ public:
     /// "12 s", "2 min 10 s", "1 h 5 min".
     static std::string duration_text(double seconds);
 
+    /// The samples of a render's pilot: 1/64 of its spp, at least 2 (what calibrate() expects
+    /// to be told about; the tools render the pilot at this spp).
+    static int pilot_spp(int spp) { return spp / 64 > 2 ? spp / 64 : 2; }
+
 private:
     struct Item {
-        std::string table, kind;
         double samples = 0.0;
-        double seconds = -1.0;  ///< < 0 while not done
+        double pilot_rate = -1.0;  ///< seconds per sample of its pilot; < 0 without one
+        double seconds = -1.0;     ///< < 0 while not done
     };
     std::vector<Item> items_;
     std::size_t done_ = 0;

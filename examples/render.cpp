@@ -40,42 +40,18 @@ using namespace nsp_examples;
 /// The reference's seeds: seed + this (the rows use seed .. seed + runs - 1, runs <= 1000).
 constexpr std::uint64_t kReferenceSeedOffset = 1000000;
 
-double samples_of(const TablePlan& t, int spp) { return double(t.width) * double(t.height) * double(spp); }
+/// One render of the run: a combination of a spectral mode, and its request.
+struct Job {
+    std::string_view mode;
+    std::size_t index = 0;
+    RenderRequest rq;
+};
 
-/// The renders of table `t` in `progress`: a table is a set-up in a mode, a kind a row's name (the
-/// same estimator costs alike in another set-up or mode, up to the table's factor).
-std::string progress_table(const TablePlan& t) { return std::string(t.scene.name()) + " " + std::string(t.mode); }
+double samples_of(const RenderRequest& rq) { return double(rq.width) * double(rq.height) * double(rq.spp); }
 
-int run(int argc, char** argv) {
-    const Options o = parse_command_line(argc, argv);
-    if (o.list) {
-        list_combinations();
-        return kExitOk;
-    }
-    const std::vector<TablePlan> tables = plan(o);
-    if (o.write_exr || o.write_png) require_writable_directory("--out", o.out);
-    const bool pictures = o.write_png && o.picture_res > 0;
-
-    Progress progress;
-    for (const TablePlan& t : tables) {
-        if (t.reference) progress.add(progress_table(t), "reference " + t.reference->name, samples_of(t, *o.reference_spp));
-        for (const Candidate& c : t.rows)
-            for (int run = 0; run < o.runs; ++run) progress.add(progress_table(t), c.name, samples_of(t, t.spp));
-    }
-    if (pictures)
-        for (const SceneKind kind : o.scenes) {
-            const SceneEntry& e = scene_entry(kind);
-            progress.add(e.picture_setup + " " + std::string(e.picture_mode), e.picture_estimator, picture_samples(kind, o));
-        }
-    std::fprintf(stderr, "nsp_render: %zu renders in %zu tables on %d threads\n", progress.planned(), tables.size(),
-                 o.threads);
-    const auto t0 = std::chrono::steady_clock::now();
-    std::size_t id = 0;
-    std::uint64_t failed = 0;  // paths that ended Aborted or NonFinite (Rejected: the -reject majorants' rows, by design)
-    auto done = [&](const RenderStats& s, const std::string& name) {
-        failed += s.aborted + s.nonfinite;
-        progress.done(id++, name, s.wall_seconds);
-    };
+/// Every render of the run, in the order it runs: per table its reference (--reference-spp),
+/// then each row's runs; then the pictures.
+std::vector<Job> plan_jobs(const std::vector<TablePlan>& tables, const Options& o, bool pictures) {
     auto request = [&](const TablePlan& t, std::uint64_t seed, SelectionRule selection) {
         RenderRequest rq;
         rq.scene = t.scene;
@@ -90,6 +66,75 @@ int run(int argc, char** argv) {
         rq.majorant = o.majorant;
         return rq;
     };
+    std::vector<Job> jobs;
+    for (const TablePlan& t : tables) {
+        if (t.reference) {
+            Job& j = jobs.emplace_back(Job{t.mode, t.reference->index, request(t, o.seed + kReferenceSeedOffset, SelectionRule::Uniform)});
+            j.rq.spp = *o.reference_spp;
+            j.rq.pixel_stats = true;
+        }
+        for (const Candidate& c : t.rows)
+            for (int run = 0; run < o.runs; ++run) {
+                Job& j = jobs.emplace_back(Job{t.mode, c.index, request(t, o.seed + std::uint64_t(run), c.selection)});
+                j.rq.pixel_stats = t.reference.has_value();
+                j.rq.learn_nee_counts = c.learned;
+            }
+    }
+    if (pictures)
+        for (const SceneKind kind : o.scenes) {
+            const PictureJob p = picture_job(kind, o);
+            jobs.push_back({p.mode, p.index, p.rq});
+        }
+    return jobs;
+}
+
+/// Times every job with a pilot at 1/64 of its spp for `progress` (progress.hpp: the costs per
+/// sample of the scenes and rows differ by up to 20x, and no rate measured on one predicts
+/// another); returns the seconds the pilots took.
+double time_jobs(const std::vector<Job>& jobs, Progress& progress) {
+    const auto t0 = std::chrono::steady_clock::now();
+    for (std::size_t id = 0; id < jobs.size(); ++id) {
+        RenderRequest rq = jobs[id].rq;
+        rq.spp = Progress::pilot_spp(rq.spp);
+        rq.pixel_stats = false;
+        rq.label = "timing the renders: " + std::to_string(id + 1) + "/" + std::to_string(jobs.size());
+        std::vector<float> rgb;
+        progress.calibrate(id, samples_of(rq), render_in_mode(jobs[id].mode, jobs[id].index, rq, rgb).wall_seconds);
+    }
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+int run(int argc, char** argv) {
+    const Options o = parse_command_line(argc, argv);
+    if (o.list) {
+        list_combinations();
+        return kExitOk;
+    }
+    const std::vector<TablePlan> tables = plan(o);
+    if (o.write_exr || o.write_png) require_writable_directory("--out", o.out);
+    const bool pictures = o.write_png && o.picture_res > 0;
+
+    const std::vector<Job> jobs = plan_jobs(tables, o, pictures);
+    Progress progress;
+    for (const Job& j : jobs) progress.add(samples_of(j.rq));
+    std::fprintf(stderr, "nsp_render: %zu renders in %zu tables on %d threads; timing each at 1/64 of its spp\n",
+                 jobs.size(), tables.size(), o.threads);
+    const auto t0 = std::chrono::steady_clock::now();
+    const double pilots = time_jobs(jobs, progress);
+    std::fprintf(stderr, "nsp_render: about %s to render (the timing took %.1f s)\n",
+                 Progress::duration_text(progress.seconds_left()).c_str(), pilots);
+    std::size_t id = 0;
+    std::uint64_t failed = 0;  // paths that ended Aborted or NonFinite (Rejected: the -reject majorants' rows, by design)
+    // Renders jobs[id] (labelled `name`), counts its failed paths and prints its progress line.
+    auto render_job = [&](const std::string& name, std::vector<float>& rgb) {
+        RenderRequest rq = jobs[id].rq;
+        rq.label = progress.next_label(name);
+        const auto start = std::chrono::steady_clock::now();
+        const RenderStats s = render_in_mode(jobs[id].mode, jobs[id].index, rq, rgb);
+        failed += s.aborted + s.nonfinite;
+        progress.done(id++, name, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+        return s;
+    };
 
     std::vector<std::string> summary, sheets;
     for (const TablePlan& t : tables) {
@@ -99,14 +144,8 @@ int run(int argc, char** argv) {
             reference->estimator = t.reference->name;
             reference->spp = *o.reference_spp;
             reference->seed = o.seed + kReferenceSeedOffset;
-            RenderRequest rq = request(t, reference->seed, SelectionRule::Uniform);
-            rq.spp = reference->spp;
-            rq.pixel_stats = true;
-            const std::string name = std::string(t.scene.name()) + "_reference_" + std::string(t.mode);
-            rq.label = progress.next_label(name);
             std::vector<float> rgb;
-            reference->stats = render_in_mode(t.mode, t.reference->index, rq, rgb);
-            done(reference->stats, name);
+            reference->stats = render_job(std::string(t.scene.name()) + "_reference_" + std::string(t.mode), rgb);
         }
         std::vector<Row> rows;
         std::vector<Image> images;
@@ -115,14 +154,8 @@ int run(int argc, char** argv) {
             std::string file = std::string(t.scene.name()) + "_" + c.name;
             if (t.mode != nsp::Mono::name) file.append("_").append(t.mode);
             for (int run = 0; run < o.runs; ++run) {
-                RenderRequest rq = request(t, o.seed + std::uint64_t(run), c.selection);
-                rq.pixel_stats = reference.has_value();
-                rq.learn_nee_counts = c.learned;
-                const std::string name = o.runs > 1 ? file + " run " + std::to_string(run + 1) : file;
-                rq.label = progress.next_label(name);
                 std::vector<float> rgb;
-                row.runs.push_back(render_in_mode(t.mode, c.index, rq, rgb));
-                done(row.runs.back(), name);
+                row.runs.push_back(render_job(o.runs > 1 ? file + " run " + std::to_string(run + 1) : file, rgb));
                 if (reference) {
                     row.effective.push_back(effective_variance(row.runs.back(), t.spp, *reference));
                     row.effective_image.push_back(effective_image_variance(row.runs.back(), t.spp, *reference));
@@ -146,9 +179,9 @@ int run(int argc, char** argv) {
             const SceneEntry& e = scene_entry(kind);
             const std::string name = e.name + " picture (" + e.picture_setup + ", " + e.picture_estimator + ", " +
                                      std::to_string(o.picture_res) + "^2 x " + std::to_string(e.picture_spp) + " spp)";
-            const auto p0 = std::chrono::steady_clock::now();
-            picture_paths.push_back(render_scene_picture(kind, o, progress.next_label(name)));
-            progress.done(id++, name, std::chrono::duration<double>(std::chrono::steady_clock::now() - p0).count());
+            Image image{o.picture_res, o.picture_res, {}};
+            render_job(name, image.rgb);
+            picture_paths.push_back(write_scene_picture(kind, o, image));
         }
 
     const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

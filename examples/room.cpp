@@ -37,6 +37,7 @@
 // an --out that cannot be created or written), with a message that names the flag.
 #include <cstdio>
 #include <iterator>
+#include <utility>
 #include <string>
 #include <vector>
 
@@ -57,12 +58,31 @@ int run(int argc, char** argv) {
     const std::vector<RoomTable> tables = room_tables(o);
     const bool picture = !o.no_png && o.wants("grey");
 
+    // Every render, in order, with its spp; each timed first with a pilot at 1/64 of its spp for
+    // the estimate of the time left (progress.hpp).
+    std::vector<std::pair<const RoomRow*, int>> renders;
     Progress progress;
     for (const RoomTable& t : tables)
-        for (const RoomRow& r : t.rows) progress.add(t.title, r.name, double(t.res) * t.res * t.spp);
-    if (picture) progress.add("Room (mono", "picture", double(o.picture_res) * o.picture_res * 128);
-    std::fprintf(stderr, "nsp_room: %zu renders in %zu tables on %d threads\n", progress.planned(), tables.size(),
-                 o.threads);
+        for (const RoomRow& r : t.rows) {
+            renders.emplace_back(&r, t.spp);
+            progress.add(double(t.res) * t.res * t.spp);
+        }
+    const RoomRow picture_row = room_picture(o);
+    if (picture) {
+        renders.emplace_back(&picture_row, kRoomPictureSpp);
+        progress.add(double(o.picture_res) * o.picture_res * kRoomPictureSpp);
+    }
+    std::fprintf(stderr, "nsp_room: %zu renders in %zu tables on %d threads; timing each at 1/64 of its spp\n",
+                 renders.size(), tables.size(), o.threads);
+    double pilots = 0.0;
+    for (std::size_t i = 0; i < renders.size(); ++i) {
+        const int spp = Progress::pilot_spp(renders[i].second);
+        const Row pilot = renders[i].first->render(spp);
+        progress.calibrate(i, double(pilot.image.width) * pilot.image.height * spp, pilot.seconds);
+        pilots += pilot.seconds;
+    }
+    std::fprintf(stderr, "nsp_room: about %s to render (the timing took %.1f s)\n",
+                 Progress::duration_text(progress.seconds_left()).c_str(), pilots);
 
     std::vector<Row> all;
     std::uint64_t failed = 0;
@@ -75,7 +95,7 @@ int run(int argc, char** argv) {
     for (const RoomTable& t : tables) {
         std::vector<Row> rows;
         for (const RoomRow& r : t.rows) {
-            rows.push_back(r.render());
+            rows.push_back(r.render(t.spp));
             progress.done(id++, r.name, rows.back().seconds);
         }
         failed += print_table(t, rows, o.threads);
@@ -95,7 +115,7 @@ int run(int argc, char** argv) {
         }
     }
     if (picture) {
-        const Row row = room_picture(o).render();
+        const Row row = picture_row.render(kRoomPictureSpp);
         progress.done(id++, "room.png", row.seconds);
         const std::string path = o.out + "/room.png";
         write_png(path, row.image, exposure_for({&row.image}));

@@ -15,10 +15,11 @@
 
 namespace nsp_examples {
 
-/// One render of a table: its row's name and how to render it (at the table's size, its seed).
+/// One render of a table: its row's name and how to render it at `spp` samples per pixel (the
+/// table's; a pilot renders fewer to time it) at the table's size with its seed.
 struct RoomRow {
     std::string name;
-    std::function<Row()> render;
+    std::function<Row(int spp)> render;
 };
 
 /// One table: its rows, the row the z column compares with, the lines printed under it.
@@ -48,7 +49,8 @@ std::vector<RoomTable> empty_tables(const RoomOptions& o);
 std::vector<RoomTable> room_tables(const RoomOptions& o);
 
 /// DIR/room.png's render: the grey room with uni + NEE MIS (balance), --picture-res pixels square,
-/// 128 spp, seed 99.
+/// seed 99, at kRoomPictureSpp.
 RoomRow room_picture(const RoomOptions& o);
+inline constexpr int kRoomPictureSpp = 128;
 
 }  // namespace nsp_examples

@@ -29,7 +29,8 @@ std::shared_ptr<const Sc> share(Sc scene) {
 }
 
 /// Adds rows to a table: each takes the table's size and the next seed (`seed`, which a table
-/// may set back to pair two rows on the same random numbers).
+/// may set back to pair two rows on the same random numbers); its render takes the spp (the
+/// table's, or a pilot's).
 class RowMaker {
 public:
     RowMaker(RoomTable& table, const RoomOptions& o, std::uint64_t first_seed)
@@ -40,7 +41,7 @@ public:
     /// A row through the room's camera rays.
     template <class Sc, class E>
     void path(std::shared_ptr<const Sc> scene, const E& estimator, const std::string& name) {
-        add(name, [=, res = table_.res, spp = table_.spp, threads = threads_, s = seed++] {
+        add(name, [=, res = table_.res, threads = threads_, s = seed++](int spp) {
             return render_image(*scene, estimator, name, res, spp, threads, s,
                                 [](float u, float v) { return room_camera_ray(u, v, 1.f); });
         });
@@ -50,7 +51,7 @@ public:
     template <class Sc, class E>
     void splatting(std::shared_ptr<const Sc> scene, const E& estimator, const std::string& name,
                    const nsp::PinholeCamera& camera = room_pinhole()) {
-        add(name, [=, res = table_.res, spp = table_.spp, threads = threads_, s = seed++] {
+        add(name, [=, res = table_.res, threads = threads_, s = seed++](int spp) {
             return render_image_splatting(*scene, estimator, camera, name, res, spp, threads, s);
         });
     }
@@ -63,7 +64,7 @@ public:
         if constexpr (requires { estimator.kMaxPath; })
             splatting(scene, estimator, name, camera);
         else
-            add(name, [=, res = table_.res, spp = table_.spp, threads = threads_, s = seed++] {
+            add(name, [=, res = table_.res, threads = threads_, s = seed++](int spp) {
                 return render_image(*scene, estimator, name, res, spp, threads, s,
                                     [&](float u, float v) { return camera.ray(u, v); });
             });
@@ -77,7 +78,7 @@ public:
     template <class Sc, class Channels>
     void learned_bdpt(std::shared_ptr<const Sc> scene, const nsp::PinholeCamera& camera, const std::string& name,
                       Channels, bool roulette = true) {
-        add(name, [=, res = table_.res, spp = table_.spp, threads = threads_, s = seed++] {
+        add(name, [=, res = table_.res, threads = threads_, s = seed++](int spp) {
             auto make = [roulette](float nee, float light) {
                 nsp::EstimatorOptions o = nsp::BdptEstimator<>::default_options();
                 o.nee_count = nee;
@@ -103,7 +104,7 @@ public:
     template <class Sc>
     void learned_path(std::shared_ptr<const Sc> scene) {
         const std::string name = "uni-nee-mis_balance_learned";
-        add(name, [=, res = table_.res, spp = table_.spp, threads = threads_, s = seed++] {
+        add(name, [=, res = table_.res, threads = threads_, s = seed++](int spp) {
             auto make = [](float nee, float segment) {
                 nsp::EstimatorOptions o;
                 o.nee_count = nee;

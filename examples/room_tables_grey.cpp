@@ -58,8 +58,8 @@ RoomTable sky_table(const RoomOptions& o) {
 
 RoomRow room_picture(const RoomOptions& o) {
     const auto grey = share(make_room_scene());
-    return {"room.png", [grey, res = o.picture_res, threads = o.threads] {
-                return render_image(*grey, PathEstimator<strategy::NullScatteringMis, mis::Balance>{}, "picture", res, 128,
+    return {"room.png", [grey, res = o.picture_res, threads = o.threads](int spp) {
+                return render_image(*grey, PathEstimator<strategy::NullScatteringMis, mis::Balance>{}, "picture", res, spp,
                                     threads, 99, [](float u, float v) { return room_camera_ray(u, v, 1.f); });
             }};
 }

@@ -91,21 +91,30 @@ void write_picture(const Row& row, const VolumeOptions& o) {
 /// Renders `medium` under `majorant` with the three strategies and prints the table (z against
 /// uni-nee-mis balance).
 template <class M, class Maj>
-std::uint64_t run_strategies(const M& medium, const Maj& majorant, const VolumeOptions& o, const std::string& label) {
+std::uint64_t run_strategies(const M& medium, const Maj& majorant, const VolumeOptions& o) {
     using namespace nsp;
     const nsp_examples::VolumeFraming<M> cam(medium);
     const auto scene = Scene(medium, majorant, HenyeyGreensteinPhase(o.g), cam.lights);
     const double samples = double(o.res) * o.res * o.spp;
+    // The rows: f(estimator, name, seed) for each.
+    auto each_row = [](auto&& f) {
+        f(PathEstimator<strategy::Unidirectional>{}, "unidirectional", 1);
+        f(PathEstimator<strategy::NextEvent>{}, "ratio-nee", 2);
+        f(PathEstimator<strategy::NullScatteringMis, mis::Balance>{}, "uni-nee-mis_balance", 3);
+    };
+    // Each timed first with a pilot at 1/64 of the spp, for the estimate of the time left.
     nsp_examples::Progress progress;
-    for (const char* name : {"unidirectional", "ratio-nee", "uni-nee-mis_balance"}) progress.add(label, name, samples);
+    each_row([&](const auto& estimator, const char*, std::uint64_t seed) {
+        const std::size_t id = progress.add(samples);
+        const int spp = nsp_examples::Progress::pilot_spp(o.spp);
+        progress.calibrate(id, double(o.res) * o.res * spp,
+                           nsp_examples::render_image(scene, estimator, "pilot", o.res, spp, o.threads, seed, cam).seconds);
+    });
     std::vector<Row> rows;
-    auto run = [&](const auto& estimator, const char* name, std::uint64_t seed) {
+    each_row([&](const auto& estimator, const char* name, std::uint64_t seed) {
         rows.push_back(nsp_examples::render_image(scene, estimator, name, o.res, o.spp, o.threads, seed, cam));
         progress.done(rows.size() - 1, name, rows.back().seconds);
-    };
-    run(PathEstimator<strategy::Unidirectional>{}, "unidirectional", 1);
-    run(PathEstimator<strategy::NextEvent>{}, "ratio-nee", 2);
-    run(PathEstimator<strategy::NullScatteringMis, mis::Balance>{}, "uni-nee-mis_balance", 3);
+    });
     const std::uint64_t failed = print_rows(rows, 2, samples, "", [](const Row&) {});
     write_picture(rows.back(), o);
     return failed;
@@ -132,7 +141,7 @@ nsp::TreeMajorant<M> tree_majorant(const M& m, const VolumeOptions& o, bool on_n
 /// 64^3 and the tree majorant, and prints the comparison with each majorant's memory and build
 /// time (z against the global majorant's row).
 template <class M>
-std::uint64_t compare_majorants(const M& medium, const VolumeOptions& o, const std::string& label) {
+std::uint64_t compare_majorants(const M& medium, const VolumeOptions& o) {
     using namespace nsp;
     const nsp_examples::VolumeFraming<M> cam(medium);
     const PathEstimator<strategy::NullScatteringMis, mis::Balance> est;
@@ -153,8 +162,7 @@ std::uint64_t compare_majorants(const M& medium, const VolumeOptions& o, const s
     names.push_back("tree");
     const double samples = double(o.res) * o.res * o.spp;
     nsp_examples::Progress progress;
-    for (const std::string& name : names)
-        for (int k = 0; k < o.runs; ++k) progress.add(label, name, samples);
+    for (std::size_t i = 0; i < names.size() * std::size_t(o.runs); ++i) progress.add(samples);  // no pilots: by samples
 
     std::vector<Row> rows;
     std::vector<std::pair<std::size_t, double>> cost;  // bytes, build milliseconds
@@ -234,11 +242,11 @@ int render(const M& medium, const VolumeOptions& o, const char* mode, const char
     std::printf("Volume (%s, %dx%d, %d spp, %d threads, %s): %s\n", mode, o.res, o.res, o.spp, o.threads, label.c_str(),
                 scene);
     std::uint64_t failed = 0;
-    if (o.compare) failed = compare_majorants(medium, o, label);
-    else if (o.majorant == "grid") failed = run_strategies(medium, nsp::GridMajorant<M>(medium, o.grid_res), o, label);
-    else if (o.majorant == "tree") failed = run_strategies(medium, tree_majorant(medium, o), o, label);
-    else if (o.majorant == "tree-nodes") failed = run_strategies(medium, tree_majorant(medium, o, true), o, label);
-    else failed = run_strategies(medium, nsp::GlobalMajorant<M>(medium), o, label);
+    if (o.compare) failed = compare_majorants(medium, o);
+    else if (o.majorant == "grid") failed = run_strategies(medium, nsp::GridMajorant<M>(medium, o.grid_res), o);
+    else if (o.majorant == "tree") failed = run_strategies(medium, tree_majorant(medium, o), o);
+    else if (o.majorant == "tree-nodes") failed = run_strategies(medium, tree_majorant(medium, o, true), o);
+    else failed = run_strategies(medium, nsp::GlobalMajorant<M>(medium), o);
     if (failed == 0) return nsp_examples::kExitOk;
     std::fprintf(stderr, "nsp_volume: %llu paths ended with a status other than Ok\n", static_cast<unsigned long long>(failed));
     return nsp_examples::kExitRuntime;
