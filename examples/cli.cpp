@@ -1,31 +1,23 @@
-// examples/cli.cpp: nsp_render's command line (see cli.hpp), parsed with CLI11. Every value is
-// checked here with a message that names the flag, the bad value and what is allowed.
+// examples/cli.cpp: nsp_render's command line (see cli.hpp), parsed with CLI11 through parse_flags
+// (tool.hpp). Every value is checked here with a message that names the flag, the bad value and
+// what is allowed.
 #include "cli.hpp"
 
 #include <algorithm>
 #include <array>
 #include <cctype>
-#include <charconv>
-#include <cmath>
-#include <cstdio>
-#include <cstdlib>
-#include <iostream>
 #include <limits>
-#include <sstream>
 #include <thread>
-#include <type_traits>
 
 #include <CLI/CLI.hpp>
 
 #include "catalogue.hpp"
 #include "plan.hpp"
+#include "tool.hpp"
 
 namespace nsp_examples {
 
-void usage_error(const std::string& msg) {
-    std::cerr << "nsp_render: " << msg << "\n(nsp_render --help lists the flags)\n";
-    std::exit(2);
-}
+void usage_error(const std::string& msg) { throw UsageError(msg, true); }
 
 std::vector<std::string_view> split(std::string_view s, char sep) {
     std::vector<std::string_view> parts;
@@ -39,33 +31,12 @@ std::vector<std::string_view> split(std::string_view s, char sep) {
 
 namespace {
 
-/// A bad value: thrown from an option's callback, reported by parse_command_line as usage_error.
-struct BadValue {
-    std::string message;
-};
-
-template <class T>
-T parse_number(std::string_view flag, std::string_view text, T lo, T hi) {
-    T v{};
-    const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
-    if (ec != std::errc() || end != text.data() + text.size() || text.empty())
-        throw BadValue{std::string(flag) + ": '" + std::string(text) + "' is not a number"};
-    if constexpr (std::is_floating_point_v<T>)
-        if (!std::isfinite(v)) throw BadValue{std::string(flag) + ": '" + std::string(text) + "' is not finite"};
-    if (v < lo || v > hi) {
-        std::ostringstream os;
-        os << flag << ": " << text << " is out of range [" << lo << ", " << hi << "]";
-        throw BadValue{os.str()};
-    }
-    return v;
-}
-
 template <std::size_t N>
 std::array<float, N> parse_floats(std::string_view flag, std::string_view text) {
     const auto parts = split(text, ',');
     if (parts.size() != N)
-        throw BadValue{std::string(flag) + ": expected " + std::to_string(N) + " comma-separated numbers, got '" +
-                       std::string(text) + "'"};
+        throw UsageError(std::string(flag) + ": expected " + std::to_string(N) + " comma-separated numbers, got '" +
+                       std::string(text) + "'", true);
     std::array<float, N> v{};
     for (std::size_t i = 0; i < N; ++i) v[i] = parse_number<float>(flag, parts[i], -1e30f, 1e30f);
     return v;
@@ -89,7 +60,7 @@ void parse_scenes(Options& o, std::string_view value) {
         else if (t == "all") for (const SceneEntry& e : catalogue()) add(e.kind);
         else if (const auto it = std::find(names.begin(), names.end(), t); it != names.end())
             add(catalogue()[std::size_t(it - names.begin())].kind);
-        else throw BadValue{"--scene: '" + std::string(t) + "' is not one of " + joined(names) + "both, all"};
+        else throw UsageError("--scene: '" + std::string(t) + "' is not one of " + joined(names) + "both, all", true);
     }
 }
 
@@ -104,7 +75,7 @@ void parse_setups(Options& o, std::string_view value) {
         else {
             std::string list;
             for (const auto& k : known) list += k + ", ";
-            throw BadValue{"--setup: '" + std::string(t) + "' is not one of " + list + "all"};
+            throw UsageError("--setup: '" + std::string(t) + "' is not one of " + list + "all", true);
         }
     }
 }
@@ -115,9 +86,9 @@ void parse_majorants(Options& o, std::string_view value) {
     for (const auto t : split(value, ',')) {
         if (t == "all") o.majorants.assign(known.begin(), known.end()), o.all_majorants = true;
         else if (std::find(known.begin(), known.end(), t) != known.end()) o.majorants.emplace_back(t);
-        else throw BadValue{"--majorant: '" + std::string(t) + "' is not one of " + joined(known) + "all"};
+        else throw UsageError("--majorant: '" + std::string(t) + "' is not one of " + joined(known) + "all", true);
     }
-    if (o.majorants.empty()) throw BadValue{"--majorant needs at least one name"};
+    if (o.majorants.empty()) throw UsageError("--majorant needs at least one name", true);
 }
 
 void parse_modes(Options& o, std::string_view value) {
@@ -127,41 +98,8 @@ void parse_modes(Options& o, std::string_view value) {
         if (t == "all") o.modes = known;
         else if (t == "both") o.modes = {nsp::Mono::name, nsp::Rgb::name};
         else if (const auto it = std::find(known.begin(), known.end(), t); it != known.end()) o.modes.push_back(*it);
-        else throw BadValue{"--spectral: '" + std::string(t) + "' is not one of mono, rgb, hero, both, all"};
+        else throw UsageError("--spectral: '" + std::string(t) + "' is not one of mono, rgb, hero, both, all", true);
     }
-}
-
-/// The arguments for CLI11, checked first against the flags' names so that the messages say what
-/// today's flags always said: an unknown flag, a flag that takes no value given one, a value
-/// missing at the end. A value that starts like a negative number is joined to its flag
-/// ("--point -0.5,..." -> "--point=-0.5,..."): CLI11 would read it as a short flag.
-std::vector<std::string> checked_arguments(int argc, char** argv, const std::vector<std::string>& takes_value,
-                                           const std::vector<std::string>& no_value) {
-    const auto known = [](const std::vector<std::string>& names, std::string_view n) {
-        return std::find(names.begin(), names.end(), n) != names.end();
-    };
-    std::vector<std::string> args;
-    for (int i = 1; i < argc; ++i) {
-        std::string a = argv[i];
-        const auto eq = a.find('=');
-        const std::string name = a.starts_with("--") ? a.substr(0, eq) : a;
-        if (name == "-h" || name == "--help") {
-            args.push_back(a);
-        } else if (known(no_value, name)) {
-            if (eq != std::string::npos) throw BadValue{name + " takes no value"};
-            args.push_back(a);
-        } else if (known(takes_value, name)) {
-            if (eq == std::string::npos) {
-                if (i + 1 >= argc) throw BadValue{name + " needs a value"};
-                a += "=" + std::string(argv[++i]);  // the next argument is its value, whatever it looks like
-            }
-            args.push_back(a);
-        } else {
-            throw BadValue{"unknown flag '" + a + "'"};
-        }
-    }
-    std::reverse(args.begin(), args.end());  // CLI11 takes a vector in reverse order
-    return args;
 }
 
 constexpr const char* kDescription =
@@ -169,7 +107,8 @@ constexpr const char* kDescription =
     "light set-up and spectral mode (LTUV = density lookups per sample x variance per sample;\n"
     "cpu-s*var = CPU seconds per sample x variance per sample; lower is better). Writes an EXR per\n"
     "row, a PNG contact sheet per table and a PNG picture per scene. docs/renderer.md explains\n"
-    "every flag at length.";
+    "every flag at length. Exits 0; 1 if a path ended with status Aborted or NonFinite or a write\n"
+    "failed; 2 on a bad command line (a message names the flag).";
 
 constexpr const char* kFooter =
     "Examples: nsp_render --scene cloud --setup A --estimators uni-nee-mis_balance\n"
@@ -189,15 +128,12 @@ Options parse_command_line(int argc, char** argv) {
     app.get_formatter()->column_width(28);
     app.footer(kFooter);
     app.set_help_flag("-h,--help", "this text");
-    // One value: `parse` turns it into the option's field or throws BadValue.
-    std::vector<std::string> takes_value, no_value;
+    // One value: `parse` turns it into the option's field or throws UsageError.
     auto value = [&](const char* flag, const char* type, const char* help, auto parse) {
-        takes_value.emplace_back(flag);
         app.add_option_function<std::string>(flag, [=](const std::string& v) { parse(std::string_view(v)); }, help)
             ->type_name(type);
     };
     auto flag = [&](const char* name, const char* help, auto set) {
-        no_value.emplace_back(name);
         app.add_flag_callback(name, set, help)->disable_flag_override();
     };
     // What is rendered
@@ -212,7 +148,7 @@ Options parse_command_line(int argc, char** argv) {
               o.estimators.clear();
               for (const auto t : split(v, ','))
                   if (!t.empty()) o.estimators.emplace_back(t);
-              if (o.estimators.empty()) throw BadValue{"--estimators needs at least one name"};
+              if (o.estimators.empty()) throw UsageError("--estimators needs at least one name", true);
           });
     value("--majorant", "LIST", "global, per-channel, grid, channel-grid, grid-signed, ..., all",
           [&](std::string_view v) { parse_majorants(o, v); });
@@ -224,7 +160,7 @@ Options parse_command_line(int argc, char** argv) {
         if (v == "uniform") o.selections = {SelectionRule::Uniform};
         else if (v == "luminance") o.selections = {SelectionRule::Luminance};
         else if (v == "both") o.selections = {SelectionRule::Uniform, SelectionRule::Luminance};
-        else throw BadValue{"--selection: '" + std::string(v) + "' is not one of uniform, luminance, both"};
+        else throw UsageError("--selection: '" + std::string(v) + "' is not one of uniform, luminance, both", true);
     });
     // How much
     value("--spp", "N", "samples per pixel, N >= 2 (default: the scene's)",
@@ -232,7 +168,7 @@ Options parse_command_line(int argc, char** argv) {
     value("--res", "WxH", "image size (default: the scene's); also --width W, --height H", [&](std::string_view v) {
         const auto x = v.find('x');
         if (x == std::string_view::npos)
-            throw BadValue{"--res: expected WxH, e.g. 128x128, got '" + std::string(v) + "'"};
+            throw UsageError("--res: expected WxH, e.g. 128x128, got '" + std::string(v) + "'", true);
         o.width = parse_number<int>("--res width", v.substr(0, x), 1, 16384);
         o.height = parse_number<int>("--res height", v.substr(x + 1), 1, 16384);
     });
@@ -264,18 +200,18 @@ Options parse_command_line(int argc, char** argv) {
           [&](std::string_view v) { o.lights.env = parse_number<float>("--env", v, 0.f, 1e30f); });
     value("--point", "X,Y,Z,I", "add a point light of intensity I >= 0 (the fog: move its lamp)", [&](std::string_view v) {
         o.lights.point = parse_floats<4>("--point", v);
-        if ((*o.lights.point)[3] < 0.f) throw BadValue{"--point: the intensity must be >= 0"};
+        if ((*o.lights.point)[3] < 0.f) throw UsageError("--point: the intensity must be >= 0", true);
     });
     value("--sphere", "X,Y,Z,R,L", "replace the sphere light (R > 0, L >= 0; outside the medium)",
           [&](std::string_view v) {
               o.lights.sphere = parse_floats<5>("--sphere", v);
-              if (!((*o.lights.sphere)[3] > 0.f)) throw BadValue{"--sphere: the radius must be > 0"};
-              if ((*o.lights.sphere)[4] < 0.f) throw BadValue{"--sphere: the radiance must be >= 0"};
+              if (!((*o.lights.sphere)[3] > 0.f)) throw UsageError("--sphere: the radius must be > 0", true);
+              if ((*o.lights.sphere)[4] < 0.f) throw UsageError("--sphere: the radiance must be >= 0", true);
           });
     // Output
     value("--out", "DIR", "directory for the images (default out), created if missing", [&](std::string_view v) {
         o.out = std::string(v);
-        if (o.out.empty()) throw BadValue{"--out needs a directory name"};
+        if (o.out.empty()) throw UsageError("--out needs a directory name", true);
     });
     flag("--no-exr", "write no EXR images", [&] { o.write_exr = false; });
     flag("--no-png", "write no PNG images (contact sheets, pictures)", [&] { o.write_png = false; });
@@ -283,17 +219,7 @@ Options parse_command_line(int argc, char** argv) {
           [&](std::string_view v) { o.picture_res = parse_number<int>("--picture-res", v, 0, 4096); });
     flag("--list", "list every compiled policy combination and exit", [&] { o.list = true; });
 
-    try {
-        std::vector<std::string> args = checked_arguments(argc, argv, takes_value, no_value);
-        app.parse(args);
-    } catch (const CLI::CallForHelp&) {
-        std::cout << app.help();
-        std::exit(0);
-    } catch (const CLI::ParseError& e) {
-        usage_error(e.what());
-    } catch (const BadValue& e) {
-        usage_error(e.message);
-    }
+    parse_flags(app, argc, argv);
     return o;
 }
 

@@ -37,11 +37,11 @@ struct Options {
     LightOverrides lights;
 };
 
-/// Parses the command line. Prints the help and exits 0 on --help; prints a message naming the
-/// bad flag or value and what is allowed, and exits 2, on any error.
+/// Parses the command line. Prints the help and exits 0 on --help; throws UsageError (tool.hpp:
+/// main prints it and exits 2) with a message naming the bad flag or value and what is allowed.
 Options parse_command_line(int argc, char** argv);
 
-/// Prints "nsp_render: msg" and the pointer to --help on stderr and exits 2 (also for the
+/// Throws UsageError(msg) with the pointer to --help: "nsp_render: msg", exit 2 (also for the
 /// planner's errors, which only show once the flags are combined).
 [[noreturn]] void usage_error(const std::string& msg);
 

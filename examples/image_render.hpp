@@ -17,6 +17,7 @@
 
 #include <nsp/nsp.hpp>
 
+#include "image_row.hpp"
 #include "png_writer.hpp"
 
 namespace nsp_examples {
@@ -26,15 +27,6 @@ inline double thread_cpu_seconds() {
     clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
     return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
 }
-
-/// What one render measured.
-struct Row {
-    std::string name;
-    double seconds = 0.0, cpu_seconds = 0.0, lookups = 0.0, variance = 0.0, mean = 0.0, se = 0.0;
-    double steps = 0.0;  ///< majorant DDA steps per sample (grid and tree majorants)
-    std::uint64_t failed = 0;  ///< paths with a status other than Ok
-    nsp_examples::Image image;
-};
 
 namespace detail {
 

@@ -26,11 +26,7 @@ std::string write_table_sheet(const TablePlan& t, const std::vector<Image>& imag
     return path;
 }
 
-double picture_samples(SceneKind kind, const Options& o) {
-    return double(o.picture_res) * double(o.picture_res) * double(scene_entry(kind).picture_spp);
-}
-
-std::string render_scene_picture(SceneKind kind, const Options& o, const std::string& label) {
+PictureJob picture_job(SceneKind kind, const Options& o) {
     const SceneEntry& e = scene_entry(kind);
     const SetupEntry* setup = nullptr;
     for (const SetupEntry& s : e.setups)
@@ -41,19 +37,20 @@ std::string render_scene_picture(SceneKind kind, const Options& o, const std::st
         if (c.emissive == e.emissive && c.name == e.picture_estimator) row = &c;
     if (!setup || !row)
         throw std::logic_error("the catalogue's picture of scene '" + e.name + "' names no compiled row");
-    RenderRequest rq;
-    rq.scene = setup->choice;
-    rq.lights = o.lights;
-    rq.width = rq.height = o.picture_res;
-    rq.spp = e.picture_spp;
-    rq.threads = o.threads;
-    rq.seed = o.seed;
-    rq.estimator = o.estimator;
-    rq.majorant = o.majorant;
-    rq.label = label;
-    Image image{o.picture_res, o.picture_res, {}};
-    render_in_mode(e.picture_mode, row->index, rq, image.rgb);
-    const std::string path = (std::filesystem::path(o.out) / (e.name + ".png")).string();
+    PictureJob job{e.picture_mode, row->index, {}};
+    job.rq.scene = setup->choice;
+    job.rq.lights = o.lights;
+    job.rq.width = job.rq.height = o.picture_res;
+    job.rq.spp = e.picture_spp;
+    job.rq.threads = o.threads;
+    job.rq.seed = o.seed;
+    job.rq.estimator = o.estimator;
+    job.rq.majorant = o.majorant;
+    return job;
+}
+
+std::string write_scene_picture(SceneKind kind, const Options& o, const Image& image) {
+    const std::string path = (std::filesystem::path(o.out) / (scene_entry(kind).name + ".png")).string();
     write_png(path, image, exposure_for({&image}));
     return path;
 }

@@ -3,12 +3,15 @@
 // example scene, rendered with one MIS estimator of that scene (catalogue.hpp).
 #pragma once
 
+#include <cstddef>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "cli.hpp"
 #include "plan.hpp"
 #include "png_writer.hpp"
+#include "render_job.hpp"
 
 namespace nsp_examples {
 
@@ -19,12 +22,16 @@ std::string table_stem(const TablePlan& t);
 /// the path written.
 std::string write_table_sheet(const TablePlan& t, const std::vector<Image>& images, const Options& o);
 
-/// The larger picture of scene `kind`: renders it at --picture-res (the catalogue's set-up, mode,
-/// estimator and samples per pixel) and writes OUT/<scene>.png. `label` names the render in the
-/// progress line. Returns the path written.
-std::string render_scene_picture(SceneKind kind, const Options& o, const std::string& label);
+/// The render of scene `kind`'s larger picture at --picture-res: the catalogue's set-up, mode,
+/// estimator (a combination of that mode) and samples per pixel.
+struct PictureJob {
+    std::string_view mode;
+    std::size_t index = 0;  ///< into CombinationsOf<S> of that mode
+    RenderRequest rq;
+};
+PictureJob picture_job(SceneKind kind, const Options& o);
 
-/// The samples of the picture of scene `kind` at --picture-res (for the time estimate).
-double picture_samples(SceneKind kind, const Options& o);
+/// Writes OUT/<scene>.png from the picture's rendered `image`; returns the path written.
+std::string write_scene_picture(SceneKind kind, const Options& o, const Image& image);
 
 }  // namespace nsp_examples

@@ -3,8 +3,10 @@
 #include "png_writer.hpp"
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstddef>
+#include <cstdio>
 #include <cstring>
 #include <stdexcept>
 
@@ -81,9 +83,25 @@ struct Canvas {
         for (int y = y0; y < y1; ++y)
             for (int x = x0; x < x1; ++x) set((std::size_t(y) * std::size_t(width) + std::size_t(x)) * 3u, c);
     }
+    /// Encodes the canvas and writes it to `path`. Not stbi_write_png, which ignores a failed
+    /// fwrite and fclose (a full disk would leave a truncated file and report success).
     void write(const std::string& path) const {
-        if (!stbi_write_png(path.c_str(), width, height, 3, bytes.data(), width * 3))
-            throw std::runtime_error("cannot write the PNG file '" + path + "'");
+        struct Sink {
+            std::FILE* file;
+            int error = 0;  // errno of the first failed write
+        };
+        Sink sink{std::fopen(path.c_str(), "wb")};
+        if (!sink.file) throw std::runtime_error("cannot write the PNG file '" + path + "': " + std::strerror(errno));
+        const int encoded = stbi_write_png_to_func(
+            [](void* context, void* data, int size) {
+                Sink& s = *static_cast<Sink*>(context);
+                if (s.error == 0 && std::fwrite(data, 1, std::size_t(size), s.file) != std::size_t(size)) s.error = errno;
+            },
+            &sink, width, height, 3, bytes.data(), width * 3);
+        if (std::fclose(sink.file) != 0 && sink.error == 0) sink.error = errno;
+        if (!encoded) throw std::runtime_error("cannot write the PNG file '" + path + "': the encoder failed");
+        if (sink.error != 0)
+            throw std::runtime_error("cannot write the PNG file '" + path + "': " + std::strerror(sink.error));
     }
 };
 

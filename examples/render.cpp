@@ -7,16 +7,18 @@
 // renders), stats (what a table measures), report and report_scenes (the tables and the
 // summary), pictures (the PNG files). The command-line choices become types once, in
 // render_combination<S> (render_job.hpp), whose render loops are monomorphic. This file runs the
-// plan: the renders in order, with progress and an estimate of the time left.
+// plan: the renders in order, with a progress line per render and an estimate of the time left
+// (progress.hpp).
+//
+// Exit codes (tool.hpp, the same in nsp_room and nsp_volume): 0; 1 if a path ended with status
+// Aborted or NonFinite (Rejected is what the -reject majorants' rows are for) or a write failed;
+// 2 on a bad command line (an unknown flag, a bad value, a flag that selects nothing, an --out
+// that cannot be created or written), with a message that names the flag.
 #include <chrono>
 #include <cstdint>
 #include <cstdio>
-#include <exception>
 #include <filesystem>
-#include <iostream>
-#include <map>
 #include <optional>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -25,9 +27,11 @@
 #include "exr_writer.hpp"
 #include "pictures.hpp"
 #include "plan.hpp"
+#include "progress.hpp"
 #include "render_job.hpp"
 #include "report.hpp"
 #include "stats.hpp"
+#include "tool.hpp"
 
 namespace {
 
@@ -36,70 +40,18 @@ using namespace nsp_examples;
 /// The reference's seeds: seed + this (the rows use seed .. seed + runs - 1, runs <= 1000).
 constexpr std::uint64_t kReferenceSeedOffset = 1000000;
 
-/// The time left, from the seconds per sample measured so far in each scene (the scenes' costs
-/// per sample differ by 20x; a scene not rendered yet is taken at the mean of all so far).
-class TimeLeft {
-public:
-    /// `remaining`: the samples still to render, per scene.
-    explicit TimeLeft(std::map<SceneKind, double> remaining) : remaining_(std::move(remaining)) {}
-
-    void done(SceneKind kind, double samples, double seconds) {
-        remaining_[kind] -= samples;
-        measured_[kind].first += samples;
-        measured_[kind].second += seconds;
-    }
-    /// "about 2 min 10 s left", or "" before anything was measured.
-    std::string text() const {
-        double samples = 0.0, seconds = 0.0;
-        for (const auto& [kind, m] : measured_) samples += m.first, seconds += m.second;
-        if (!(samples > 0.0)) return "";
-        double left = 0.0;
-        for (const auto& [kind, n] : remaining_) {
-            const auto m = measured_.find(kind);
-            const double rate = m != measured_.end() && m->second.first > 0.0 ? m->second.second / m->second.first
-                                                                                : seconds / samples;
-            left += std::max(0.0, n) * rate;
-        }
-        const long s = long(left + 0.5);
-        return s >= 60 ? "about " + std::to_string(s / 60) + " min " + std::to_string(s % 60) + " s left"
-                       : "about " + std::to_string(s) + " s left";
-    }
-
-private:
-    std::map<SceneKind, double> remaining_;
-    std::map<SceneKind, std::pair<double, double>> measured_;  // samples, seconds
+/// One render of the run: a combination of a spectral mode, and its request.
+struct Job {
+    std::string_view mode;
+    std::size_t index = 0;
+    RenderRequest rq;
 };
 
-double samples_of(const TablePlan& t, int spp) { return double(t.width) * double(t.height) * double(spp); }
+double samples_of(const RenderRequest& rq) { return double(rq.width) * double(rq.height) * double(rq.spp); }
 
-int run(const Options& o) {
-    if (o.list) {
-        list_combinations();
-        return 0;
-    }
-    const std::vector<TablePlan> tables = plan(o);
-    if (o.write_exr || o.write_png) std::filesystem::create_directories(o.out);
-    const bool pictures = o.write_png && o.picture_res > 0;
-
-    std::size_t total = 0;
-    std::map<SceneKind, double> remaining;
-    for (const TablePlan& t : tables) {
-        total += t.rows.size() * std::size_t(o.runs) + (t.reference ? 1 : 0);
-        remaining[t.scene.kind] += double(t.rows.size() * std::size_t(o.runs)) * samples_of(t, t.spp) +
-                                   (t.reference ? samples_of(t, *o.reference_spp) : 0.0);
-    }
-    if (pictures)
-        for (const SceneKind kind : o.scenes) ++total, remaining[kind] += picture_samples(kind, o);
-    std::fprintf(stderr, "nsp_render: %zu renders in %zu tables on %d threads\n", total, tables.size(), o.threads);
-    TimeLeft left(remaining);
-    const auto t0 = std::chrono::steady_clock::now();
-    std::size_t done = 0;
-    auto label = [&](const std::string& name) {
-        std::ostringstream os;  // not "[" + std::to_string(..): GCC 12 warns (-Wrestrict, bug 105329)
-        os << '[' << ++done << '/' << total << "] " << name;
-        if (const std::string eta = left.text(); !eta.empty()) os << " (" << eta << ")";
-        return os.str();
-    };
+/// Every render of the run, in the order it runs: per table its reference (--reference-spp),
+/// then each row's runs; then the pictures.
+std::vector<Job> plan_jobs(const std::vector<TablePlan>& tables, const Options& o, bool pictures) {
     auto request = [&](const TablePlan& t, std::uint64_t seed, SelectionRule selection) {
         RenderRequest rq;
         rq.scene = t.scene;
@@ -114,6 +66,75 @@ int run(const Options& o) {
         rq.majorant = o.majorant;
         return rq;
     };
+    std::vector<Job> jobs;
+    for (const TablePlan& t : tables) {
+        if (t.reference) {
+            Job& j = jobs.emplace_back(Job{t.mode, t.reference->index, request(t, o.seed + kReferenceSeedOffset, SelectionRule::Uniform)});
+            j.rq.spp = *o.reference_spp;
+            j.rq.pixel_stats = true;
+        }
+        for (const Candidate& c : t.rows)
+            for (int run = 0; run < o.runs; ++run) {
+                Job& j = jobs.emplace_back(Job{t.mode, c.index, request(t, o.seed + std::uint64_t(run), c.selection)});
+                j.rq.pixel_stats = t.reference.has_value();
+                j.rq.learn_nee_counts = c.learned;
+            }
+    }
+    if (pictures)
+        for (const SceneKind kind : o.scenes) {
+            const PictureJob p = picture_job(kind, o);
+            jobs.push_back({p.mode, p.index, p.rq});
+        }
+    return jobs;
+}
+
+/// Times every job with a pilot at 1/64 of its spp for `progress` (progress.hpp: the costs per
+/// sample of the scenes and rows differ by up to 20x, and no rate measured on one predicts
+/// another); returns the seconds the pilots took.
+double time_jobs(const std::vector<Job>& jobs, Progress& progress) {
+    const auto t0 = std::chrono::steady_clock::now();
+    for (std::size_t id = 0; id < jobs.size(); ++id) {
+        RenderRequest rq = jobs[id].rq;
+        rq.spp = Progress::pilot_spp(rq.spp);
+        rq.pixel_stats = false;
+        rq.label = "timing the renders: " + std::to_string(id + 1) + "/" + std::to_string(jobs.size());
+        std::vector<float> rgb;
+        progress.calibrate(id, samples_of(rq), render_in_mode(jobs[id].mode, jobs[id].index, rq, rgb).wall_seconds);
+    }
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+int run(int argc, char** argv) {
+    const Options o = parse_command_line(argc, argv);
+    if (o.list) {
+        list_combinations();
+        return kExitOk;
+    }
+    const std::vector<TablePlan> tables = plan(o);
+    if (o.write_exr || o.write_png) require_writable_directory("--out", o.out);
+    const bool pictures = o.write_png && o.picture_res > 0;
+
+    const std::vector<Job> jobs = plan_jobs(tables, o, pictures);
+    Progress progress;
+    for (const Job& j : jobs) progress.add(samples_of(j.rq));
+    std::fprintf(stderr, "nsp_render: %zu renders in %zu tables on %d threads; timing each at 1/64 of its spp\n",
+                 jobs.size(), tables.size(), o.threads);
+    const auto t0 = std::chrono::steady_clock::now();
+    const double pilots = time_jobs(jobs, progress);
+    std::fprintf(stderr, "nsp_render: about %s to render (the timing took %.1f s)\n",
+                 Progress::duration_text(progress.seconds_left()).c_str(), pilots);
+    std::size_t id = 0;
+    std::uint64_t failed = 0;  // paths that ended Aborted or NonFinite (Rejected: the -reject majorants' rows, by design)
+    // Renders jobs[id] (labelled `name`), counts its failed paths and prints its progress line.
+    auto render_job = [&](const std::string& name, std::vector<float>& rgb) {
+        RenderRequest rq = jobs[id].rq;
+        rq.label = progress.next_label(name);
+        const auto start = std::chrono::steady_clock::now();
+        const RenderStats s = render_in_mode(jobs[id].mode, jobs[id].index, rq, rgb);
+        failed += s.aborted + s.nonfinite;
+        progress.done(id++, name, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+        return s;
+    };
 
     std::vector<std::string> summary, sheets;
     for (const TablePlan& t : tables) {
@@ -123,13 +144,8 @@ int run(const Options& o) {
             reference->estimator = t.reference->name;
             reference->spp = *o.reference_spp;
             reference->seed = o.seed + kReferenceSeedOffset;
-            RenderRequest rq = request(t, reference->seed, SelectionRule::Uniform);
-            rq.spp = reference->spp;
-            rq.pixel_stats = true;
-            rq.label = label(std::string(t.scene.name()) + "_reference_" + std::string(t.mode));
             std::vector<float> rgb;
-            reference->stats = render_in_mode(t.mode, t.reference->index, rq, rgb);
-            left.done(t.scene.kind, samples_of(t, rq.spp), reference->stats.wall_seconds);
+            reference->stats = render_job(std::string(t.scene.name()) + "_reference_" + std::string(t.mode), rgb);
         }
         std::vector<Row> rows;
         std::vector<Image> images;
@@ -138,13 +154,8 @@ int run(const Options& o) {
             std::string file = std::string(t.scene.name()) + "_" + c.name;
             if (t.mode != nsp::Mono::name) file.append("_").append(t.mode);
             for (int run = 0; run < o.runs; ++run) {
-                RenderRequest rq = request(t, o.seed + std::uint64_t(run), c.selection);
-                rq.pixel_stats = reference.has_value();
-                rq.learn_nee_counts = c.learned;
-                rq.label = label(o.runs > 1 ? file + " run " + std::to_string(run + 1) : file);
                 std::vector<float> rgb;
-                row.runs.push_back(render_in_mode(t.mode, c.index, rq, rgb));
-                left.done(t.scene.kind, samples_of(t, t.spp), row.runs.back().wall_seconds);
+                row.runs.push_back(render_job(o.runs > 1 ? file + " run " + std::to_string(run + 1) : file, rgb));
                 if (reference) {
                     row.effective.push_back(effective_variance(row.runs.back(), t.spp, *reference));
                     row.effective_image.push_back(effective_image_variance(row.runs.back(), t.spp, *reference));
@@ -168,10 +179,9 @@ int run(const Options& o) {
             const SceneEntry& e = scene_entry(kind);
             const std::string name = e.name + " picture (" + e.picture_setup + ", " + e.picture_estimator + ", " +
                                      std::to_string(o.picture_res) + "^2 x " + std::to_string(e.picture_spp) + " spp)";
-            const auto p0 = std::chrono::steady_clock::now();
-            picture_paths.push_back(render_scene_picture(kind, o, label(name)));
-            left.done(kind, picture_samples(kind, o),
-                      std::chrono::duration<double>(std::chrono::steady_clock::now() - p0).count());
+            Image image{o.picture_res, o.picture_res, {}};
+            render_job(name, image.rgb);
+            picture_paths.push_back(write_scene_picture(kind, o, image));
         }
 
     const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -188,17 +198,13 @@ int run(const Options& o) {
         for (const std::string& p : picture_paths) std::printf(" %s", p.c_str());
         std::printf("\n");
     }
-    return 0;
+    if (failed == 0) return kExitOk;
+    std::fprintf(stderr, "nsp_render: %llu paths ended with status Aborted or NonFinite\n", (unsigned long long)failed);
+    return kExitRuntime;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-    const Options o = parse_command_line(argc, argv);
-    try {
-        return run(o);
-    } catch (const std::exception& e) {
-        std::cerr << "nsp_render: error: " << e.what() << "\n";
-        return 1;
-    }
+    return run_tool("nsp_render", [&] { return run(argc, argv); });
 }

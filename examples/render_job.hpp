@@ -43,7 +43,7 @@ struct RenderRequest {
     int width = 0, height = 0, spp = 0, threads = 1;
     std::uint64_t seed = 1;
     nsp::EstimatorOptions estimator;
-    std::string label;  ///< for the progress line
+    std::string label;  ///< for the line shown in place while it renders (on a terminal)
     bool pixel_stats = false;  ///< also return every pixel's mean and sample variance (RenderStats)
     /// Learn the NEE count per tile (combinations with learns_nee_count only): the first
     /// pilot_spp(spp) samples of every pixel at count 1 with an nsp::NeeCountLearner per

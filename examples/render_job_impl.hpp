@@ -56,10 +56,11 @@ struct ThreadTotals {
     std::array<double, 3> variance_sum{}, mean_sum{};
 };
 
-/// Prints "label  NN%" in place on a terminal; nothing elsewhere (the caller prints a line per render).
-class Progress {
+/// Prints "label  NN%" in place on a terminal while a render runs; nothing elsewhere (the driver
+/// prints a line per finished render, progress.hpp).
+class InPlaceProgress {
 public:
-    Progress(std::string label, bool tty) : label_(std::move(label)), tty_(tty) {}
+    InPlaceProgress(std::string label, bool tty) : label_(std::move(label)), tty_(tty) {}
 
     /// Called by any worker after a row; prints at most every 0.25 s.
     void update(int done, int total) {
@@ -72,10 +73,9 @@ public:
         }
         mutex_.unlock();
     }
-    /// Replaces the progress line with a summary line.
-    void finish(const std::string& summary) {
+    /// Clears the line.
+    void finish() {
         if (tty_) std::fprintf(stderr, "\r%-90s\r", "");
-        std::fprintf(stderr, "  %s\n", summary.c_str());
     }
 
 private:
@@ -221,7 +221,7 @@ RenderStats render(const typename C::Scene& scene, const RenderRequest& rq, std:
 
     std::atomic<int> next_row{0}, rows_done{0};
     std::vector<ThreadTotals> totals(std::size_t(rq.threads)), pilot_totals(std::size_t(rq.threads));
-    Progress progress(rq.label, isatty(STDERR_FILENO) != 0);
+    InPlaceProgress progress(rq.label, isatty(STDERR_FILENO) != 0);
     RenderStats st;
     const auto t0 = std::chrono::steady_clock::now();
     auto run_pool = [&](auto& work, std::vector<ThreadTotals>& out) {
@@ -360,9 +360,7 @@ RenderStats render(const typename C::Scene& scene, const RenderRequest& rq, std:
     }
     st.pixel_mean = std::move(pixel_mean);
     st.pixel_variance = std::move(pixel_variance);
-    char summary[64];
-    std::snprintf(summary, sizeof summary, ": %.3f s", st.wall_seconds);
-    progress.finish(rq.label + summary);
+    progress.finish();
     return st;
 }
 
