@@ -159,7 +159,7 @@ TEST_CASE("bdpt: an overflowed (infinite) density takes the weight; NaN gives Na
     CHECK(std::isnan(bdpt::strategy_weight(h, p, 0)));
 }
 
-TEST_CASE("bdpt: the furnace of six emitting walls around a medium of albedo 1 (L = 2), camera inside") {
+TEST_CASE("bdpt: the furnace of six emitting walls around a medium of albedo 1 (L = 2), camera inside" * doctest::test_suite("converge")) {
     // As the surface estimators' furnace: L = Le / (1 - 0.5) = 2 whatever the phase function,
     // the density and which walls are mirrors. Subpaths of up to 64 vertices: the walls halve the
     // throughput about every third vertex, so the paths cut off carry ~1e-6 of L.
@@ -199,9 +199,9 @@ TEST_CASE("bdpt: an unusable camera ray (not unit length, NaN, infinite) gives I
         CAPTURE(std::string(name));
         Pcg32 rng(21, 1);
         LookupCount lookups;
-        for (const auto& [what, ray] : bad) {
-            CAPTURE(std::string(what));
-            const auto r = est.radiance(sc, ray, {}, rng, lookups);
+        for (const auto& entry : bad) {  // no structured binding: clang cannot capture one in CAPTURE's lambda
+            CAPTURE(std::string(entry.first));
+            const auto r = est.radiance(sc, entry.second, {}, rng, lookups);
             CHECK(r.status == Status::InvalidInput);
             CHECK(r.value[0] == 0.f);
         }
@@ -443,7 +443,7 @@ void check_strategies_alone_and_symmetric(StrategyRecord& rec, bool hittable = t
     CHECK(worst_share_asymmetry(rec, 3) <= kSigmas);
 }
 
-TEST_CASE("bdpt: each strategy alone is unbiased, and the strategies' pdfs are the true densities") {
+TEST_CASE("bdpt: each strategy alone is unbiased, and the strategies' pdfs are the true densities" * doctest::test_suite("converge")) {
     // The cube over the floor under the lamp alone (no sky, no roulette, no delta vertices), paths
     // of n = 1, 2, 3 interior vertices, the image's average over uniform (u, v), light tracing on:
     // every (s, t) with s + t - 2 = n (t = 1 too) draws every such path, so each alone (weight 1)
@@ -474,7 +474,7 @@ Sc cube_under_sky(float radius = 4.5f) {
               -1);
 }
 
-TEST_CASE("bdpt: light subpaths from the sky: each strategy alone is unbiased, the pdfs true densities") {
+TEST_CASE("bdpt: light subpaths from the sky: each strategy alone is unbiased, the pdfs true densities" * doctest::test_suite("converge")) {
     // As the test above, with the sky as the only light and light subpaths starting from it
     // (x_0 a direction, x_1 reached from a disk outside the scene's sphere): every (s, t) of
     // n = 1..3 alone against NEE (5 combined SE), and the pdf symmetry over every pair (5 SE).
@@ -517,7 +517,7 @@ SunSc cube_under_sun(bool lamp, bool sphere) {
                  -1);
 }
 
-TEST_CASE("bdpt: light subpaths from a directional light: each strategy alone is unbiased, the pdfs true densities") {
+TEST_CASE("bdpt: light subpaths from a directional light: each strategy alone is unbiased, the pdfs true densities" * doctest::test_suite("converge")) {
     // As the sky's test above, under a sun alone: x_0 is the sun's one direction, x_1 reached
     // from a disk outside the scene's sphere. No path hits the sun, so s = 0 contributes nothing;
     // every other (s, t) of n = 1..3 alone against NEE (5 combined SE), and the pdf symmetry over
@@ -552,7 +552,7 @@ PointSc cube_under_point_lamp(bool quad) {
     return PointSc(shapes, base.media, base.materials, PointLs(LightSelection::Power, 4.f, lamps, {point}), -1);
 }
 
-TEST_CASE("bdpt: under a point lamp the equiangular strategy alone is unbiased, its pdf the true density") {
+TEST_CASE("bdpt: under a point lamp the equiangular strategy alone is unbiased, its pdf the true density" * doctest::test_suite("converge")) {
     // The cube over the floor under a point lamp alone: no path hits it (s = 0 contributes
     // nothing); every other (s, t) of n = 1..3 alone against NEE, the equiangular strategy alone
     // against NEE over the paths it draws (x_1 in the cube), and the pdf symmetry over every pair
@@ -635,7 +635,7 @@ TEST_CASE("bdpt: a medium outside the lights' BoundingSphere is rejected with it
     CHECK_NOTHROW(cube_under_sky(1.8f));
 }
 
-TEST_CASE("bdpt: the pdf symmetry test sees directional MIS's pdfs are not densities") {
+TEST_CASE("bdpt: the pdf symmetry test sees directional MIS's pdfs are not densities" * doctest::test_suite("converge")) {
     // The same measurement with bdpt::Directional, whose weights leave out the distance pdfs
     // (unbiased, but its "pdfs" are not the strategies' densities): the symmetry must break, by
     // far more than 5 SE. Shows that the test above can fail.
@@ -697,7 +697,7 @@ TEST_CASE("bdpt: without nulls, null-scattering MIS weighs every path as directi
     }
 }
 
-TEST_CASE("bdpt: with light tracing, the image agrees with PathEstimator pixel by pixel") {
+TEST_CASE("bdpt: with light tracing, the image agrees with PathEstimator pixel by pixel" * doctest::test_suite("converge")) {
     // The cube over the floor under the lamp and the sky, 4 x 4 pixels through cube_pinhole(),
     // BdptEstimator::sample with splats: each pixel = (its samples' returns + the splats it
     // received) / its sample count. Against PathEstimator's pixel means, 5 combined SE; the BDPT
@@ -857,7 +857,7 @@ ESc emitting_cube_over_floor() {
                Ls(LightSelection::Power, 4.f, {lamp}, {}), -1);
 }
 
-TEST_CASE("bdpt: an emitting cube: each strategy alone unbiased, the pdfs true densities, volume sources included") {
+TEST_CASE("bdpt: an emitting cube: each strategy alone unbiased, the pdfs true densities, volume sources included" * doctest::test_suite("converge")) {
     // The symmetry and each-strategy-alone tests of the plain cube, with the cube emitting: paths
     // now start at the lamp or anywhere in the volume, every strategy samples both (5 SE).
     const ESc sc = emitting_cube_over_floor();
@@ -882,7 +882,7 @@ ESc nested_emitting_cubes() {
                materials(0.6f), Ls(LightSelection::Power, 4.f, {lamp}, {}), -1);
 }
 
-TEST_CASE("bdpt: nested emitting media: each strategy alone unbiased, the pdfs true densities") {
+TEST_CASE("bdpt: nested emitting media: each strategy alone unbiased, the pdfs true densities" * doctest::test_suite("converge")) {
     // The emitting cube's checks with an emitting core behind null interfaces inside it: the
     // segment technique's points in the core come after the shell's tracked piece (its nulls'
     // P_n in the technique's density, on the camera side, in NEE toward the volume and in light
@@ -912,7 +912,7 @@ TEST_CASE("bdpt: agrees with PathEstimator on an emitting cube over a floor unde
     });
 }
 
-TEST_CASE("bdpt: light subpaths and NEE on a fraction of the samples (expected counts < 1) stay unbiased") {
+TEST_CASE("bdpt: light subpaths and NEE on a fraction of the samples (expected counts < 1) stay unbiased" * doctest::test_suite("converge")) {
     // THEORY 5.9: with light_subpath_probability c the connections and light tracing run on a
     // fraction c of the samples and weigh with c times their densities; with nee_count n, NEE
     // toward the lights (s = 1) runs at a camera vertex with probability n, divides by it, and
