@@ -11,7 +11,8 @@ cd "$(dirname "$0")/.."
 # What the sanitizer build runs: the tracking suite (free flight, pdfs, MIS weights, transmittance,
 # equiangular sampling), the stability suite (every tracker, majorant kind, bound policy and mode
 # at the extremes, and the path estimators), the bidirectional suite (BdptEstimator's vertex
-# arrays and strategy weights; about 30 s instrumented) and the debug-mode tests. The fuzz corpus runs under
+# arrays and strategy weights, grey and per channel, without its "converge" test suite: see
+# tests/CMakeLists.txt), the volume-file suite and the debug-mode tests. The fuzz corpus runs under
 # the same sanitizers in scripts/run-fuzz.sh (libFuzzer replays the corpus before it fuzzes, and
 # the harness drives grid majorants, channel trackers, emissive media and seven estimators), so
 # its replay test is not built twice. Left out, to keep CI under 30 minutes on 2 cores (the

@@ -248,7 +248,7 @@ Sc<S> chromatic_furnace() {
                  Ls<S>(LightSelection::Uniform, 2.f, walls, {}), 0);
 }
 
-TEST_CASE_TEMPLATE("spectral bdpt: the furnace of six emitting walls around a chromatic medium of albedo 1 (L = 2)", S,
+TEST_CASE_TEMPLATE("spectral bdpt: the furnace of six emitting walls around a chromatic medium of albedo 1 (L = 2)" * doctest::test_suite("converge"), S,
                    Rgb, Hero<4>) {
     // Extinctions 0.5, 1.5 and 4 per channel (Hero<4>: a smooth curve between them), albedo 1:
     // L = 2 in every channel whatever the extinction. Subpaths of up to 64 vertices (the walls
@@ -374,7 +374,7 @@ SunSc chromatic_cube_under_sun(bool lamp) {
                  SunLs(LightSelection::Power, BoundingSphere{Vec3(0.f), 4.5f}, lamps, {sun}), -1);
 }
 
-TEST_CASE("spectral bdpt: agrees with SpectralPathEstimator on a strongly chromatic cube over a floor") {
+TEST_CASE("spectral bdpt: agrees with SpectralPathEstimator on a strongly chromatic cube over a floor" * doctest::test_suite("converge")) {
     // No closed form: against spectral MIS + NEE (SpectralPathEstimator<SpectralMis,
     // NullScatteringMis>) per channel, within 5 combined SE of the two independent estimates: the
     // camera's rays (radiance()), and the image's average with light tracing against the same
@@ -598,7 +598,7 @@ void check_channel_strategies(ChannelStrategyRecord& rec, bool hittable = true, 
     }
 }
 
-TEST_CASE("spectral bdpt: each strategy alone is unbiased per channel, every channel's pdfs true densities") {
+TEST_CASE("spectral bdpt: each strategy alone is unbiased per channel, every channel's pdfs true densities" * doctest::test_suite("converge")) {
     // The chromatic cube under the lamp alone, no roulette, paths of n = 1..3 interior vertices,
     // the image's average over uniform (u, v) with light tracing, under a per-channel and under a
     // grey majorant.
@@ -631,7 +631,7 @@ TEST_CASE("spectral bdpt: each strategy alone is unbiased per channel, every cha
     }
 }
 
-TEST_CASE("spectral bdpt: under a point lamp the equiangular strategy alone is unbiased per channel, its pdfs true") {
+TEST_CASE("spectral bdpt: under a point lamp the equiangular strategy alone is unbiased per channel, its pdfs true" * doctest::test_suite("converge")) {
     // The strongly chromatic cube (per-channel majorants) over the floor under a point lamp alone:
     // s = 0 draws nothing, every other strategy alone and the equiangular one alone (over the
     // paths it draws) agree with NEE per channel, and both symmetries hold with it among the
@@ -771,7 +771,7 @@ EmittingScene<Rgb> emitting_chromatic_cube() {
         Ls<Rgb>(LightSelection::Power, 4.f, {lamp}, {}), -1);
 }
 
-TEST_CASE("spectral bdpt: an emitting chromatic cube: each strategy alone, every channel's pdfs true densities") {
+TEST_CASE("spectral bdpt: an emitting chromatic cube: each strategy alone, every channel's pdfs true densities" * doctest::test_suite("converge")) {
     // The per-channel checks of the plain chromatic cube (above), with the cube emitting: paths
     // start at the lamp or anywhere in the volume, and every strategy draws both (collisions,
     // NEE toward the volume, light subpaths from it); 5 combined SE.
@@ -782,7 +782,7 @@ TEST_CASE("spectral bdpt: an emitting chromatic cube: each strategy alone, every
     check_channel_strategies(rec, true, false, true);
 }
 
-TEST_CASE("spectral bdpt: nested emitting chromatic media: each strategy alone, every channel's pdfs true densities") {
+TEST_CASE("spectral bdpt: nested emitting chromatic media: each strategy alone, every channel's pdfs true densities" * doctest::test_suite("converge")) {
     // The emitting chromatic cube with a core [-0.5, 0.5]^3 of another emitting chromatic medium
     // behind null interfaces inside it: every channel's P_n of the shell's nulls before the core's
     // piece enters the segment technique's densities (camera side, NEE toward the volume, light
