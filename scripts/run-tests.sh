@@ -13,7 +13,7 @@
 #     corpus over a fixed sequence (seed 1, 30000 inputs, at most NSP_FUZZ_SECONDS, default 120;
 #     NSP_FUZZ_SECONDS=0 skips the stage).
 # Stages 2 and 3 run side by side (each is mostly one long single-threaded process), with their
-# output printed when both are done.
+# output printed when both are done (a failing stage's last).
 # NSP_SKIP_SANITIZERS=1 skips stage 2 (for a quick local run).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -37,7 +37,11 @@ san_status=0 fuzz_status=0
 [ "$fuzz" = 0 ] || { scripts/run-fuzz.sh >"$logs/fuzz.log" 2>&1 & fuzz_pid=$!; }
 [ "$sanitize" = 0 ] || wait "$san_pid" || san_status=$?
 [ "$fuzz" = 0 ] || wait "$fuzz_pid" || fuzz_status=$?
-for stage in sanitizers fuzz; do
+# A failing stage's log is printed last, so that the end of the output (all a CI page may keep)
+# shows the failure rather than the other stage's progress.
+order="sanitizers fuzz"
+[ "$san_status" = 0 ] || order="fuzz sanitizers"
+for stage in $order; do
     [ -f "$logs/$stage.log" ] || continue
     echo "===== run-tests: $stage ====="
     cat "$logs/$stage.log"
