@@ -11,7 +11,7 @@
 # then prints the tables (bench/report.py; --markdown gives them as Markdown).
 #
 # Build directory: $NSP_BENCH_BUILD if set; else ./build if scripts/setup.sh configured it (a
-# Release build with benchmarks); else ./build-bench, configured here. Environment:
+# Release build with benchmarks at -O3); else ./build-bench, configured here. Environment:
 #   NSP_BENCH_REPS        repetitions of every benchmark in step 1 (default 5)
 #   NSP_BENCH_JOBS        build parallelism (default: nproc)
 #   NSP_BENCH_BEFORE      the "before" commit of steps 2 and 3 (default 08dc9b7, the commit before
@@ -29,9 +29,10 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-is_release_with_benchmarks() {
+is_release_with_benchmarks() {  # at the build type's -O3: not run-main.sh's -O1 build
     [ -f "$1/CMakeCache.txt" ] && grep -q '^NSP_BUILD_BENCHMARKS:BOOL=ON' "$1/CMakeCache.txt" &&
-        grep -q '^CMAKE_BUILD_TYPE:STRING=Release' "$1/CMakeCache.txt"
+        grep -q '^CMAKE_BUILD_TYPE:STRING=Release' "$1/CMakeCache.txt" &&
+        ! grep -q '^NSP_OPTIMIZE:STRING=.' "$1/CMakeCache.txt"
 }
 
 generator=()
