@@ -43,16 +43,11 @@
 # with --room first, nsp_room with the rest (build/examples/nsp_room --help).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-# -O1, not the build type's -O3: the renderers instantiate every combination of policies, and
-# their build takes 886 s of compiler time at -O3 (over 7 minutes on 2 cores), 610 s at -O2 and
-# 433 s at -O1 (measured 2026-12-05). A render file compiles at -O1 in 43% of its -O3 time
-# (render_mono.cpp: 50 s against 116 s, -O2 72 s),
-# and the renders take about 24% longer (set-ups A and B at 48x48, 64 spp, one thread: 11.4 s
-# against 9.2 s; -O2 11.1 s). Every row of a table pays the same, so its ratios stand; the
-# benchmarks (bench/run.sh) build their own -O3 tree.
-# The targets in this order: ninja starts the two longest files (nsp_room's tables, nsp_volume's
-# renders) first, and nsp_render's three render files fill the other core.
-NSP_CMAKE_ARGS="-DNSP_OPTIMIZE=-O1 ${NSP_CMAKE_ARGS:-}" scripts/setup.sh nsp_room nsp_volume nsp_render
+# At the build type's -O3. -O1 was tried (2026-12-05): on a fresh clone on 2 cores it built in
+# 233 s against about 212 s at -O3 the day before (the renderers' build is mostly template
+# instantiation, which the optimisation level does not change) and rendered slower, so the run
+# took longer in all.
+scripts/setup.sh nsp_room nsp_volume nsp_render
 
 references=0
 if [ "${1:-}" = --with-references ]; then
