@@ -29,7 +29,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-is_release_with_benchmarks() {  # at the build type's -O3 (no NSP_OPTIMIZE)
+is_release_with_benchmarks() {  # at the build type's -O3: not run-main.sh's -O1 build
     [ -f "$1/CMakeCache.txt" ] && grep -q '^NSP_BUILD_BENCHMARKS:BOOL=ON' "$1/CMakeCache.txt" &&
         grep -q '^CMAKE_BUILD_TYPE:STRING=Release' "$1/CMakeCache.txt" &&
         ! grep -q '^NSP_OPTIMIZE:STRING=.' "$1/CMakeCache.txt"

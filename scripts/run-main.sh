@@ -43,11 +43,12 @@
 # with --room first, nsp_room with the rest (build/examples/nsp_room --help).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-# At the build type's -O3. -O1 was tried (2026-12-05): on a fresh clone on 2 cores it built in
-# 233 s against about 212 s at -O3 the day before (the renderers' build is mostly template
-# instantiation, which the optimisation level does not change) and rendered slower, so the run
-# took longer in all.
-scripts/setup.sh nsp_room nsp_volume nsp_render
+# -O1, not the build type's -O3: the renderers instantiate every combination of policies. On a
+# fresh clone on 2 cores (2026-12-05) they built in 233 s at -O1 and 420 s at -O3; the
+# renders take about 24% longer at -O1 (set-ups A and B at 48x48, 64 spp, one thread: 11.4 s
+# against 9.2 s), every row alike, so the tables' ratios stand. The benchmarks (bench/run.sh)
+# build their own -O3 tree.
+NSP_CMAKE_ARGS="-DNSP_OPTIMIZE=-O1 ${NSP_CMAKE_ARGS:-}" scripts/setup.sh nsp_room nsp_volume nsp_render
 
 references=0
 if [ "${1:-}" = --with-references ]; then
@@ -66,7 +67,7 @@ start=$SECONDS
 build/examples/nsp_render --out out
 # The scene with surfaces: the cloud over a floor in an open room, grey, chromatic and glowing, and
 # the lantern with BDPT (about 75 s).
-build/examples/nsp_room --out out --res 64
+build/examples/nsp_room --out out --res 64 --spp 128
 # Volumes from files: the procedural smoke plume (512^3 voxels, 0.5% of them active) written as .vdb
 # and the cloud as .vdb, each rendered under the global, grid 16^3 and 64^3 and tree majorants
 # (about 25 s).
@@ -86,7 +87,7 @@ fi
 echo
 echo "Heavy-tail comparison: grey-majorant baseline vs spectral MIS + NEE (per-channel and global"
 echo "majorant), 3 runs, effective variance against a 2048-spp reference"
-build/examples/nsp_render --scene chromatic --runs 3 --res 32x32 --spp 128 --no-exr \
+build/examples/nsp_render --scene chromatic --spectral rgb,hero --runs 3 --res 32x32 --spp 128 --no-exr \
     --reference-spp 2048 --selection uniform --no-png \
     --estimators uni-nee-mis_grey_balance_absorb-weight,uni-nee-mis_spectral-mis_absorb-weight
 echo
