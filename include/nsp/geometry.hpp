@@ -69,31 +69,22 @@ struct MediumBox {
     /// The first face on (epsilon, t_max), a null interface (no material, no light), its outward
     /// normal as ng and ns; t = kInf if none.
     SurfaceHit intersect(const Ray& r, float t_max) const noexcept {
-        float t0 = -kInf, t1 = kInf;
-        int a0 = 0, a1 = 0;
-        for (int a = 0; a < 3; ++a) {
-            if (r.d[a] == 0.f) {
-                if (r.o[a] < box.lo[a] || r.o[a] > box.hi[a]) return {};
-                continue;
-            }
-            float ta = (box.lo[a] - r.o[a]) / r.d[a], tb = (box.hi[a] - r.o[a]) / r.d[a];
-            if (ta > tb) std::swap(ta, tb);
-            if (ta > t0) t0 = ta, a0 = a;
-            if (tb < t1) t1 = tb, a1 = a;
-        }
-        if (!(t0 <= t1)) return {};
-        float t;
-        int axis;
-        if (t0 > epsilon) t = t0, axis = a0;
-        else if (t1 > epsilon) t = t1, axis = a1;
-        else return {};
-        if (!(t < t_max)) return {};
+        const Interval span = box.clip(r, -kInf, kInf);  // the whole line's stretch inside the box
+        if (span.empty()) return {};
+        const float t = span.t0 > epsilon ? span.t0 : span.t1;
+        if (!(t > epsilon && t < t_max)) return {};
         SurfaceHit h;
         h.t = t;
         h.p = r.at(t);
-        // The outward normal of the face: against the ray where it enters, along it where it leaves.
+        // The face the point lies on (the axis where it is nearest a face) and its outward normal.
+        int axis = 0;
+        float nearest = kInf, outward = 1.f;
+        for (int a = 0; a < 3; ++a) {
+            const float dl = std::abs(h.p[a] - box.lo[a]), dh = std::abs(h.p[a] - box.hi[a]);
+            if (std::min(dl, dh) < nearest) nearest = std::min(dl, dh), axis = a, outward = dl < dh ? -1.f : 1.f;
+        }
         Vec3 n(0.f);
-        n[axis] = (t == t0) == (r.d[axis] > 0.f) ? -1.f : 1.f;
+        n[axis] = outward;
         h.ng = h.ns = n;
         h.medium_front = outside;
         h.medium_back = inside;

@@ -44,7 +44,7 @@ inline bool usable_ray(const Ray& r) noexcept {
     // o - o is 0 for a finite coordinate and NaN otherwise: one branch for the whole test, which
     // runs at the start of every flight (a few flops against a flight's hundreds of instructions).
     const float finite_o = (r.o.x - r.o.x) + (r.o.y - r.o.y) + (r.o.z - r.o.z);
-    return finite_o == 0.f && std::abs(glm::dot(r.d, r.d) - 1.f) <= kUnitTolerance;
+    return finite_o == 0.f && unit_length(r.d);
 }
 
 /// A parametric interval [t0, t1] along a ray.
