@@ -19,10 +19,7 @@ want=$(git rev-parse --verify "$before^{commit}")
 command -v valgrind >/dev/null || { echo "instructions.sh: valgrind is needed (apt-get install valgrind)" >&2; exit 2; }
 out=${NSP_INSTRUCTIONS_DIR:-build-instructions}
 mkdir -p "$out"
-cxx=${CXX:-c++}
-# One compiler command for both sides (the Release flags of CMake).
-work_cc() { "$cxx" -O3 -DNDEBUG -std=gnu++20 -I"$1/examples" -I"$1/include" -isystem /usr/include/eigen3 \
-                bench/work_count.cpp -o "$2"; }
+source bench/work_count.sh  # work_cc, count_instructions
 
 src=$(cd "$out" && pwd)/before-src
 new_src=.
@@ -46,13 +43,7 @@ trap - EXIT
 
 for side in old new; do
     echo "instructions.sh: running the $side build under callgrind" >&2
-    rm -f "$out/cg-$side" "$out/cg-$side".*
-    valgrind --tool=callgrind --instr-atstart=no --callgrind-out-file="$out/cg-$side" "$out/work-$side" \
-        >"$out/work-$side.txt" 2>"$out/valgrind-$side.log"
-    for f in "$out/cg-$side".*; do
-        sed -n -e 's/^desc: Trigger: Client Request: //p' -e 's/^summary: //p' "$f" | paste -sd' '
-    done >"$out/ir-$side.txt"
-    rm -f "$out/cg-$side" "$out/cg-$side".*
+    count_instructions "$out/work-$side" "$out" "$side"
 done
 
 python3 - "$out" "$(git rev-parse --short "$want")" "${after:-the working tree}" <<'EOF'

@@ -77,10 +77,7 @@ if [ -n "$before" ]; then
     if ! want=$(git rev-parse --verify --quiet "$before^{commit}"); then
         echo "note: commit $before is not available here; skipping the before/after check" >&2
     else
-        cxx=${CXX:-c++}
-        # One compiler command for both sides of the instruction count (Release flags of CMake).
-        work_cc() { "$cxx" -O3 -DNDEBUG -std=gnu++20 -I"$1/examples" -I"$1/include" -isystem /usr/include/eigen3 \
-                        bench/work_count.cpp -o "$2"; }
+        source bench/work_count.sh  # work_cc, count_instructions
         old_build=${NSP_BENCH_BEFORE_BUILD:-$build-before}
         old_bin=$old_build/build/bench/nsp_bench
         if [ ! -x "$old_bin" ] || [ ! -x "$old_build/work_count" ] || [ "$(cat "$old_build/commit" 2>/dev/null)" != "$want" ]; then
@@ -136,13 +133,7 @@ if [ -n "$before" ]; then
                 bin=$build/bench/work_count
                 [ "$side" = old ] && bin=$old_build/work_count
                 echo "instruction count: $side build (callgrind)" >&2
-                valgrind --tool=callgrind --instr-atstart=no --callgrind-out-file="$ab/cg-$side" "$bin" \
-                    >"$ab/work-$side.txt" 2>"$ab/valgrind-$side.log"
-                # One dump per kernel: "<kernel> <instructions>".
-                for f in "$ab/cg-$side".*; do
-                    sed -n -e 's/^desc: Trigger: Client Request: //p' -e 's/^summary: //p' "$f" | paste -sd' '
-                done >"$ab/ir-$side.txt"
-                rm -f "$ab/cg-$side" "$ab/cg-$side".*
+                count_instructions "$bin" "$ab" "$side"
             done
         else
             echo "note: valgrind not found; skipping the instruction count" >&2
