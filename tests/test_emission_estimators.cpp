@@ -44,11 +44,23 @@ EmissionGrid make_emission(const Box& b, std::array<int, 3> res, float mean, std
     return EmissionGrid(b, res, std::move(v));
 }
 
-/// Runs every estimator of EmissionEstimatorsWith<A> on `scene` along `ray` and checks each
-/// channel's mean against `expected(c)`.
+/// Which estimators of EmissionEstimatorsWith<A> a check runs.
+/// - kAll: every one.
+/// - kFiniteVariance: all but NEE alone (ratio-nee). Where the path scatters inside the emitting
+///   medium, its volume NEE weighs a point at distance d by 1 / (d^2 p_V), whose second moment
+///   diverges (the integral of 1 / d^2 over d near 0): its standard error says nothing, and a
+///   k-SE check of it passes or fails by luck (seen here: 5.6 "SE" low on one seed, 3.6 on
+///   others). The combining strategies keep the variance finite, and NEE alone is checked where
+///   every NEE distance is >= 1 (tests/test_surface_emission.cpp, the floor under an emitting
+///   sphere).
+/// - kCombining: the strategies that combine techniques (an option that changes only them).
+enum class Run { kAll, kFiniteVariance, kCombining };
+
+/// Runs the estimators of EmissionEstimatorsWith<A> that `which` names on `scene` along `ray`
+/// and checks each channel's mean against `expected(c)`.
 template <class C, class Sc, class F>
 void check_all(const Sc& scene, const Ray& ray, const EstimatorOptions& opts, int n, int seed0,
-               const std::string& what, F expected, bool combining_only = false) {
+               const std::string& what, F expected, Run which = Run::kAll) {
     using S = typename C::Spectral;
     std::apply(
         [&](auto... est) {
@@ -56,7 +68,8 @@ void check_all(const Sc& scene, const Ray& ray, const EstimatorOptions& opts, in
             ((void)[&] {
                 using E = decltype(est);
                 ++seed;
-                if (combining_only && !E::Strategy::combines) return;
+                if (which == Run::kCombining && !E::Strategy::combines) return;
+                if (which == Run::kFiniteVariance && E::Strategy::samples_lights && !E::Strategy::combines) return;
                 const auto res = estimate_radiance(E(opts), scene, ray, n, std::uint64_t(seed));
                 CHECK(res.not_ok == 0);
                 for (int c = 0; c < S::channels; ++c) {
@@ -85,12 +98,14 @@ TEST_CASE_TEMPLATE_DEFINE("emissive furnace: L_e equal to the environment gives 
     const Ray ray{Vec3(-3.f, 0.15f, -0.1f), glm::normalize(Vec3(1.f, 0.02f, 0.03f))};
     auto run = [&](const auto& maj, const std::string& maj_name) {
         const auto scene = Scene(medium, maj, HenyeyGreensteinPhase(0.3f), lights);
-        check_all<C>(scene, ray, EstimatorOptions{}, 6000, 40, maj_name, [&](int c) { return double(le[c]); });
+        check_all<C>(scene, ray, EstimatorOptions{}, 6000, 40, maj_name, [&](int c) { return double(le[c]); },
+                     Run::kFiniteVariance);
         // Roulette from the first real vertex, survival at most 0.6: both MIS sides must carry it.
         EstimatorOptions rr;
         rr.rr_start_depth = 1;
         rr.rr_max_survival = 0.6f;
-        check_all<C>(scene, ray, rr, 6000, 50, maj_name + " roulette", [&](int c) { return double(le[c]); });
+        check_all<C>(scene, ray, rr, 6000, 50, maj_name + " roulette", [&](int c) { return double(le[c]); },
+                     Run::kFiniteVariance);
     };
     run(GlobalMajorant<Emissive<M>>(medium), "global");
     {
@@ -99,14 +114,14 @@ TEST_CASE_TEMPLATE_DEFINE("emissive furnace: L_e equal to the environment gives 
         off.emission_along_segments = false;
         // The option changes the combining strategies only (the others were run above).
         check_all<C>(scene, ray, off, 6000, 140, "global, no segment technique", [&](int c) { return double(le[c]); },
-                     true);
+                     Run::kCombining);
         // Expected counts (THEORY 5.9): the segment technique on 30% of the segments, NEE toward
         // the environment at half the vertices; every weight takes count x pdf, L stays L_e.
         EstimatorOptions few;
         few.emission_segment_count = 0.3f;
         few.nee_count = 0.5f;
         check_all<C>(scene, ray, few, 6000, 240, "global, segment count 0.3, NEE count 0.5",
-                     [&](int c) { return double(le[c]); }, true);
+                     [&](int c) { return double(le[c]); }, Run::kCombining);
     }
     for_each_kind<std::tuple<GridKind, SignedGridKind>, Emissive<M>>(
         [&](auto kind) { run(decltype(kind)::make(medium), decltype(kind)::name); });
@@ -131,11 +146,11 @@ TEST_CASE_TEMPLATE_DEFINE("emitting absorber with analytic optical depth = quadr
         // Without the segment technique: the camera ray has the collision estimator alone.
         EstimatorOptions off;
         off.emission_along_segments = false;
-        check_all<C>(scene, ray, off, 20000, 160, maj_name + " no segment technique", [&](int c) { return ref[c]; }, true);
+        check_all<C>(scene, ray, off, 20000, 160, maj_name + " no segment technique", [&](int c) { return ref[c]; }, Run::kCombining);
         // The segment technique on a fifth of the segments: the collision estimator covers the rest.
         EstimatorOptions few;
         few.emission_segment_count = 0.2f;
-        check_all<C>(scene, ray, few, 20000, 260, maj_name + " segment count 0.2", [&](int c) { return ref[c]; }, true);
+        check_all<C>(scene, ray, few, 20000, 260, maj_name + " segment count 0.2", [&](int c) { return ref[c]; }, Run::kCombining);
     };
     run(GlobalMajorant<Emissive<M>>(medium), "global");
     for_each_kind<std::tuple<SignedGlobalKind, GridKind, SignedGridKind>, Emissive<M>>(
@@ -151,6 +166,7 @@ TEST_CASE_TEMPLATE_DEFINE("emission NEE and MIS agree with the collision estimat
     const Box box{Vec3(-1.f), Vec3(1.f)};
     // Albedo about 0.6, optical thickness about 1.5, emission in a 4 x 4 x 4 grid over part of the
     // box; no other light. Reference: the collision estimator alone (unidirectional), 3x the samples.
+    // NEE alone is left out: its paths scatter inside the emitter (see Run::kFiniteVariance).
     const M base = make_medium<M>(box, 0.75f, spec<S>(0.4f, 0.6f, 0.3f), spec<S>(0.6f, 0.5f, 0.8f));
     const Emissive<M> medium(base, make_emission(Box{Vec3(-0.6f, -0.5f, -0.4f), Vec3(0.5f, 0.7f, 0.6f)}, {4, 4, 4}, 1.f, 91),
                              spec<S>(1.f, 0.6f, 0.3f), {8, 8, 8});
@@ -176,7 +192,7 @@ TEST_CASE_TEMPLATE_DEFINE("emission NEE and MIS agree with the collision estimat
                 }
             }(), ...);
         },
-        std::tuple<PathEstimator<strategy::NextEvent, mis::None, A>, PathEstimator<strategy::NullScatteringMis, mis::Balance, A>,
+        std::tuple<PathEstimator<strategy::NullScatteringMis, mis::Balance, A>,
                    PathEstimator<strategy::NullScatteringMis, mis::Power, A>>{});
 }
 TEST_CASE_TEMPLATE_APPLY(emissive_scattering, AllCombos);
