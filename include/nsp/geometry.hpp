@@ -69,22 +69,21 @@ struct MediumBox {
     /// The first face on (epsilon, t_max), a null interface (no material, no light), its outward
     /// normal as ng and ns; t = kInf if none.
     SurfaceHit intersect(const Ray& r, float t_max) const noexcept {
-        const Interval span = box.clip(r, -kInf, kInf);  // the whole line's stretch inside the box
-        if (span.empty()) return {};
-        const float t = span.t0 > epsilon ? span.t0 : span.t1;
-        if (!(t > epsilon && t < t_max)) return {};
+        int enter_axis, exit_axis;
+        const Interval span = box.clip(r, -kInf, kInf, enter_axis, exit_axis);  // the whole line's stretch
+        if (!(span.t0 <= span.t1)) return {};  // a miss (a ray grazing an edge hits it)
+        const bool entering = span.t0 > epsilon;
+        const float t = entering ? span.t0 : span.t1;
+        const int axis = entering ? enter_axis : exit_axis;
+        if (!(t > epsilon && t < t_max) || axis < 0) return {};
         SurfaceHit h;
         h.t = t;
         h.p = r.at(t);
-        // The face the point lies on (the axis where it is nearest a face) and its outward normal.
-        int axis = 0;
-        float nearest = kInf, outward = 1.f;
-        for (int a = 0; a < 3; ++a) {
-            const float dl = std::abs(h.p[a] - box.lo[a]), dh = std::abs(h.p[a] - box.hi[a]);
-            if (std::min(dl, dh) < nearest) nearest = std::min(dl, dh), axis = a, outward = dl < dh ? -1.f : 1.f;
-        }
+        // The outward normal of the face the slab test found: against the ray where it enters,
+        // along it where it leaves, so medium_entered() is right even at an edge, where the
+        // point alone cannot tell the faces apart.
         Vec3 n(0.f);
-        n[axis] = outward;
+        n[axis] = entering == (r.d[axis] > 0.f) ? -1.f : 1.f;
         h.ng = h.ns = n;
         h.medium_front = outside;
         h.medium_back = inside;

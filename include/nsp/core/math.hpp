@@ -68,6 +68,25 @@ struct Box {
     /// The part of [tmin, tmax] inside the box (empty interval on a miss). Axis-parallel rays
     /// and denormal direction components are handled without 0 * inf.
     Interval clip(const Ray& r, float tmin, float tmax) const noexcept {
+        int axes[2];
+        return slabs<false>(r, tmin, tmax, axes);
+    }
+
+    /// clip(), with the axes of the faces where the part starts and ends (-1 where tmin or tmax
+    /// bounds it instead): a face's normal without guessing it from the point.
+    Interval clip(const Ray& r, float tmin, float tmax, int& enter_axis, int& exit_axis) const noexcept {
+        int axes[2] = {-1, -1};
+        const Interval in = slabs<true>(r, tmin, tmax, axes);
+        enter_axis = axes[0];
+        exit_axis = axes[1];
+        return in;
+    }
+
+private:
+    /// The slab test of both clip()s; with kAxes it also notes which axis bounds each end (kept
+    /// out of the plain clip, which tracking runs on every segment: min and max stay branch-free).
+    template <bool kAxes>
+    Interval slabs(const Ray& r, float tmin, float tmax, int (&axes)[2]) const noexcept {
         float t0 = tmin, t1 = tmax;
         for (int a = 0; a < 3; ++a) {
             if (r.d[a] == 0.f) {
@@ -78,6 +97,10 @@ struct Box {
             // the face would give 0 * inf = NaN (found by the grid-majorant DDA tests).
             float tn = (lo[a] - r.o[a]) / r.d[a], tf = (hi[a] - r.o[a]) / r.d[a];
             if (tn > tf) std::swap(tn, tf);
+            if constexpr (kAxes) {
+                if (tn > t0) axes[0] = a;  // as std::max below: a NaN leaves the bound as it was
+                if (tf < t1) axes[1] = a;
+            }
             t0 = std::max(t0, tn);
             t1 = std::min(t1, tf);
         }
