@@ -20,7 +20,7 @@
 #include <type_traits>
 
 #include "core/error.hpp"
-#include "counts.hpp"
+#include "recorder.hpp"
 #include "spectrum.hpp"
 
 namespace nsp {

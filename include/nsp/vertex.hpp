@@ -41,8 +41,9 @@
 #include <limits>
 #include <utility>
 
-#include "estimators/common.hpp"
 #include "mis.hpp"
+#include "options.hpp"
+#include "recorder.hpp"
 #include "tracking.hpp"
 
 namespace nsp {
@@ -77,14 +78,6 @@ float next_event_weight(const H& h, float survival, float direction_pdf, float n
                         float light_pdf) noexcept {
     return mis::weight_among(h, light_pdf, unidirectional_pdf<St>(survival, direction_pdf, null_pdf_product));
 }
-
-/// The three techniques that can produce a path's last real vertex x and its light vertex y
-/// when equiangular sampling is on (THEORY 5.4).
-enum class VertexTechnique : std::uint8_t {
-    TrackNee,        ///< x by tracking, y by NEE
-    TrackHit,        ///< x by tracking, y by tracking from x (hitting the light)
-    EquiangularNee,  ///< x by equiangular sampling (nulls before it ratio-tracked), y by NEE
-};
 
 /// p_equiangular / p_tracking of a real vertex that delta tracking drew at distance t, from the
 /// equiangular density there, the nulls' prod P_n and mu_bar(t) P_s(t) (DeltaTrack's

@@ -10,7 +10,8 @@
 
 #include "../core/error.hpp"
 #include "../core/status.hpp"
-#include "../counts.hpp"
+#include "../options.hpp"
+#include "../recorder.hpp"
 #include "../equiangular.hpp"
 #include "../light.hpp"
 #include "../media/emissive.hpp"
@@ -19,117 +20,6 @@
 #include "../tracking.hpp"
 
 namespace nsp {
-
-namespace strategy {
-/// Delta tracking; lights contribute when a path hits them.
-struct Unidirectional {
-    static constexpr const char* name = "unidirectional";
-    static constexpr bool samples_lights = false, hits_lights = true, combines = false, null_pdfs = false;
-    static constexpr bool equiangular = false;
-};
-/// Next-event estimation with ratio-tracking transmittance; hits count only for camera rays.
-struct NextEvent {
-    static constexpr const char* name = "ratio-nee";
-    static constexpr bool samples_lights = true, hits_lights = false, combines = false, null_pdfs = false;
-    static constexpr bool equiangular = false;
-};
-/// Unidirectional + NEE weighted by direction pdfs only (THEORY 5.2).
-struct DirectionalMis {
-    static constexpr const char* name = "directional-mis";
-    static constexpr bool samples_lights = true, hits_lights = true, combines = true, null_pdfs = false;
-    static constexpr bool equiangular = false;
-};
-/// Unidirectional + NEE weighted by null-scattering path pdfs (THEORY 5.1).
-struct NullScatteringMis {
-    static constexpr const char* name = "uni-nee-mis";
-    static constexpr bool samples_lights = true, hits_lights = true, combines = true, null_pdfs = true;
-    static constexpr bool equiangular = false;
-};
-/// Equiangular sampling + NEE (THEORY 5.4): on every segment of the path (the camera ray
-/// included) a real vertex drawn with the equiangular pdf toward the point light (else the
-/// sphere light's centre), the nulls before it ratio-tracked, and NEE from it; tracked vertices
-/// only continue the path. Lights count when hit only on camera rays. Without a point or sphere
-/// light there is nothing to aim at and it is NextEvent.
-struct EquiangularNextEvent {
-    static constexpr const char* name = "equiangular-nee";
-    static constexpr bool samples_lights = true, hits_lights = false, combines = false, null_pdfs = false;
-    static constexpr bool equiangular = true;
-};
-/// Unidirectional + NEE + equiangular: the last real vertex before a light drawn by tracking or
-/// by equiangular sampling, the light reached by NEE or (from a tracked vertex) by hitting it;
-/// the three techniques weighted by their null-scattering path pdfs (THEORY 5.1, 5.4).
-struct EquiangularMis {
-    static constexpr const char* name = "uni-nee-eq-mis";
-    static constexpr bool samples_lights = true, hits_lights = true, combines = true, null_pdfs = true;
-    static constexpr bool equiangular = true;
-};
-}  // namespace strategy
-
-/// A path strategy: which techniques it runs (light sampling, light hits, equiangular vertices)
-/// and whether it combines them with MIS, weighing by null-scattering path pdfs or not.
-template <class T>
-concept PathStrategy = requires {
-    { T::name } -> std::convertible_to<const char*>;
-    { T::samples_lights } -> std::convertible_to<bool>;
-    { T::hits_lights } -> std::convertible_to<bool>;
-    { T::combines } -> std::convertible_to<bool>;
-    { T::null_pdfs } -> std::convertible_to<bool>;
-    { T::equiangular } -> std::convertible_to<bool>;
-};
-
-/// Run-time settings of a path estimator.
-struct EstimatorOptions {
-    int max_depth = 1000;          ///< most real scattering vertices on a path (>= 0)
-    bool russian_roulette = true;  ///< roulette at real vertices from `rr_start_depth` on
-    int rr_start_depth = 3;        ///< first real vertex (1-based) at which roulette may stop a path
-    float rr_max_survival = 0.95f; ///< survival q = min(rr_max_survival, max_c |throughput_c|), in (0, 1]
-    /// strategy::EquiangularMis: draw the equiangular vertex of a segment with the probability of
-    /// equiangular_probability (below) instead of on every segment. Off: on every segment.
-    bool adaptive_equiangular = true;
-    /// The combining strategies on an emissive medium: on every segment also draw one point in
-    /// proportion to the emitted power along the segment (the segment technique of THEORY 5.7,
-    /// the nulls before it ratio-tracked), combined with the collision estimator and NEE toward
-    /// the volume by MIS. It is the only sampling technique for the emission a camera ray sees
-    /// directly. Off: collisions and NEE only. No effect on other media or strategies.
-    /// nsp::BdptEstimator<bdpt::NullScattering> (grey and per channel) draws it on every piece of
-    /// a camera segment in an emitting medium, one more strategy among the (s, t) ones (THEORY 5.7
-    /// in 5.5); directional MIS leaves it out.
-    bool emission_along_segments = true;
-    /// The expected count of the segment technique on each segment, in (0, 1] (THEORY 5.9,
-    /// counts.hpp; with emission_along_segments on): it runs on a segment with this probability,
-    /// its estimate divided by it, and every emission weight takes count x p_seg. 1: on every
-    /// segment. Below 1 it saves the technique's flight and lookup where the collision estimator
-    /// and NEE find the emission well; the power grid's walk along the segment stays (the other
-    /// techniques' weights need W). nsp::PathEstimator and nsp::SpectralPathEstimator, media and
-    /// surfaces, and nsp::BdptEstimator (on the camera segments' pieces; NeeCountLearner does
-    /// not learn it there).
-    float emission_segment_count = 1.f;
-    /// The expected count of NEE toward the lights at each real vertex, in (0, 1] (THEORY 5.9,
-    /// counts.hpp): NEE runs there with this probability, its estimate divided by it, and the MIS
-    /// weights of both techniques take nee_count x the light pdf. 1: NEE at every vertex. Below 1
-    /// it trades variance for the shadow rays' cost where tracking finds the light well (a large
-    /// light, an environment); NeeCountLearner chooses it per pixel tile. nsp::PathEstimator and
-    /// nsp::SpectralPathEstimator (every strategy that samples lights, NEE from equiangular
-    /// vertices excepted: they exist for it); nsp::BdptEstimator (s = 1 toward the lights at each
-    /// camera vertex; NEE toward an emitting volume keeps count 1).
-    float nee_count = 1.f;
-    /// nsp::BdptEstimator<bdpt::NullScattering> (grey and per channel): on every camera segment
-    /// also draw one vertex by equiangular sampling toward the point lights on the part of the ray
-    /// inside the media's bounding box, the nulls before it ratio-tracked, and connect it to the
-    /// lights by NEE: one more strategy among the (s, t) ones, weighed with its analytic pdf
-    /// (THEORY 5.4 in 5.5). Only where the scene has a point light (delta lights with a target;
-    /// lights a path can hit have tracking's hits besides) and a medium. Directional MIS has no
-    /// distance pdfs to weigh it by and leaves it out. The path estimators choose equiangular
-    /// sampling by their strategy instead.
-    bool bdpt_equiangular = true;
-};
-
-/// A radiance estimate and its status.
-template <SpectralMode S>
-struct RadianceSample {
-    typename S::Spectrum value;
-    Status status = Status::Ok;
-};
 
 /// What tracking would see at a vertex it did not draw itself (an equiangular or emission sample).
 template <Medium M, class Maj>
@@ -248,19 +138,6 @@ float emission_segment_pdf(const EstimatorOptions& opts, const Sc& scene, const 
     if (!opts.emission_along_segments) return 0.f;
     const float along = scene.medium.emission_along(e.shadow, 0.f, scene.lights.intersect(e.shadow).t);
     return segment_density(opts, e.y.pdf, along);
-}
-
-/// Throws InvalidArgument on max_depth < 0, rr_start_depth < 1 or rr_max_survival outside (0, 1].
-inline void validate(const EstimatorOptions& opts) {
-    if (opts.max_depth < 0)
-        detail::fail("EstimatorOptions max_depth = ", opts.max_depth, " is not allowed: it must be >= 0");
-    if (opts.rr_start_depth < 1)
-        detail::fail("EstimatorOptions rr_start_depth = ", opts.rr_start_depth, " is not allowed: it must be >= 1");
-    if (!(opts.rr_max_survival > 0.f && opts.rr_max_survival <= 1.f))
-        detail::fail("EstimatorOptions rr_max_survival = ", opts.rr_max_survival,
-                     " is not allowed: it must lie in (0, 1]");
-    validate_count("EstimatorOptions nee_count", opts.nee_count);
-    validate_count("EstimatorOptions emission_segment_count", opts.emission_segment_count);
 }
 
 }  // namespace nsp
