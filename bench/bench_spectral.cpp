@@ -1,4 +1,4 @@
-// bench/bench_spectral.cpp: the spectral path estimators (estimators/spectral.hpp), time per
+// bench/bench_spectral.cpp: the spectral path estimators (estimators/path.hpp with the per-channel path state), time per
 // sample and density lookups per sample.
 //
 // Chromatic scene (examples/default_scene.hpp: the default cloud with extinction 1 : 4 : 16 in

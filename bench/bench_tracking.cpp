@@ -55,7 +55,7 @@ typename S::Wavelengths lookup_wavelengths() {
 /// independent, so the CPU overlaps several: this is the lookup's throughput.
 template <nsp::SpectralMode S, class Points>
 void BM_RawLookup(benchmark::State& state) {
-    const auto& medium = default_scene<S>(LightSetup::A).medium;
+    const auto& medium = default_scene<S>(LightSetup::A).medium();
     const std::vector<nsp::Vec3>& pts = Points::get();
     const typename S::Wavelengths lambda = lookup_wavelengths<S>();
     typename S::Spectrum acc = S::Spectrum::Zero();
@@ -75,7 +75,7 @@ void BM_RawLookup(benchmark::State& state) {
 /// point is offset by 0 x the previous result), so none overlap: the lookup's latency.
 template <nsp::SpectralMode S>
 void BM_RawLookupChained(benchmark::State& state) {
-    const auto& medium = default_scene<S>(LightSetup::A).medium;
+    const auto& medium = default_scene<S>(LightSetup::A).medium();
     const std::vector<nsp::Vec3>& pts = tracked_points();
     const typename S::Wavelengths lambda = lookup_wavelengths<S>();
     float prev = 0.f;
@@ -126,9 +126,9 @@ using RatioNullWeight = Ratio<nsp::absorption::Weight, true>;
 /// test: what remains is the cost of the loop itself per tentative collision.
 struct Cloud {
     template <nsp::SpectralMode S>
-    static const auto& medium() { return default_scene<S>(LightSetup::A).medium; }
+    static const auto& medium() { return default_scene<S>(LightSetup::A).medium(); }
     template <nsp::SpectralMode S>
-    static const auto& majorant() { return default_scene<S>(LightSetup::A).majorant; }
+    static const auto& majorant() { return default_scene<S>(LightSetup::A).majorant(); }
 };
 struct Trivial {
     template <nsp::SpectralMode S>

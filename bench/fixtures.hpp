@@ -57,7 +57,7 @@ inline nsp::Vec3 uniform_in(const nsp::Box& b, nsp::Pcg32& rng) {
 /// kSetSize points uniform in the cloud's box, in random order (every lookup a random voxel).
 inline const std::vector<nsp::Vec3>& uniform_points() {
     static const std::vector<nsp::Vec3> pts = [] {
-        const nsp::Box box = default_scene<nsp::Mono>(LightSetup::A).medium.bounds();
+        const nsp::Box box = default_scene<nsp::Mono>(LightSetup::A).medium().bounds();
         nsp::Pcg32 rng(1, 11);
         std::vector<nsp::Vec3> p(kSetSize);
         for (auto& x : p) x = uniform_in(box, rng);
@@ -70,7 +70,7 @@ inline const std::vector<nsp::Vec3>& uniform_points() {
 /// the box centre, aimed at a point uniform in the box. Their chords average ~1.5 box units.
 inline const std::vector<nsp::Ray>& tracking_rays() {
     static const std::vector<nsp::Ray> rays = [] {
-        const nsp::Box box = default_scene<nsp::Mono>(LightSetup::A).medium.bounds();
+        const nsp::Box box = default_scene<nsp::Mono>(LightSetup::A).medium().bounds();
         nsp::Pcg32 rng(2, 22);
         std::vector<nsp::Ray> r(kSetSize);
         for (auto& ray : r) {
@@ -113,7 +113,7 @@ inline const std::vector<nsp::Vec3>& tracked_points() {
         const auto& scene = default_scene<nsp::Mono>(LightSetup::A);
         std::vector<nsp::Vec3> p;
         p.reserve(kSetSize + 4096);
-        const RecordingMedium rec(scene.medium, p);
+        const RecordingMedium rec(scene.medium(), p);
         const nsp::GlobalMajorant maj(rec);
         nsp::Pcg32 rng(3, 33);
         nsp::NoLookupCount none;
@@ -130,7 +130,7 @@ inline const std::vector<nsp::Vec3>& tracked_points() {
 /// drawn uniformly, kept if the density reaches 0.05 somewhere along the ray (a 256-step march).
 inline const std::vector<nsp::Ray>& camera_rays() {
     static const std::vector<nsp::Ray> rays = [] {
-        const auto& medium = default_scene<nsp::Mono>(LightSetup::A).medium;
+        const auto& medium = default_scene<nsp::Mono>(LightSetup::A).medium();
         nsp::Pcg32 rng(4, 44);
         std::vector<nsp::Ray> r;
         r.reserve(kSetSize);

@@ -90,11 +90,24 @@ void kernel(const char* name, int n, const nsp::LookupCount& counter, F&& body) 
     std::printf("%s %d %llu %.9g\n", name, n, static_cast<unsigned long long>(counter.count() - before), checksum);
 }
 
+/// The medium and majorant of an nsp::Scene, as accessors (a Scene is a SurfaceScene) or as the
+/// members of earlier versions: this file is built against both.
+template <class Sc>
+const auto& medium_of(const Sc& s) {
+    if constexpr (requires { s.medium(); }) return s.medium();
+    else return s.medium;
+}
+template <class Sc>
+const auto& majorant_of(const Sc& s) {
+    if constexpr (requires { s.majorant(); }) return s.majorant();
+    else return s.majorant;
+}
+
 template <nsp::AbsorptionPolicy A>
 void delta(const char* name, const auto& scene, const std::vector<nsp::Ray>& rays, nsp::LookupCount& counter) {
     nsp::Pcg32 rng(5, 55);
     kernel(name, kTrackCalls, counter, [&](int i) {
-        const auto r = nsp::track_delta<A>(scene.medium, scene.majorant, rays[i % kRays], kTmax, {}, rng, counter);
+        const auto r = nsp::track_delta<A>(medium_of(scene), majorant_of(scene), rays[i % kRays], kTmax, {}, rng, counter);
         return double(r.t) + double(r.weight[0]) + double(r.null_pdf_product);
     });
 }
@@ -103,7 +116,7 @@ template <nsp::AbsorptionPolicy A, bool kNullRatio>
 void ratio(const char* name, const auto& scene, const std::vector<nsp::Ray>& rays, nsp::LookupCount& counter) {
     nsp::Pcg32 rng(5, 55);
     kernel(name, kTrackCalls, counter, [&](int i) {
-        const auto r = nsp::track_ratio<A, kNullRatio>(scene.medium, scene.majorant, rays[i % kRays], kTmax, {},
+        const auto r = nsp::track_ratio<A, kNullRatio>(medium_of(scene), majorant_of(scene), rays[i % kRays], kTmax, {},
                                                         rng, counter);
         return double(r.transmittance[0]) + double(r.null_pdf_product);
     });
@@ -264,8 +277,8 @@ void surface_kernels(nsp::LookupCount& counter) {
 int main() {
     const auto a = nsp_examples::make_default_scene<Mono>(LightSetup::A);
     const auto b = nsp_examples::make_default_scene<Mono>(LightSetup::B);
-    const std::vector<nsp::Ray> track = tracking_rays(a.medium.bounds());
-    const std::vector<nsp::Ray> camera = camera_rays(a.medium);
+    const std::vector<nsp::Ray> track = tracking_rays(medium_of(a).bounds());
+    const std::vector<nsp::Ray> camera = camera_rays(medium_of(a));
     nsp::LookupCount counter;
     CALLGRIND_START_INSTRUMENTATION;
 

@@ -47,10 +47,41 @@ concept Geometry = requires(const G& g, const Ray& r, float t) {
 
 /// A scene without surfaces: media in empty space. Every query is answered at no cost.
 struct NoSurfaces {
+    static constexpr bool is_empty_space = true;  ///< no surface bounds a medium: the camera's fills space
     SurfaceHit intersect(const Ray&, float) const noexcept { return {}; }
 };
 
-static_assert(Geometry<NoSurfaces>);
+/// Media in empty space with an optional sphere light (nsp::Scene's geometry): the sphere is the
+/// only surface, reported with light handle `light` and no material (what reaches it ends there);
+/// medium `medium` lies on both of its sides, as it fills space (tracking clips it to its box).
+struct EmptySpace {
+    static constexpr bool is_empty_space = true;
+    bool has_sphere = false;
+    Vec3 center{0.f};
+    float radius = 0.f;
+    int light = -1;
+    int medium = 0;
+
+    SurfaceHit intersect(const Ray& r, float t_max) const noexcept {
+        SurfaceHit h;
+        if (!has_sphere) return h;
+        const float t = intersect_sphere(r, center, radius);
+        if (!(t < t_max)) return h;
+        h.t = t;
+        h.p = r.at(t);
+        const Vec3 n = glm::normalize(h.p - center);
+        h.ng = h.ns = n;
+        h.light = light;
+        h.medium_front = h.medium_back = medium;
+        return h;
+    }
+};
+
+/// True for a geometry with no surface that bounds a medium (NoSurfaces, EmptySpace).
+template <class G>
+inline constexpr bool is_empty_space_v = requires { requires bool(G::is_empty_space); };
+
+static_assert(Geometry<NoSurfaces> && Geometry<EmptySpace>);
 
 /// The faces of a medium's box as null interfaces (THEORY 5.8), for a host's `intersect` to
 /// report beside its own surfaces: the medium `inside` fills `box`, `outside` surrounds it. Hits

@@ -101,6 +101,7 @@ struct SceneMedium {
 /// `camera_medium` is the medium camera rays start in (-1: vacuum).
 template <Geometry G, Medium M, MajorantPolicy<M> Maj, PhaseFunction P, class Mats, class Ls>
 struct SurfaceScene {
+    static constexpr bool is_surface_scene = true;  ///< what the estimators render (nsp::Scene is one too)
     using GeometryType = G;
     using MediumType = M;
     using MajorantType = Maj;
@@ -205,9 +206,8 @@ private:
     std::vector<float> emission_pdf_;  ///< emissive media: emission_selection_pdf by medium
 };
 
+/// True for a SurfaceScene and the types built on one (nsp::Scene).
 template <class Sc>
-inline constexpr bool is_surface_scene_v = false;
-template <class G, class M, class Maj, class P, class Mats, class Ls>
-inline constexpr bool is_surface_scene_v<SurfaceScene<G, M, Maj, P, Mats, Ls>> = true;
+inline constexpr bool is_surface_scene_v = requires { requires bool(Sc::is_surface_scene); };
 
 }  // namespace nsp

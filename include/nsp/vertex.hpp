@@ -156,6 +156,32 @@ float emission_weight(const H& h, EmissionTechnique which, const EmissionPdfs& p
     }
 }
 
+/// The segment technique's density of a point in the MIS weights, count x p_V / W (W = `along`,
+/// its normaliser on the point's segment; opts.emission_segment_count the count): 0 where the
+/// technique does not run (W = 0).
+inline float segment_density(const EstimatorOptions& opts, float p_v, float along) noexcept {
+    return along > 0.f ? opts.emission_segment_count * (p_v / along) : 0.f;
+}
+
+/// Records an emission contribution drawn by technique `t` on a MisRecorder (else nothing):
+/// `unweighted` its channel mean without MIS weight or count (f over the drawing technique's
+/// density), `p` the three techniques' pdfs on their common scale (emission_pdfs, vertex.hpp), the
+/// segment's with opts.emission_segment_count in it.
+template <class C, class Pdfs>
+void record_emission_of(C& counter, float unweighted, const Pdfs& p, const EstimatorOptions& opts,
+                        EmissionTechnique t) noexcept {
+    if constexpr (MisRecorder<C>) {
+        const float count = opts.emission_segment_count;
+        const float p_seg = p.segment / count;
+        const float drawn = t == EmissionTechnique::Collision ? p.collision
+                            : t == EmissionTechnique::Segment ? p_seg
+                                                              : p.nee;
+        detail::record_emission(counter, unweighted * drawn, p.collision, p_seg, p.nee, count, t);
+    } else {
+        (void)counter, (void)unweighted, (void)p, (void)opts, (void)t;
+    }
+}
+
 /// The last real vertex of a path, as the MIS weight of whatever its next segments reach needs it.
 struct VertexPdf {
     float survival = 1.f;       ///< the roulette survival probability the path passed there

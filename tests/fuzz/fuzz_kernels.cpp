@@ -1027,7 +1027,7 @@ void run_estimator(Input& in, FuzzRng& rng, const Base& base, const Box& box, co
             } else {
                 r = est->radiance(*scene, ray, lambda, rng, counter);
             }
-            // Status (estimators/common.hpp): the value is always finite; NonFinite replaced it by
+            // Status (core/status.hpp): the value is always finite; NonFinite replaced it by
             // 0; Rejected only under bound::Reject; Aborted needs 2^24 collisions, beyond the budget.
             NSP_FUZZ_CHECK(finite_all(r.value));
             if (r.status == Status::NonFinite) NSP_FUZZ_CHECK((r.value == 0.f).all());

@@ -4,7 +4,7 @@
 // 5.3 with 5.5).
 //
 // A camera subpath and a light subpath are delta-tracked through the scene's media and surfaces
-// (the same VertexKernels and interface crossings as estimators/surface_path.hpp). Every real
+// (the same VertexKernels and interface crossings as estimators/path.hpp). Every real
 // vertex stores the density with which its own subpath drew it and the density with which the
 // other side would have drawn it, in area measure on surfaces and volume measure in media, each
 // with the segment's null-scattering factors: prod P_n(n_j) of the nulls on the segment it was
@@ -62,12 +62,12 @@
 #include "../mis.hpp"
 #include "../path_pdf.hpp"
 #include "../surface_scene.hpp"
+#include "../options.hpp"
+#include "../path_state.hpp"
+#include "../recorder.hpp"
 #include "../vertex.hpp"
-#include "common.hpp"
-#include "spectral_surface_emission.hpp"
-#include "spectral_surface_equiangular.hpp"
-#include "surface_emission.hpp"
-#include "surface_walk.hpp"
+#include "emission.hpp"
+#include "scene_walk.hpp"
 
 namespace nsp {
 
@@ -483,7 +483,7 @@ float from_infinity_measure(float pdf_perpendicular, const Vec3& w, const Vertex
 /// The medium a light subpath starting at p along w is in (-3 where the host's hits cannot be
 /// used): the side of the first surface ahead that the ray leaves, else of the first surface
 /// behind it that faces p, else, where no surface lies on the whole line, the scene's unbounded
-/// region: the camera's medium when the geometry has no surfaces at all (nsp::NoSurfaces: media
+/// region: the camera's medium when the geometry has no surface that bounds a medium (nsp::NoSurfaces, nsp::EmptySpace: media
 /// in empty space fill it), vacuum otherwise. The camera side's walks see the same media, so both
 /// sides of every connection agree.
 template <class Sc>
@@ -494,7 +494,7 @@ int light_start_medium(const Sc& sc, const Vec3& p, const Vec3& w) noexcept {
     const SurfaceHit behind = sc.geometry.intersect(Ray{p, -w}, kInf);
     if (!detail::usable_hit(sc, behind)) return -3;
     if (behind.found()) return behind.medium_left(-w);
-    if constexpr (std::is_same_v<typename Sc::GeometryType, NoSurfaces>) return sc.camera_medium;
+    if constexpr (is_empty_space_v<typename Sc::GeometryType>) return sc.camera_medium;
     else return -1;
 }
 
@@ -1315,27 +1315,31 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
         P nulls = broadcast<P>(1.f);
         GammaT gamma = unit_gamma<P>();
     };
+    // One piece of a shadow walk (ratio tracking through one medium), grey or per channel.
+    auto shadow_piece = [&](int m, const Ray& r, float t_max, const Spectrum& f) {
+        const auto& med = sc.media[std::size_t(m)];
+        if constexpr (kPerChannel)
+            return detail::channel_shadow_piece<Ch, A>(med.medium, med.majorant, r, t_max, lambda, channel, f, true, rng,
+                                                       counter);
+        else
+            return (void)f, detail::grey_shadow_piece(kernels_, med.medium, med.majorant, r, t_max, lambda, rng, counter);
+    };
     // `end_medium`, if given, receives the medium the ray ends in.
     auto shadow = [&](const Ray& r, float distance, int start, int* end_medium = nullptr) {
         Shadow out;
+        const auto sh = detail::walk_shadow<P>(sc, r, start, WalkEnd{distance}, shadow_piece);
+        out.status = sh.status;
+        if (sh.status != Status::Ok || !sh.reached) return out;
+        if (end_medium) *end_medium = sh.end_medium;
         if constexpr (kPerChannel) {
-            const auto sh = detail::channel_shadow_through<Ch, A>(sc, r, distance, start, lambda, channel,
-                                                                  Spectrum::Ones(), true, rng, counter, end_medium);
-            if (sh.end != SegmentEnd::Passed) {
-                out.status = flight_status(sh.end);
-                return out;
-            }
             // A sampling channel's density below float's range beside another's: its weight is 0.
             if (!(sh.f != 0.f).any() || !(sh.nee[channel] > 0.f)) return out;
             out.tr = sh.f / sh.nee[channel];
             out.nulls = (sh.nee > 0.f).select(sh.uni / sh.nee, 0.f);
             out.gamma = relative_to_largest<Spectrum>(sh.nee);
         } else {
-            const auto sh = detail::shadow_through(kernels_, sc, r, distance, start, lambda, rng, counter, end_medium);
-            out.status = sh.status;
-            if (sh.status != Status::Ok) return out;
-            out.tr = sh.transmittance;
-            out.nulls = Mis::null_pdfs ? sh.null_pdf_product : 1.f;
+            out.tr = sh.f;
+            out.nulls = Mis::null_pdfs ? sh.uni : 1.f;
         }
         return out;
     };
@@ -1424,7 +1428,7 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
         if (sh.status != Status::Ok) status = sh.status;
         if (sh.status != Status::Ok || !(sh.tr != 0.f).any() || !sc.has_medium(at)) return;
         const auto& m = sc.media[std::size_t(at)];
-        const auto c = lookup_untracked(m.medium, m.majorant, ray, ds.t, lambda, counter);
+        const auto c = detail::lookup_untracked(m.medium, m.majorant, ray, ds.t, lambda, counter);
         if (!c) {
             status = Status::Rejected;
             return;
@@ -1473,7 +1477,7 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
             const Shadow sh = shadow(ray, ds.t, medium);
             if (sh.status != Status::Ok) status = sh.status;
             const auto c = sh.status == Status::Ok && (sh.tr != 0.f).any()
-                               ? lookup_untracked(m.medium, m.majorant, ray, ds.t, lambda, counter)
+                               ? detail::lookup_untracked(m.medium, m.majorant, ray, ds.t, lambda, counter)
                                : std::nullopt;
             detail::record_shadow_walk(counter, before, false);
             if (sh.status != Status::Ok || !(sh.tr != 0.f).any()) return along;
@@ -1544,7 +1548,7 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
                 if (start == -3) status = Status::InvalidInput;
                 const bool inside = start == i;
                 if (i >= 0 && select > 0.f && yv.pdf > 0.f && inside) {
-                    const auto c = lookup_untracked(m.medium, m.majorant, Ray{yv.p, w}, 0.f, lambda, counter);
+                    const auto c = detail::lookup_untracked(m.medium, m.majorant, Ray{yv.p, w}, 0.f, lambda, counter);
                     if (!c) {
                         status = Status::Rejected;
                     } else if ((c->k.sigma_a > 0.f).any() && majorant_at(c->mu, channel) > 0.f) {
@@ -1640,31 +1644,23 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
         EmissionShadowT out;
         if constexpr (!kEmissive) {
             (void)r, (void)distance, (void)start, (void)target;
-        } else if constexpr (kPerChannel) {
-            const auto sh = detail::channel_emission_shadow<Ch, A>(sc, r, distance, start, target, seg_on, lambda,
-                                                                   channel, Spectrum::Ones(), rng, counter);
-            if (sh.end != SegmentEnd::Passed) {
-                out.status = flight_status(sh.end);
-                return out;
-            }
-            if (!sh.reached || !(sh.f != 0.f).any() || !(sh.nee[channel] > 0.f)) return out;
-            out.reached = true;
-            out.tr = sh.f / sh.nee[channel];
-            out.nulls = (sh.nee > 0.f).select(sh.uni / sh.nee, 0.f);
-            // sh.seg is uni of the pieces before the point's times nee of its own.
-            out.nulls_before = (sh.nee > 0.f).select(sh.seg / sh.nee, 0.f);
-            out.gamma = relative_to_largest<Spectrum>(sh.nee);
-            out.last = sh.last;
-            out.t_last = sh.t_last;
-            out.along = sh.along;
         } else {
-            const auto sh = detail::emission_shadow(kernels_, sc, r, distance, start, target, seg_on, lambda, rng, counter);
+            const auto sh = detail::walk_shadow<P>(sc, r, start, WalkEnd{distance, target, false, seg_on}, shadow_piece);
             out.status = sh.status;
-            if (sh.status != Status::Ok) return out;
-            out.reached = sh.reached;
-            out.tr = sh.transmittance;
-            out.nulls = Mis::null_pdfs ? sh.nulls_before * sh.nulls_own : 1.f;
-            out.nulls_before = Mis::null_pdfs ? sh.nulls_before : 1.f;
+            if (sh.status != Status::Ok || !sh.reached || !(sh.f != 0.f).any()) return out;
+            if constexpr (kPerChannel) {
+                if (!(sh.nee[channel] > 0.f)) return out;
+                out.tr = sh.f / sh.nee[channel];
+                out.nulls = (sh.nee > 0.f).select(sh.uni / sh.nee, 0.f);
+                // sh.seg is uni of the pieces before the point's times nee of its own.
+                out.nulls_before = (sh.nee > 0.f).select(sh.seg / sh.nee, 0.f);
+                out.gamma = relative_to_largest<Spectrum>(sh.nee);
+            } else {
+                out.tr = sh.f;
+                out.nulls = Mis::null_pdfs ? sh.uni : 1.f;
+                out.nulls_before = Mis::null_pdfs ? sh.seg : 1.f;
+            }
+            out.reached = true;
             out.last = sh.last;
             out.t_last = sh.t_last;
             out.along = sh.along;
@@ -1708,7 +1704,7 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
                             shadow_to_emission(Ray{z.p, e->wi}, e->dist, z.medium_toward(e->wi), e->index);
                         if (sh.status != Status::Ok) status = sh.status;
                         if (sh.status == Status::Ok && sh.reached && (sh.tr != 0.f).any()) {
-                            const auto c = lookup_untracked(m.medium, m.majorant, sh.last, sh.t_last, lambda, counter);
+                            const auto c = detail::lookup_untracked(m.medium, m.majorant, sh.last, sh.t_last, lambda, counter);
                             if (!c) {
                                 status = Status::Rejected;
                             } else if ((c->k.sigma_a > 0.f).any() && majorant_at(c->mu, channel) > 0.f) {

@@ -1,0 +1,218 @@
+// nsp/estimators/scene_walk.hpp: a path's way through a SurfaceScene (THEORY 5.8): which host
+// hits nsp can use, which surfaces a path crosses without a vertex (null interfaces), a real
+// vertex's direction value, pdf and sample (BSDF or phase function), and the one shadow walk: a
+// ray followed from surface to surface toward a light or a point in a medium, each medium on its
+// way ratio-tracked by the path state's tracker (grey or per channel), the pieces' factors
+// multiplied. Every estimator's shadow rays, connections and emission NEE walk this way.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+#include <type_traits>
+
+#include "../core/counter.hpp"
+#include "../geometry.hpp"
+#include "../media/emissive.hpp"
+#include "../path_state.hpp"
+#include "../pdf.hpp"
+#include "../surface_scene.hpp"
+#include "../tracking.hpp"
+
+namespace nsp::detail {
+
+/// More null interfaces on one segment than this (a host's geometry that reports the same
+/// boundary again and again) stops the path with Status::InvalidInput.
+inline constexpr int kMaxInterfaceCrossings = 256;
+
+/// Whether a hit from the host's geometry is one the estimator can use: a distance that is not
+/// NaN or negative, and where something was found a finite point, unit normals and handles
+/// inside the scene's tables.
+template <class Sc>
+bool usable_hit(const Sc& sc, const SurfaceHit& h) noexcept {
+    if (std::isnan(h.t) || h.t < 0.f) return false;
+    if (!h.found()) return true;
+    if (!finite(h.p) || !unit_length(h.ng) || !unit_length(h.ns)) return false;
+    if (h.material != -1 && !sc.materials.contains(h.material)) return false;
+    if (h.light != -1 && !(h.light >= 0 && h.light < sc.lights.count())) return false;
+    auto medium_ok = [&](int m) { return m == -1 || sc.has_medium(m); };
+    return medium_ok(h.medium_front) && medium_ok(h.medium_back);
+}
+
+/// Whether a path crosses the surface of `h` without a vertex: no light there, and no BSDF or
+/// one that passes through (a null interface).
+template <class Sc>
+bool crosses(const Sc& sc, const SurfaceHit& h) noexcept {
+    return h.light < 0 && (h.material < 0 || sc.materials.passes_through(h.material));
+}
+
+/// A real vertex of a path through a SurfaceScene: on a surface (material >= 0, the hit's shading
+/// normal ns) or in medium `medium` (material -1). What the estimators ask of it: the value and
+/// pdf of a direction (NEE), and a sampled direction (the path's continuation).
+struct SceneVertex {
+    int material = -1;
+    int medium = -1;
+    Vec3 ns{0.f, 0.f, 1.f};
+    bool on_surface() const noexcept { return material >= 0; }
+};
+
+/// A direction's throughput factor at a vertex (BSDF f_s |n . wi| or phase f_p) and its pdf.
+template <SpectralMode S>
+struct VertexDirection {
+    Vec3 wi{0.f, 0.f, 1.f};
+    typename S::Spectrum value = S::Spectrum::Zero();
+    float pdf = 0.f;
+    bool delta = false;
+};
+
+/// The value and pdf of direction wi at vertex v for a path that arrived along wo.
+template <class Sc>
+VertexDirection<typename Sc::Spectral> eval_vertex(const Sc& sc, const SceneVertex& v, const Vec3& wo, const Vec3& wi,
+                                                   const typename Sc::Spectral::Wavelengths& lambda) noexcept {
+    VertexDirection<typename Sc::Spectral> out;
+    out.wi = wi;
+    if (v.on_surface()) {
+        sc.materials.visit(v.material, [&](const auto& b) {
+            out.value = b.eval(wo, wi, v.ns, lambda);
+            out.pdf = b.pdf(wo, wi, v.ns);
+        });
+    } else {
+        const auto& phase = sc.media[std::size_t(v.medium)].phase;
+        out.value = Sc::Spectrum::Constant(phase.eval(wo, wi));
+        out.pdf = phase.pdf(wo, wi);
+    }
+    return out;
+}
+
+/// The next direction at vertex v from (u1, u2): the BSDF's or the phase function's sample; pdf
+/// 0 when there is none.
+template <class Sc>
+VertexDirection<typename Sc::Spectral> sample_vertex(const Sc& sc, const SceneVertex& v, const Vec3& wo, float u1,
+                                                     float u2, const typename Sc::Spectral::Wavelengths& lambda) noexcept {
+    VertexDirection<typename Sc::Spectral> out;
+    if (v.on_surface()) {
+        sc.materials.visit(v.material, [&](const auto& b) {
+            const BsdfSample<typename Sc::Spectral> bs = b.sample(wo, v.ns, u1, u2, lambda);
+            out = {bs.wi, bs.value, bs.pdf, bs.delta};
+        });
+    } else {
+        const PhaseSample ps = sc.media[std::size_t(v.medium)].phase.sample(wo, u1, u2);
+        out = {ps.wi, Sc::Spectrum::Constant(ps.value), ps.pdf, false};
+    }
+    return out;
+}
+
+/// What tracking would see at a vertex it did not draw itself (an equiangular or emission point).
+template <Medium M, class Maj>
+struct UntrackedVertex {
+    Coefficients<typename M::Spectral> k;  ///< the lookup, clamped to the majorant under bound::Clamp
+    MajorantValue<Maj, M> mu;              ///< the majorant there (grey or per channel)
+};
+
+/// One density lookup (counted) at distance t on `ray` with the majorant there, treated as
+/// free_flight treats its lookups: clamped under bound::Clamp; std::nullopt under bound::Reject
+/// where mu_t exceeds mu_bar (the estimator reports Status::Rejected).
+template <Medium M, MajorantPolicy<M> Maj, LookupCounter C>
+std::optional<UntrackedVertex<M, Maj>> lookup_untracked(const M& medium, const Maj& majorant, const Ray& ray, float t,
+                                                        const typename M::Spectral::Wavelengths& lambda, C& counter) {
+    using B = bound_policy_t<Maj>;
+    counter.lookup();
+    UntrackedVertex<M, Maj> v{medium.coefficients(ray.at(t), lambda), majorant_value_at_point<M>(majorant, ray, t, lambda)};
+    if constexpr (std::is_same_v<B, bound::Clamp>) {
+        clamp_to_majorant(v.k, v.mu);
+    } else if constexpr (std::is_same_v<B, bound::Reject>) {
+        if (exceeds_majorant(v.k, v.mu)) return std::nullopt;
+    }
+    return v;
+}
+
+/// The part of a shadow ray's length near its end where a walk toward a light does not look for
+/// blockers: 1e-4 of it, so that the surface or light the ray ends on does not block it (0 for
+/// lights at infinity). The media are tracked over the whole length all the same.
+inline float shadow_margin(float distance) noexcept { return std::isfinite(distance) ? distance * 1e-4f : 0.f; }
+
+namespace walk_detail {
+template <class P>
+P unit() noexcept {
+    if constexpr (std::is_same_v<P, float>) return 1.f;
+    else return P::Ones();
+}
+template <class P>
+float largest(const P& p) noexcept {
+    if constexpr (std::is_same_v<P, float>) return p;
+    else return p.maxCoeff();
+}
+}  // namespace walk_detail
+
+/// Walks the shadow ray r from a point in medium `medium` to `end`: from surface to surface
+/// (the host's intersect), crossing null interfaces, each medium on the way tracked by
+/// `piece(medium_index, ray, t_max, f_so_far)` (a ShadowPiece), the pieces' factors multiplied and
+/// renormalised by one common factor (it cancels in every ratio the callers form). Blocked (not
+/// reached, f = 0, status Ok) where a surface that is not a null interface lies before the end
+/// (found before the piece up to it is tracked), a piece's estimate fell below float's range, or
+/// (`end.target`) the end lies in another medium; a failed flight's status, or InvalidInput for a
+/// hit the estimators cannot use.
+template <class P, class Sc, class Piece>
+ShadowWalk<P, typename Sc::Spectral> walk_shadow(const Sc& sc, Ray r, int medium, const WalkEnd& end, Piece&& piece) {
+    using S = typename Sc::Spectral;
+    using Spec = typename S::Spectrum;
+    ShadowWalk<P, S> out;
+    auto fail = [](Status s) {
+        ShadowWalk<P, S> b;
+        b.status = s;
+        return b;
+    };
+    Spec f = Spec::Ones();
+    P nee = walk_detail::unit<P>(), uni = walk_detail::unit<P>(), seg = walk_detail::unit<P>();
+    float distance = end.distance;
+    const float margin = end.margin ? shadow_margin(distance) : 0.f;
+    for (int crossing = 0; crossing <= kMaxInterfaceCrossings; ++crossing) {
+        const SurfaceHit h = sc.geometry.intersect(r, end.with_along ? kInf : distance - margin);
+        if (!usable_hit(sc, h)) return fail(Status::InvalidInput);
+        const bool last = !h.found() || h.t >= distance - margin;
+        // A surface that is not a null interface before the end blocks the ray: nothing to track.
+        if (!last && !crosses(sc, h)) return fail(Status::Ok);
+        if (sc.has_medium(medium)) {
+            const ShadowPiece<P, S> s = piece(medium, r, last ? distance : h.t, f);
+            if (s.status != Status::Ok) return fail(s.status);
+            if (!(s.f != 0.f).any()) return fail(Status::Ok);
+            if (last) {
+                seg = uni * s.nee;
+                out.uni_last = s.uni;
+            }
+            f *= s.f;
+            nee *= s.nee;
+            uni *= s.uni;
+            // One common factor keeps many pieces inside float's range; it cancels.
+            const float k = std::max(walk_detail::largest(nee), walk_detail::largest(uni));
+            if (k > 0.f && std::isfinite(k) && k != 1.f) {
+                f /= k;
+                nee /= k;
+                uni /= k;
+                if (last) seg /= k;
+            }
+            if (!(f != 0.f).any()) return fail(Status::Ok);
+        }
+        if (last) {
+            if (end.target != -2 && medium != end.target) return fail(Status::Ok);
+            out.reached = true;
+            out.f = f;
+            out.nee = nee;
+            out.uni = uni;
+            out.seg = seg;
+            out.last = r;
+            out.t_last = distance;
+            out.end_medium = medium;
+            if constexpr (EmissiveMedium<typename Sc::MediumType>)
+                if (end.with_along && sc.has_medium(medium))
+                    out.along = sc.media[std::size_t(medium)].medium.emission_along(r, 0.f, h.t);
+            return out;
+        }
+        medium = h.medium_entered(r.d);
+        r.o = h.p;
+        distance -= h.t;
+    }
+    return fail(Status::InvalidInput);
+}
+
+}  // namespace nsp::detail
