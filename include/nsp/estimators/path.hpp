@@ -67,9 +67,12 @@ RadianceSample<typename Sc::Spectral> trace_path(const K& k, const Sc& sc, const
     int crossings = 0;
     for (int depth = 0;;) {
         const SurfaceHit hit = sc.geometry.intersect(ray, kInf);
-        if (!usable_hit(sc, hit)) {
-            status = Status::InvalidInput;
-            break;
+        // nsp's own empty space (Scene) reports only hits it built; a host's are checked.
+        if constexpr (!is_empty_space_v<typename Sc::GeometryType>) {
+            if (!usable_hit(sc, hit)) {
+                status = Status::InvalidInput;
+                break;
+            }
         }
         bool in_medium = false;
         float t_medium = 0.f;
