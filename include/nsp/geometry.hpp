@@ -49,6 +49,8 @@ concept Geometry = requires(const G& g, const Ray& r, float t) {
 struct NoSurfaces {
     static constexpr bool is_empty_space = true;  ///< no surface bounds a medium: the camera's fills space
     SurfaceHit intersect(const Ray&, float) const noexcept { return {}; }
+    /// The distance to the first surface before t_max (kInf: none), for shadow rays.
+    float distance(const Ray&, float) const noexcept { return kInf; }
 };
 
 /// Media in empty space with an optional sphere light (nsp::Scene's geometry): the sphere is the
@@ -74,6 +76,12 @@ struct EmptySpace {
         h.light = light;
         h.medium_front = h.medium_back = medium;
         return h;
+    }
+    /// The distance to the sphere light before t_max (kInf: none), for shadow rays.
+    float distance(const Ray& r, float t_max) const noexcept {
+        if (!has_sphere) return kInf;
+        const float t = intersect_sphere(r, center, radius);
+        return t < t_max ? t : kInf;
     }
 };
 

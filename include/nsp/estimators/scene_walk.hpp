@@ -166,51 +166,72 @@ ShadowWalk<P, typename Sc::Spectral> walk_shadow(const Sc& sc, Ray r, int medium
     P nee = walk_detail::unit<P>(), uni = walk_detail::unit<P>(), seg = walk_detail::unit<P>();
     float distance = end.distance;
     const float margin = end.margin ? shadow_margin(distance) : 0.f;
-    for (int crossing = 0; crossing <= kMaxInterfaceCrossings; ++crossing) {
-        const SurfaceHit h = sc.geometry.intersect(r, end.with_along ? kInf : distance - margin);
-        if (!usable_hit(sc, h)) return fail(Status::InvalidInput);
-        const bool last = !h.found() || h.t >= distance - margin;
-        // A surface that is not a null interface before the end blocks the ray: nothing to track.
-        if (!last && !crosses(sc, h)) return fail(Status::Ok);
-        if (sc.has_medium(medium)) {
-            const ShadowPiece<P, S> s = piece(medium, r, last ? distance : h.t, f);
-            if (s.status != Status::Ok) return fail(s.status);
-            if (!(s.f != 0.f).any()) return fail(Status::Ok);
-            if (last) {
-                seg = uni * s.nee;
-                out.uni_last = s.uni;
-            }
-            f *= s.f;
-            nee *= s.nee;
-            uni *= s.uni;
-            // One common factor keeps many pieces inside float's range; it cancels.
-            const float k = std::max(walk_detail::largest(nee), walk_detail::largest(uni));
-            if (k > 0.f && std::isfinite(k) && k != 1.f) {
-                f /= k;
-                nee /= k;
-                uni /= k;
-                if (last) seg /= k;
-            }
-            if (!(f != 0.f).any()) return fail(Status::Ok);
+    // Multiplies in the piece of medium `medium` up to t_max (the last one: up to the end); false
+    // where the walk is blocked or failed (`out` then holds what to return).
+    auto take_piece = [&](const Ray& ray, float t_max, bool last) {
+        if (!sc.has_medium(medium)) return true;
+        const ShadowPiece<P, S> s = piece(medium, ray, t_max, f);
+        if (s.status != Status::Ok || !(s.f != 0.f).any()) {
+            out = fail(s.status);
+            return false;
         }
         if (last) {
-            if (end.target != -2 && medium != end.target) return fail(Status::Ok);
-            out.reached = true;
-            out.f = f;
-            out.nee = nee;
-            out.uni = uni;
-            out.seg = seg;
-            out.last = r;
-            out.t_last = distance;
-            out.end_medium = medium;
-            if constexpr (EmissiveMedium<typename Sc::MediumType>)
-                if (end.with_along && sc.has_medium(medium))
-                    out.along = sc.media[std::size_t(medium)].medium.emission_along(r, 0.f, h.t);
-            return out;
+            seg = uni * s.nee;
+            out.uni_last = s.uni;
         }
-        medium = h.medium_entered(r.d);
-        r.o = h.p;
-        distance -= h.t;
+        f *= s.f;
+        nee *= s.nee;
+        uni *= s.uni;
+        // One common factor keeps many pieces inside float's range; it cancels.
+        const float k = std::max(walk_detail::largest(nee), walk_detail::largest(uni));
+        if (k > 0.f && std::isfinite(k) && k != 1.f) {
+            f /= k;
+            nee /= k;
+            uni /= k;
+            if (last) seg /= k;
+        }
+        if (!(f != 0.f).any()) {
+            out = fail(Status::Ok);
+            return false;
+        }
+        return true;
+    };
+    // The walk reached the end at `distance` along `ray`; `beyond` is the next surface's distance.
+    auto reached = [&](const Ray& ray, float beyond) {
+        if (end.target != -2 && medium != end.target) return fail(Status::Ok);
+        out.reached = true;
+        out.f = f;
+        out.nee = nee;
+        out.uni = uni;
+        out.seg = seg;
+        out.last = ray;
+        out.t_last = distance;
+        out.end_medium = medium;
+        if constexpr (EmissiveMedium<typename Sc::MediumType>)
+            if (end.with_along && sc.has_medium(medium))
+                out.along = sc.media[std::size_t(medium)].medium.emission_along(ray, 0.f, beyond);
+        return out;
+    };
+    if constexpr (is_empty_space_v<typename Sc::GeometryType>) {
+        // nsp's own empty space (Scene, NoSurfaces): no interface to cross; a surface before the
+        // end (Scene's sphere light) blocks. One piece, no hit records to check.
+        const float t = sc.geometry.distance(r, end.with_along ? kInf : distance - margin);
+        if (t < distance - margin) return fail(Status::Ok);
+        if (!take_piece(r, distance, true)) return out;
+        return reached(r, t);
+    } else {
+        for (int crossing = 0; crossing <= kMaxInterfaceCrossings; ++crossing) {
+            const SurfaceHit h = sc.geometry.intersect(r, end.with_along ? kInf : distance - margin);
+            if (!usable_hit(sc, h)) return fail(Status::InvalidInput);
+            const bool last = !h.found() || h.t >= distance - margin;
+            // A surface that is not a null interface before the end blocks the ray: nothing to track.
+            if (!last && !crosses(sc, h)) return fail(Status::Ok);
+            if (!take_piece(r, last ? distance : h.t, last)) return out;
+            if (last) return reached(r, h.t);
+            medium = h.medium_entered(r.d);
+            r.o = h.p;
+            distance -= h.t;
+        }
     }
     return fail(Status::InvalidInput);
 }
