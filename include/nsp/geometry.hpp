@@ -51,6 +51,8 @@ struct NoSurfaces {
     SurfaceHit intersect(const Ray&, float) const noexcept { return {}; }
     /// The distance to the first surface before t_max (kInf: none), for shadow rays.
     float distance(const Ray&, float) const noexcept { return kInf; }
+    /// Whether light `light` is this geometry's surface (never).
+    bool ends_on(int) const noexcept { return false; }
 };
 
 /// Media in empty space with an optional sphere light (nsp::Scene's geometry): the sphere is the
@@ -83,6 +85,8 @@ struct EmptySpace {
         const float t = intersect_sphere(r, center, radius);
         return t < t_max ? t : kInf;
     }
+    /// Whether light `light` is the sphere: a walk to a point sampled on its visible cap.
+    bool ends_on(int l) const noexcept { return has_sphere && l >= 0 && l == light; }
 };
 
 /// True for a geometry with no surface that bounds a medium (NoSurfaces, EmptySpace).

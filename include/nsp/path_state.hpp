@@ -126,6 +126,7 @@ struct WalkEnd {
     int target = -2;  ///< -2: any medium
     bool margin = true;
     bool with_along = false;
+    int light = -1;  ///< the light the walk ends on (a light sample's index), -1: none
 };
 
 /// A shadow walk's result (estimators/scene_walk.hpp): its status; `f`, `nee`, `uni` the pieces'

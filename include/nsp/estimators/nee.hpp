@@ -36,7 +36,7 @@ Status light_nee(const State& st, const Sc& sc, const detail::SceneVertex& v, co
     const bool uni_alternative = St::combines && !ls.sample.delta;  // a point light cannot be hit
     const double before = detail::recorder_work(counter);
     const auto walk = detail::walk_shadow<P>(
-        sc, Ray{x, fv.wi}, start_medium(fv.wi), WalkEnd{ls.sample.distance},
+        sc, Ray{x, fv.wi}, start_medium(fv.wi), WalkEnd{ls.sample.distance, -2, true, false, ls.light},
         [&](int m, const Ray& r, float t_max, const Spectrum& f) {
             const auto& med = sc.media[std::size_t(m)];
             return st.shadow_piece(med.medium, med.majorant, r, t_max, Spectrum(x_rec.f * f), uni_alternative, lambda,

@@ -214,8 +214,12 @@ ShadowWalk<P, typename Sc::Spectral> walk_shadow(const Sc& sc, Ray r, int medium
     };
     if constexpr (is_empty_space_v<typename Sc::GeometryType>) {
         // nsp's own empty space (Scene, NoSurfaces): no interface to cross; a surface before the
-        // end (Scene's sphere light) blocks. One piece, no hit records to check.
-        const float t = sc.geometry.distance(r, end.with_along ? kInf : distance - margin);
+        // end (Scene's sphere light) blocks. One piece, no hit records to check. A point sampled
+        // on the sphere light's visible cap is not blocked by it (the medium, where every walk
+        // starts, lies outside the sphere; Scene checks), so that walk needs no test.
+        float t = kInf;
+        if (end.with_along || !sc.geometry.ends_on(end.light))
+            t = sc.geometry.distance(r, end.with_along ? kInf : distance - margin);
         if (t < distance - margin) return fail(Status::Ok);
         if (!take_piece(r, distance, true)) return out;
         return reached(r, t);
