@@ -77,19 +77,33 @@ struct ShadowPiece {
 
 namespace detail {
 /// One shadow piece on the grey axis: ratio tracking through medium (medium, majorant) with the
-/// kernels `k` (VertexKernels::shadow), its null product where the strategy weighs by
-/// null-scattering pdfs.
+/// absorption policy of the kernels `k` (as VertexKernels::shadow), its null product where the
+/// strategy weighs by null-scattering pdfs. The tracker is called itself: the flight checks the
+/// ray (usable_ray, a NaN distance: Status::InvalidInput), which VertexKernels::shadow, made for a
+/// host's rays, would check once more.
 template <class K, class Med, class Maj, UniformRng R, LookupCounter C>
 ShadowPiece<float, typename Med::Spectral> grey_shadow_piece(const K& k, const Med& medium, const Maj& majorant,
                                                              const Ray& r, float t_max,
                                                              const typename Med::Spectral::Wavelengths& lambda, R& rng,
                                                              C& counter) {
-    const auto sh = k.shadow(medium, majorant, r, t_max, lambda, rng, counter);
+    (void)k;
     ShadowPiece<float, typename Med::Spectral> out;
-    out.status = sh.status;
-    out.f = sh.transmittance;
     out.nee = 1.f;
-    out.uni = sh.null_pdf_product;
+    out.uni = 1.f;
+    if (!(t_max >= 0.f)) [[unlikely]] {  // a negative or NaN distance: nothing to track
+        out.status = Status::InvalidInput;
+        out.f = Med::Spectral::Spectrum::Zero();
+        return out;
+    }
+    const auto tr = track_ratio<typename K::Absorption, K::Strategy::null_pdfs>(medium, majorant, r, t_max, lambda,
+                                                                               rng, counter);
+    out.status = flight_status(tr.end);
+    if (out.status != Status::Ok || tr.end == SegmentEnd::Terminated) {  // failed, or below float's range: 0
+        out.f = Med::Spectral::Spectrum::Zero();
+        return out;
+    }
+    out.f = tr.transmittance;
+    out.uni = tr.null_pdf_product;
     return out;
 }
 
@@ -268,11 +282,14 @@ public:
     template <class Med, class Maj, class Visit, UniformRng R, LookupCounter C>
     SegmentEnd track(const Med& medium, const Maj& majorant, const Ray& ray, float t_max,
                      const typename S::Wavelengths& lambda, R& rng, C& counter, Visit&& visit, float& t) {
+        // The tracker itself, not VertexKernels::track: the flight checks the ray (usable_ray, a
+        // NaN t_max: SegmentEnd::InvalidInput), and the loop's t_max, a usable hit's, is >= 0.
         DeltaTrack<S> seg;
         if constexpr (std::remove_cvref_t<Visit>::enabled)
-            seg = k_.track_visiting(medium, majorant, ray, t_max, lambda, rng, counter, std::forward<Visit>(visit));
+            seg = track_delta_visiting<A>(medium, majorant, ray, t_max, lambda, rng, counter,
+                                          std::forward<Visit>(visit));
         else
-            seg = k_.track(medium, majorant, ray, t_max, lambda, rng, counter);
+            seg = track_delta<A>(medium, majorant, ray, t_max, lambda, rng, counter);
         if (flight_status(seg.end) != Status::Ok) return seg.end;
         beta_ *= seg.weight;
         nulls_ *= seg.null_pdf_product;
