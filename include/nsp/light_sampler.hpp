@@ -89,7 +89,7 @@ private:
         return b;
     }
     LightSampler(Checked, LightSelection selection, float scene_radius, BoundingSphere sphere, std::vector<Ls>... lights)
-        : lights_(std::move(lights)...), sphere_(sphere) {
+        : lights_(std::move(lights)...), sphere_(sphere), uniform_(selection == LightSelection::Uniform) {
         double total = 0.0;
         for_each_light([&](const auto& l, int kind, int index) {
             validate(l);
@@ -243,9 +243,14 @@ public:
     SampledLight<S> sample(const Vec3& x, float u0, float u1, float u2, const typename S::Wavelengths& lambda = {}) const
         noexcept {
         if (entries_.empty()) return {};
-        const auto it = std::upper_bound(entries_.begin(), entries_.end(), u0,
-                                         [](float u, const Entry& e) { return u < e.cdf; });
-        const std::size_t i = std::min(std::size_t(it - entries_.begin()), entries_.size() - 1);
+        std::size_t i;
+        if (uniform_) {  // every pmf 1/n: the index without a search
+            i = std::min(std::size_t(u0 * float(entries_.size())), entries_.size() - 1);
+        } else {
+            const auto it = std::upper_bound(entries_.begin(), entries_.end(), u0,
+                                             [](float u, const Entry& e) { return u < e.cdf; });
+            i = std::min(std::size_t(it - entries_.begin()), entries_.size() - 1);
+        }
         SampledLight<S> out{{}, int(i)};
         const Entry& e = entries_[i];
         visit(e, [&](const auto& l) { out.sample = l.sample(x, u1, u2, lambda, e.pmf); });
@@ -389,6 +394,7 @@ private:
     std::vector<Emitter> emitters_;  ///< the EmittingLight entries, with their cdf for sample_emission
     std::vector<float> emit_pmf_;    ///< by light index: sample_emission's probability of it
     BoundingSphere sphere_;          ///< radius 0: the lights at infinity start no light subpaths
+    bool uniform_;                   ///< LightSelection::Uniform: sample() picks by index
 };
 
 }  // namespace nsp

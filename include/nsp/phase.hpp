@@ -52,7 +52,7 @@ public:
     float pdf(const Vec3& wo, const Vec3& wi) const noexcept { return eval(wo, wi); }
 
     /// Inverts the HG cdf in cos_theta (a closed form; isotropic below |g| = 1e-3).
-    PhaseSample sample(const Vec3& wo, float u1, float u2) const noexcept {
+    [[gnu::always_inline]] PhaseSample sample(const Vec3& wo, float u1, float u2) const noexcept {
         float cos_theta;
         if (std::abs(g_) < 1e-3f) {
             cos_theta = 1.f - 2.f * u1;

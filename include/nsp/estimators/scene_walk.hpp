@@ -67,7 +67,7 @@ struct VertexDirection {
 
 /// The value and pdf of direction wi at vertex v for a path that arrived along wo.
 template <class Sc>
-VertexDirection<typename Sc::Spectral> eval_vertex(const Sc& sc, const SceneVertex& v, const Vec3& wo, const Vec3& wi,
+[[gnu::always_inline]] inline VertexDirection<typename Sc::Spectral> eval_vertex(const Sc& sc, const SceneVertex& v, const Vec3& wo, const Vec3& wi,
                                                    const typename Sc::Spectral::Wavelengths& lambda) noexcept {
     VertexDirection<typename Sc::Spectral> out;
     out.wi = wi;
@@ -87,7 +87,7 @@ VertexDirection<typename Sc::Spectral> eval_vertex(const Sc& sc, const SceneVert
 /// The next direction at vertex v from (u1, u2): the BSDF's or the phase function's sample; pdf
 /// 0 when there is none.
 template <class Sc>
-VertexDirection<typename Sc::Spectral> sample_vertex(const Sc& sc, const SceneVertex& v, const Vec3& wo, float u1,
+[[gnu::always_inline]] inline VertexDirection<typename Sc::Spectral> sample_vertex(const Sc& sc, const SceneVertex& v, const Vec3& wo, float u1,
                                                      float u2, const typename Sc::Spectral::Wavelengths& lambda) noexcept {
     VertexDirection<typename Sc::Spectral> out;
     if (v.on_surface()) {
@@ -153,7 +153,7 @@ float largest(const P& p) noexcept {
 /// (`end.target`) the end lies in another medium; a failed flight's status, or InvalidInput for a
 /// hit the estimators cannot use.
 template <class P, class Sc, class Piece>
-ShadowWalk<P, typename Sc::Spectral> walk_shadow(const Sc& sc, Ray r, int medium, const WalkEnd& end, Piece&& piece) {
+[[gnu::always_inline]] inline ShadowWalk<P, typename Sc::Spectral> walk_shadow(const Sc& sc, Ray r, int medium, const WalkEnd& end, Piece&& piece) {
     using S = typename Sc::Spectral;
     using Spec = typename S::Spectrum;
     ShadowWalk<P, S> out;
