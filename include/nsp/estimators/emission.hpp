@@ -124,7 +124,7 @@ float emission_segment(const State& st, const Sc& sc, int index, const Ray& ray,
 /// see light_nee; `start_medium(wi)` the medium a shadow ray along wi starts in): adds the
 /// weighted contribution to L. Draws five random numbers. Returns a failed walk's status.
 template <class State, class Sc, class StartMedium, UniformRng R, LookupCounter C>
-Status volume_nee(const State& st, const Sc& sc, const detail::SceneVertex& v, const Vec3& x, const Vec3& wo,
+Status volume_nee(const State& st, const Sc& sc, const SceneVertex& v, const Vec3& x, const Vec3& wo,
                   const VertexRecord<typename State::P, typename Sc::Spectral>& x_rec, StartMedium&& start_medium,
                   const typename Sc::Spectral::Wavelengths& lambda, R& rng, C& counter, typename Sc::Spectrum& L) {
     using St = typename State::Strategy;
@@ -134,10 +134,10 @@ Status volume_nee(const State& st, const Sc& sc, const detail::SceneVertex& v, c
     const auto point = detail::draw_emission_point(sc, x, rng);
     if (!point) return Status::Ok;
     const auto& m = sc.media[std::size_t(point->index)];
-    const auto fv = detail::eval_vertex(sc, v, wo, point->wi, lambda);
+    const auto fv = eval_vertex(sc, v, wo, point->wi, lambda);
     if (!(fv.value != 0.f).any()) return Status::Ok;
     const bool with_along = St::combines && st.options().emission_along_segments;
-    const auto walk = detail::walk_shadow<P>(
+    const auto walk = walk_shadow<P>(
         sc, Ray{x, point->wi}, start_medium(point->wi), WalkEnd{point->dist, point->index, false, with_along},
         [&](int i, const Ray& r, float t_max, const Spectrum& f) {
             const auto& med = sc.media[std::size_t(i)];

@@ -45,8 +45,6 @@ float equiangular_probability(const Maj& majorant, const Ray& ray, const Equiang
     return r < 1.f ? r : 1.f;            // NaN and inf give 1
 }
 
-namespace detail {
-
 /// The equiangular technique on one piece [t0, t1] of `ray`: the mixture over the light
 /// sampler's targets. Default-constructed: off (density 0).
 template <class Sc>
@@ -100,14 +98,12 @@ private:
     float t0_ = 0.f, t1_ = 0.f;
 };
 
-}  // namespace detail
-
 /// Equiangular + NEE on one piece `ray` of a path segment in medium `index` (see the header): t
 /// drawn from `eq`, the nulls on [0, t) ratio-tracked, t a real scattering vertex at path depth
 /// `depth` with NEE from it. `select` is the probability with which the piece draws the vertex at
 /// all (its density is select x the mixture's). Returns a failed flight's status.
 template <class State, class Sc, UniformRng R, LookupCounter C>
-Status equiangular_nee(const State& st, const Sc& sc, int index, const Ray& ray, const detail::PieceEquiangular<Sc>& eq,
+Status equiangular_nee(const State& st, const Sc& sc, int index, const Ray& ray, const PieceEquiangular<Sc>& eq,
                        float select, int depth, const typename Sc::Spectral::Wavelengths& lambda, R& rng, C& counter,
                        typename Sc::Spectrum& L) {
     using St = typename State::Strategy;
@@ -124,7 +120,7 @@ Status equiangular_nee(const State& st, const Sc& sc, int index, const Ray& ray,
     if (!v) return Status::Rejected;
     const auto x = st.equiangular_vertex(piece, v->k, v->mu, ds.pdf, depth);
     if (!x) return Status::Ok;
-    const detail::SceneVertex xv{-1, index, Vec3(0.f, 0.f, 1.f)};
+    const SceneVertex xv{-1, index, Vec3(0.f, 0.f, 1.f)};
     return light_nee(st, sc, xv, ray.at(ds.t), ray.d, *x, [&](const Vec3&) { return index; }, lambda, rng, counter, L);
 }
 

@@ -20,7 +20,7 @@ namespace nsp {
 /// light sampling cannot reach the path). Returns a failed walk's status (NonFinite: an overflowed
 /// flight, the caller discards the path).
 template <class State, class Sc, class StartMedium, UniformRng R, LookupCounter C>
-[[gnu::always_inline]] inline Status light_nee(const State& st, const Sc& sc, const detail::SceneVertex& v, const Vec3& x, const Vec3& wo,
+[[gnu::always_inline]] inline Status light_nee(const State& st, const Sc& sc, const SceneVertex& v, const Vec3& x, const Vec3& wo,
                  const VertexRecord<typename State::P, typename Sc::Spectral>& x_rec, StartMedium&& start_medium,
                  const typename Sc::Spectral::Wavelengths& lambda, R& rng, C& counter, typename Sc::Spectrum& L) {
     using P = typename State::P;
@@ -31,11 +31,11 @@ template <class State, class Sc, class StartMedium, UniformRng R, LookupCounter 
     if (v.on_surface() && sc.materials.is_delta(v.material)) return Status::Ok;
     const SampledLight<S> ls = sc.lights.sample(x, u0, u1, u2, lambda);
     if (!(ls.sample.pdf > 0.f)) return Status::Ok;
-    const auto fv = detail::eval_vertex(sc, v, wo, ls.sample.wi, lambda);
+    const auto fv = eval_vertex(sc, v, wo, ls.sample.wi, lambda);
     if (!(fv.value != 0.f).any()) return Status::Ok;
     const bool uni_alternative = St::combines && !ls.sample.delta;  // a point light cannot be hit
     const double before = detail::recorder_work(counter);
-    const auto walk = detail::walk_shadow<P>(
+    const auto walk = walk_shadow<P>(
         sc, Ray{x, fv.wi}, start_medium(fv.wi), WalkEnd{ls.sample.distance, -2, true, false, ls.light},
         [&](int m, const Ray& r, float t_max, const Spectrum& f) {
             const auto& med = sc.media[std::size_t(m)];

@@ -46,6 +46,10 @@ bool crosses(const Sc& sc, const SurfaceHit& h) noexcept {
     return h.light < 0 && (h.material < 0 || sc.materials.passes_through(h.material));
 }
 
+}  // namespace nsp::detail
+
+namespace nsp {
+
 /// A real vertex of a path through a SurfaceScene: on a surface (material >= 0, the hit's shading
 /// normal ns) or in medium `medium` (material -1). What the estimators ask of it: the value and
 /// pdf of a direction (NEE), and a sampled direction (the path's continuation).
@@ -102,6 +106,10 @@ template <class Sc>
     return out;
 }
 
+}  // namespace nsp
+
+namespace nsp::detail {
+
 /// What tracking would see at a vertex it did not draw itself (an equiangular or emission point).
 template <Medium M, class Maj>
 struct UntrackedVertex {
@@ -144,6 +152,10 @@ float largest(const P& p) noexcept {
 }
 }  // namespace walk_detail
 
+}  // namespace nsp::detail
+
+namespace nsp {
+
 /// Walks the shadow ray r from a point in medium `medium` to `end`: from surface to surface
 /// (the host's intersect), crossing null interfaces, each medium on the way tracked by
 /// `piece(medium_index, ray, t_max, f_so_far)` (a ShadowPiece), the pieces' factors multiplied and
@@ -163,9 +175,9 @@ template <class P, class Sc, class Piece>
         return b;
     };
     Spec f = Spec::Ones();
-    P nee = walk_detail::unit<P>(), uni = walk_detail::unit<P>(), seg = walk_detail::unit<P>();
+    P nee = detail::walk_detail::unit<P>(), uni = detail::walk_detail::unit<P>(), seg = detail::walk_detail::unit<P>();
     float distance = end.distance;
-    const float margin = end.margin ? shadow_margin(distance) : 0.f;
+    const float margin = end.margin ? detail::shadow_margin(distance) : 0.f;
     // Multiplies in the piece of medium `medium` up to t_max (the last one: up to the end); false
     // where the walk is blocked or failed (`out` then holds what to return).
     auto take_piece = [&](const Ray& ray, float t_max, bool last) {
@@ -183,7 +195,7 @@ template <class P, class Sc, class Piece>
         nee *= s.nee;
         uni *= s.uni;
         // One common factor keeps many pieces inside float's range; it cancels.
-        const float k = std::max(walk_detail::largest(nee), walk_detail::largest(uni));
+        const float k = std::max(detail::walk_detail::largest(nee), detail::walk_detail::largest(uni));
         if (k > 0.f && std::isfinite(k) && k != 1.f) {
             f /= k;
             nee /= k;
@@ -224,12 +236,12 @@ template <class P, class Sc, class Piece>
         if (!take_piece(r, distance, true)) return out;
         return reached(r, t);
     } else {
-        for (int crossing = 0; crossing <= kMaxInterfaceCrossings; ++crossing) {
+        for (int crossing = 0; crossing <= detail::kMaxInterfaceCrossings; ++crossing) {
             const SurfaceHit h = sc.geometry.intersect(r, end.with_along ? kInf : distance - margin);
-            if (!usable_hit(sc, h)) return fail(Status::InvalidInput);
+            if (!detail::usable_hit(sc, h)) return fail(Status::InvalidInput);
             const bool last = !h.found() || h.t >= distance - margin;
             // A surface that is not a null interface before the end blocks the ray: nothing to track.
-            if (!last && !crosses(sc, h)) return fail(Status::Ok);
+            if (!last && !detail::crosses(sc, h)) return fail(Status::Ok);
             if (!take_piece(r, last ? distance : h.t, last)) return out;
             if (last) return reached(r, h.t);
             medium = h.medium_entered(r.d);
@@ -240,4 +252,4 @@ template <class P, class Sc, class Piece>
     return fail(Status::InvalidInput);
 }
 
-}  // namespace nsp::detail
+}  // namespace nsp

@@ -1,0 +1,932 @@
+// nsp/estimators/bdpt_sample.hpp: one sample of BdptEstimator::trace (bdpt.hpp) as named parts:
+// the camera and light subpaths, each strategy family (s = 0 at an emitter and by emission as
+// collision, the equiangular and segment strategies, NEE toward the lights and the volume, s >= 2
+// connections, light tracing) and the weights, records and shadow walks they share. Included by
+// bdpt.hpp, after the estimator's declaration.
+#pragma once
+
+#include "bdpt.hpp"
+
+namespace nsp {
+
+/// One sample of trace: the state its strategies share (the scene, the sample's wavelengths and
+/// random numbers, both subpaths, the path's densities, the estimate) and each strategy family
+/// as a named part. trace calls the parts in the order their random numbers are drawn.
+template <bdpt::MisPolicy Mis, mis::CombiningHeuristic H, AbsorptionPolicy A, int MaxDepth, bdpt::ChannelAxis Ch>
+template <class Sc, class Cam, class R, class C, class Splat, class Observe>
+struct BdptEstimator<Mis, H, A, MaxDepth, Ch>::BdptSample {
+    static constexpr bool kLightTracing = !std::is_same_v<Cam, NoCamera>;
+    static constexpr bool kEmissive = EmissiveMedium<typename Sc::MediumType>;
+    using Spectrum = typename Sc::Spectrum;
+    using V = VertexT<Sc>;
+    using P = bdpt::PdfType<Ch, typename Sc::Spectral>;
+    using PathPdfsT = PdfsFor<typename Sc::Spectral>;
+    using GammaT = bdpt::GammaOf<P>;
+    static constexpr int kEq = PathPdfsT::kEquiangular;
+    static constexpr int kSeg = PathPdfsT::kSegment;
+
+    const BdptEstimator& est;
+    const Sc& sc;
+    const Cam* cam;
+    const typename Sc::Spectral::Wavelengths& lambda;
+    R& rng;
+    C& counter;
+    Splat& splat;
+    Observe& observe;
+    V* const camera;  // z_0 .. z_{depth+1}
+    V* const light;   // y_0 .. y_{depth-1}, y_depth (light tracing)
+    const int depth = est.kernels_.options().max_depth;
+    Spectrum L = Spectrum::Zero();
+    Status status = Status::Ok;
+    PathPdfsT pdfs;
+    EqRegion eq_region;
+    const EqRegion* eq = nullptr;  // the equiangular strategy's region (null: off)
+    int channel = 0;               // per channel: the sample's sampling channel
+    // A light subpath is traced with probability light_probability_; it starts in the emitting
+    // volume with probability q_volume_share, at a light otherwise (both kinds: one half each);
+    // every density of a light subpath's start carries both.
+    const bool has_volume = kEmissive && sc.select_emission(0.5f) >= 0;
+    // Both carry the light subpath's expected count (THEORY 5.9): a start density times it is the
+    // density of a light subpath starting there per sample.
+    const float q_volume_share = has_volume ? (sc.lights.has_emitters() ? 0.5f : 1.f) : 0.f;
+    const float q_volume = est.light_probability_ * q_volume_share;
+    const float q_lights = est.light_probability_ * (1.f - q_volume_share);
+    // The segment technique (THEORY 5.7 in 5.5): with null-scattering MIS (directional MIS has no
+    // distance pdfs to weigh it against tracking by) in emitting media, the option on.
+    const bool seg_on = kEmissive && Mis::null_pdfs && est.kernels_.options().emission_along_segments;
+    const float seg_count = est.kernels_.options().emission_segment_count;
+    const float nee_count = est.kernels_.options().nee_count;
+
+    // The subpaths' lengths, and what the strategies need of the light subpath's start.
+    int nc = 0;
+    int nl = 0;
+    float nee_y0 = 0.f;         // NEE's density of y_0 from y_1 (with its count at a light)
+    float eq_nee_y0 = 0.f;      // the same without the count (the equiangular strategy's; 0 in the volume)
+    float emit_y0 = 0.f;        // the light subpath's density of y_0
+    bool volume_start = true;  // y_0 lies in the emitting volume (else on a light)
+    // The segment technique's density of y_0 (in the volume) drawn from y_1, without y_1's
+    // direction density (which depends on where x_2 is), and y_1's from y_2 (s >= 3).
+    P seg_y0_unit = bdpt::broadcast<P>(0.f);
+    FirstSegment<Sc> first_segment;
+
+    BdptSample(const BdptEstimator& e, const Sc& scene, const Cam* c, const typename Sc::Spectral::Wavelengths& lam,
+               R& r, C& cnt, Splat& spl, Observe& obs, V* camera_vertices, V* light_vertices)
+        : est(e), sc(scene), cam(c), lambda(lam), rng(r), counter(cnt), splat(spl), observe(obs),
+          camera(camera_vertices), light(light_vertices) {
+        pdfs.light_tracing = kLightTracing;
+        // The equiangular strategy: with null-scattering MIS (directional MIS has no distance pdfs
+        // to weigh it against tracking by), the option on, a light with a target and a medium.
+        if constexpr (Mis::null_pdfs) {
+            for (int k = 0; k < sc.lights.equiangular_count(); ++k)
+                if (sc.lights.equiangular_is_delta(k)) eq_region.total += sc.lights.equiangular_pmf(k);
+            if (est.kernels_.options().bdpt_equiangular && eq_region.total > 0.f && !sc.media.empty()) {
+                eq_region.box = sc.media[0].medium.bounds();
+                for (const auto& m : sc.media) {
+                    const Box b = m.medium.bounds();
+                    eq_region.box.lo = glm::min(eq_region.box.lo, b.lo);
+                    eq_region.box.hi = glm::max(eq_region.box.hi, b.hi);
+                }
+                eq = &eq_region;
+            }
+        }
+        // Per channel: the sample's sampling channel, chosen uniformly (THEORY 5.3). Its light
+        // subpath, connections and splats use the same channel, so the one-sample weights of every
+        // pixel's strategies share one denominator.
+        if constexpr (kPerChannel) {
+            constexpr int kChannels = int(Spectrum::SizeAtCompileTime);
+            channel = std::min(int(rng.uniform() * float(kChannels)), kChannels - 1);
+            pdfs.channel = channel;
+        }
+    }
+    BdptSample(const BdptSample&) = delete;
+    BdptSample& operator=(const BdptSample&) = delete;
+
+    /// The sample's estimate: L, or 0 and Status::NonFinite where it is not finite.
+    RadianceSample<typename Sc::Spectral> result() const {
+        if (!all_finite(L)) return {Spectrum::Zero(), Status::NonFinite};
+        return {L, status};
+    }
+
+    // ---- The path's densities and the estimate ------------------------------------------------
+
+    /// The equiangular strategy's density of `to` drawn from `from` with direction pdf pdf_dir
+    /// there (0 off, and where `to` is no medium vertex).
+    P eq_from(const Vec3& from, float pdf_dir, const V& to) const {
+        using namespace bdpt;
+        if (!eq || to.kind != VertexKind::Medium) return broadcast<P>(0.f);
+        const Vec3 d = to.p - from;
+        const float len = glm::length(d);
+        if (!(len > 0.f)) return broadcast<P>(0.f);
+        return broadcast<P>(to_vertex_measure(pdf_dir, from, to) * eq->density(sc, from, d / len, len));
+    }
+
+    /// The weight of strategy s for the path in p (per channel: its factor of the sampling
+    /// channel's throughput).
+    auto weight_of(const PathPdfsT& p, int s) const {
+        using namespace bdpt;
+        if constexpr (kPerChannel) return channel_strategy_weight(est.kernels_.heuristic(), p, s);
+        else return strategy_weight(est.kernels_.heuristic(), p, s);
+    }
+
+    /// The segment technique's density of x_0 = y drawn from x_1 on y's piece: the direction
+    /// density at x_1 in y's measure (g), the nulls of the pieces before y's, p_V(y) / W with W the
+    /// normaliser `along`.
+    P seg_density(float g, const P& nulls_before, float p_v, float along) const {
+        using namespace bdpt;
+        if (!seg_on) return broadcast<P>(0.f);
+        return nulls_before * (g * segment_density(est.kernels_.options(), p_v, along));
+    }
+
+    /// A BdptRecorder (NeeCountLearner) sees every strategy's contribution with the path's pdfs
+    /// summed by count group: s = 0 (and NEE toward the volume, `volume_x0`) at count 1, NEE toward
+    /// a light at nee_count, s >= 2 and t = 1 at the light subpath probability (THEORY 5.9).
+    /// Per channel the sums run over channels x strategies, each channel's weighed by its
+    /// selection probability (the one-sample denominator, THEORY 5.3 with 5.9).
+    void record(int s, const Spectrum& f, const PathPdfsT& p, bool volume_x0, bool splatted) {
+        using namespace bdpt;
+        if constexpr (BdptRecorder<C>) {
+            const int n = strategy_count(p);
+            double p_fixed = 0.0, p_nee = 0.0, p_light = 0.0, own = 0.0;
+            auto add_group = [&](const double* q, double selection) {
+                // The equiangular strategy (count 1) and the segment technique (its own count).
+                p_fixed += selection * (q[0] + q[kEq] + q[kSeg]);
+                if (n > 1) (volume_x0 ? p_fixed : p_nee) += selection * q[1];
+                for (int r = 2; r < n; ++r) p_light += selection * q[r];
+            };
+            if constexpr (kPerChannel) {
+                constexpr int kChannels = int(Spectrum::SizeAtCompileTime);
+                double q[kChannels * PathPdfsT::kSlots];
+                if (!channel_strategy_pdfs(p, q)) return;
+                for (int ch = 0; ch < kChannels; ++ch) add_group(q + ch * PathPdfsT::kSlots, 1.0 / kChannels);
+                own = q[p.channel * PathPdfsT::kSlots + s];
+            } else {
+                double q[PathPdfsT::kSlots];
+                if (!strategy_pdfs(p, q)) return;
+                add_group(q, 1.0);
+                own = q[s];
+            }
+            const BdptTechnique group = s == 0 || s == kEq || s == kSeg ? BdptTechnique::Fixed
+                                        : s == 1 ? (volume_x0 ? BdptTechnique::Fixed : BdptTechnique::Nee)
+                                                 : BdptTechnique::Light;
+            detail::record_bdpt(counter, float(double(f.mean()) * own), float(p_fixed),
+                                float(p_nee / double(nee_count)), float(p_light / double(est.light_probability_)),
+                                nee_count, est.light_probability_, group,
+                                splatted);
+        } else {
+            (void)s, (void)f, (void)p, (void)volume_x0, (void)splatted;
+        }
+    }
+
+    /// Adds strategy s's contribution f (t camera vertices, x_0 at `x0`) to L with its weight.
+    void add(int s, int t, const Spectrum& f, const PathPdfsT& p, const Vec3& x0, bool x0_at_infinity = false,
+             bool volume_x0 = false) {
+        using namespace bdpt;
+        const float w = weight_of(p, s);
+        record(s, f, p, volume_x0, false);
+        // The equiangular strategy's vertices are s = 1's, the segment technique's s = 0's.
+        const int sv = s == kEq ? 1 : s == kSeg ? 0 : s;
+        observe(s, t, f, w, p,
+                PathVertices<typename Sc::Spectral, P>{light, sv, camera, sv == 0 ? t - 1 : t, x0, x0_at_infinity});
+        L += f * w;
+    }
+
+    /// The BSDF or phase function at vertex v.
+    auto eval_at(const V& v, const Vec3& wo, const Vec3& wi) const {
+        return eval_vertex(sc, SceneVertex{v.material, v.medium, v.ns}, wo, wi, lambda);
+    }
+
+    /// Fills pdfs with the path of k + 1 vertices made of light[0..s-1] (x_0..x_{s-1}) and
+    /// camera[0..nz-1] (x_k..x_{k-nz+1}) from the subpaths' stored densities; the caller then sets
+    /// x_0's and the densities that its connection changes.
+    void gather(int s, int nz, int k) {
+        using namespace bdpt;
+        pdfs.k = k;
+        pdfs.eq = broadcast<P>(0.f);
+        pdfs.seg = broadcast<P>(0.f);
+        pdfs.eq_nee = 0.f;
+        for (int i = 0; i < s; ++i) {
+            pdfs.from_light[i] = light[i].pdf_fwd;
+            pdfs.from_camera[i] = light[i].pdf_rev;
+            pdfs.connectible[i] = !light[i].delta;
+        }
+        for (int j = 0; j < nz; ++j) {
+            const int i = k - j;
+            pdfs.from_camera[i] = camera[j].pdf_fwd;
+            pdfs.from_light[i] = camera[j].pdf_rev;
+            pdfs.connectible[i] = !camera[j].delta;
+        }
+        pdfs.connectible[0] = true;
+    }
+
+    // ---- Shadow walks -------------------------------------------------------------------------
+
+    /// A shadow ray's (a connection's) transmittance through the scene, ratio-tracked: its
+    /// throughput (per channel f_lambda / p_c*), its nulls' P_n product and, per channel, the
+    /// factor every strategy of the path shares over it (prod mu_bar_c(n_j) Tbar_c).
+    struct Shadow {
+        Status status = Status::Ok;
+        Spectrum tr = Spectrum::Zero();
+        P nulls = bdpt::broadcast<P>(1.f);
+        GammaT gamma = bdpt::unit_gamma<P>();
+    };
+
+    /// One piece of a shadow walk (ratio tracking through one medium), grey or per channel.
+    auto shadow_piece(int m, const Ray& r, float t_max, const Spectrum& f) {
+        const auto& med = sc.media[std::size_t(m)];
+        if constexpr (kPerChannel)
+            return detail::channel_shadow_piece<Ch, A>(med.medium, med.majorant, r, t_max, lambda, channel, f, true, rng,
+                                                       counter);
+        else
+            return (void)f, detail::grey_shadow_piece(est.kernels_, med.medium, med.majorant, r, t_max, lambda, rng,
+                                                      counter);
+    }
+
+    /// The shadow walk along r up to `distance` from medium `start`. `end_medium`, if given,
+    /// receives the medium the ray ends in.
+    Shadow shadow(const Ray& r, float distance, int start, int* end_medium = nullptr) {
+        using namespace bdpt;
+        Shadow out;
+        const auto sh = walk_shadow<P>(sc, r, start, WalkEnd{distance}, pieces());
+        out.status = sh.status;
+        if (sh.status != Status::Ok || !sh.reached) return out;
+        if (end_medium) *end_medium = sh.end_medium;
+        if constexpr (kPerChannel) {
+            // A sampling channel's density below float's range beside another's: its weight is 0.
+            if (!(sh.f != 0.f).any() || !(sh.nee[channel] > 0.f)) return out;
+            out.tr = sh.f / sh.nee[channel];
+            out.nulls = (sh.nee > 0.f).select(sh.uni / sh.nee, 0.f);
+            out.gamma = relative_to_largest<Spectrum>(sh.nee);
+        } else {
+            out.tr = sh.f;
+            out.nulls = Mis::null_pdfs ? sh.uni : 1.f;
+        }
+        return out;
+    }
+
+    /// shadow_piece as the callable walk_shadow takes.
+    auto pieces() {
+        return [this](int m, const Ray& r, float t_max, const Spectrum& f) { return shadow_piece(m, r, t_max, f); };
+    }
+
+    /// A shadow ray toward a point drawn in emitting medium `target` (NEE toward the volume): its
+    /// throughput, nulls and shared factors as `shadow`'s, whether it reached the point inside
+    /// `target`, the point's piece (the point is last.at(t_last)) and, with the segment technique
+    /// on, the P_n of the nulls on the pieces before the point's and the technique's normaliser W
+    /// on the point's piece.
+    struct EmissionShadowT {
+        Status status = Status::Ok;
+        bool reached = false;
+        Spectrum tr = Spectrum::Zero();
+        P nulls = bdpt::broadcast<P>(1.f);
+        P nulls_before = bdpt::broadcast<P>(1.f);
+        GammaT gamma = bdpt::unit_gamma<P>();
+        Ray last{};
+        float t_last = 0.f;
+        float along = 0.f;
+    };
+    EmissionShadowT shadow_to_emission(const Ray& r, float distance, int start, int target) {
+        EmissionShadowT out;
+        if constexpr (!kEmissive) {
+            (void)r, (void)distance, (void)start, (void)target;
+        } else {
+            const auto sh = walk_shadow<P>(sc, r, start, WalkEnd{distance, target, false, seg_on}, pieces());
+            out.status = sh.status;
+            if (sh.status != Status::Ok || !sh.reached || !(sh.f != 0.f).any()) return out;
+            if constexpr (kPerChannel) {
+                if (!(sh.nee[channel] > 0.f)) return out;
+                out.tr = sh.f / sh.nee[channel];
+                out.nulls = (sh.nee > 0.f).select(sh.uni / sh.nee, 0.f);
+                // sh.seg is uni of the pieces before the point's times nee of its own.
+                out.nulls_before = (sh.nee > 0.f).select(sh.seg / sh.nee, 0.f);
+                out.gamma = relative_to_largest<Spectrum>(sh.nee);
+            } else {
+                out.tr = sh.f;
+                out.nulls = Mis::null_pdfs ? sh.uni : 1.f;
+                out.nulls_before = Mis::null_pdfs ? sh.seg : 1.f;
+            }
+            out.reached = true;
+            out.last = sh.last;
+            out.t_last = sh.t_last;
+            out.along = sh.along;
+        }
+        return out;
+    }
+
+    /// Transmittance of a connection a -> b through the scene, with its nulls' P_n product and
+    /// shared factors (its work the light subpath's).
+    Spectrum transmit(const V& a, const V& b, P& nulls, GammaT& gamma) {
+        const Vec3 d = b.p - a.p;
+        const float dist = glm::length(d);
+        if (!(dist > 0.f)) return Spectrum::Zero();
+        const Vec3 w = d / dist;
+        const double before = detail::recorder_work(counter);
+        const Shadow sh = shadow(Ray{a.p, w}, dist, a.medium_toward(w));
+        detail::record_light_walk(counter, before);
+        if (sh.status != Status::Ok) {
+            status = sh.status;
+            return Spectrum::Zero();
+        }
+        nulls = sh.nulls;
+        gamma = sh.gamma;
+        return sh.tr;
+    }
+
+    /// The shared factors of a path made of pieces (per channel), relative to the largest.
+    template <class... G>
+    auto path_gamma(const G&... g) const {
+        if constexpr (kPerChannel) return relative_to_largest<Spectrum>((... * g));
+        else return bdpt::NoGamma{};
+    }
+
+    // ---- The camera subpath and the strategies that run while it is tracked -----------------
+
+    /// Tracks the camera subpath from camera_ray; s = 0 (hit_emitter, emission_collision), the
+    /// equiangular strategy and the segment technique run inside the walk as it goes.
+    void trace_camera_subpath(const Ray& camera_ray) {
+        using namespace bdpt;
+        camera[0] = V{};
+        camera[0].kind = VertexKind::Camera;
+        camera[0].p = camera_ray.o;
+        camera[0].beta = Spectrum::Ones();
+        camera[0].medium = sc.camera_medium;
+        if constexpr (kPerChannel) camera[0].gamma = Spectrum::Ones();
+        float camera_pdf = 0.f;  // the camera's density of the ray's direction (light tracing), else 0
+        if constexpr (kLightTracing) camera_pdf = cam->pdf_dir(camera_ray.d);
+        auto on_hit = [this](V* path, int count, const SurfaceHit& hit, const Ray& ray, const P& nulls,
+                             const Spectrum& beta, const auto& gamma) {
+            hit_emitter(path, count, hit, ray, nulls, beta, gamma);
+        };
+        auto on_segment = [this](V* path, int count, const Ray& ray, int medium, float pdf_dir, const Spectrum& beta) {
+            equiangular(path, count, ray, medium, pdf_dir, beta);
+        };
+        if constexpr (kEmissive) {
+            auto on_emission = [this](const V* path, int count, int medium, const Vec3& y,
+                                      const Coefficients<typename Sc::Spectral>& c, const P& mu_bar, float mu_sample,
+                                      const Spectrum& beta, const P& nulls, float pdf_dir, const auto& gamma,
+                                      const P& nulls_before, float along) {
+                emission_collision(path, count, medium, y, c, mu_bar, mu_sample, beta, nulls, pdf_dir, gamma,
+                                   nulls_before, along);
+            };
+            auto on_piece = [this](V* path, int count, const Ray& ray, int medium, float t_max, float pdf_dir,
+                                   const Spectrum& beta, const P& nulls_before, const auto& gamma) -> float {
+                return segment(path, count, ray, medium, t_max, pdf_dir, beta, nulls_before, gamma);
+            };
+            nc = est.walk(sc, camera, 1, depth + 2, camera_ray, sc.camera_medium, camera_pdf, Spectrum::Ones(), lambda,
+                          channel, rng, counter, on_hit, status, eq, true, on_emission, on_segment, on_piece);
+        } else {
+            nc = est.walk(sc, camera, 1, depth + 2, camera_ray, sc.camera_medium, camera_pdf, Spectrum::Ones(), lambda,
+                          channel, rng, counter, on_hit, status, eq, true, NoEmission{}, on_segment);
+        }
+    }
+
+    /// s = 0: the camera subpath reaches an emitter after camera[0..t-2]; and the lights at
+    /// infinity.
+    template <class G>
+    void hit_emitter(V* path, int count, const SurfaceHit& hit, const Ray& ray, const P& nulls, const Spectrum& beta,
+                     const G& gamma) {
+        const int t = count + 1;  // the emitter is z_{t-1}
+        if (t - 2 > depth) return;
+        const V& z = path[count - 1];  // the vertex the segment left (x_1)
+        if (!hit.found()) {
+            for (const int i : sc.lights.infinite())
+                hit_one_emitter(t, z, hit, ray, nulls, beta, gamma, i, sc.lights.emitted(i, ray.d, lambda), kInf);
+        } else {
+            hit_one_emitter(t, z, hit, ray, nulls, beta, gamma, hit.light, sc.lights.emitted(hit.light, ray.d, lambda),
+                            hit.t);
+        }
+    }
+
+    /// s = 0 for one light: its emission Le toward the camera subpath's vertex z = x_1, at
+    /// distance `dist` (kInf: a light at infinity).
+    template <class G>
+    void hit_one_emitter(int t, const V& z, const SurfaceHit& hit, const Ray& ray, const P& nulls,
+                         const Spectrum& beta, const G& gamma, int light_index, const Spectrum& Le, float dist) {
+        using namespace bdpt;
+        if (!(Le != 0.f).any()) return;
+        const Spectrum f = beta * Le;
+        if constexpr (kPerChannel) pdfs.gamma = gamma;
+        else (void)gamma;
+        if (t == 2) {  // the camera sees the emitter: the only strategy
+            pdfs.k = 1;
+            // Per channel its nulls' P_n,c still weigh the channels; grey, 1 (one strategy).
+            if constexpr (kPerChannel) pdfs.from_camera[0] = nulls;
+            else pdfs.from_camera[0] = 1.f;
+            pdfs.nee = pdfs.emit = 0.f;
+            pdfs.seg = broadcast<P>(0.f);
+            add(0, 2, f, pdfs, std::isfinite(dist) ? hit.p : z.p, !std::isfinite(dist));
+            return;
+        }
+        gather(0, t - 1, t - 1);  // camera[0..t-2]; the emitter is x_0
+        const Vec3 w = ray.d;  // from x_1 toward x_0
+        const float pdf_dir_z = z.kind == VertexKind::Camera ? 0.f : eval_at(z, z.wo, w).pdf;
+        if (std::isfinite(dist)) {
+            const Vec3 d = hit.p - z.p;
+            const float d2 = glm::dot(d, d);
+            const EmissionDensity e = sc.lights.emission_pdf(light_index, hit.p, -w);
+            const float cos0 = std::abs(glm::dot(hit.ng, w));
+            pdfs.from_camera[0] = (z.delta ? 1.f : pdf_dir_z) * cos0 / d2 * nulls;
+            pdfs.emit = q_lights * e.pdf_pos;
+            pdfs.eq_nee = sc.lights.pdf(light_index, z.p, w) * cos0 / d2;
+            pdfs.nee = nee_count * pdfs.eq_nee;
+            pdfs.from_light[1] = to_vertex_measure(e.pdf_dir, hit.p, z) * nulls * z.event;
+        } else {  // x_0 is the direction w; light subpaths (if any) reach z along -w
+            const EmissionDensity e = sc.lights.emission_pdf(light_index, z.p, -w);
+            pdfs.from_camera[0] = (z.delta ? 1.f : pdf_dir_z) * nulls;
+            pdfs.emit = q_lights * e.pdf_pos;
+            pdfs.eq_nee = sc.lights.pdf(light_index, z.p, w);
+            pdfs.nee = nee_count * pdfs.eq_nee;
+            pdfs.from_light[1] = from_infinity_measure(e.pdf_dir, -w, z) * nulls * z.event;
+        }
+        pdfs.eq = z.eq;
+        // z's own density from the light side: from x_1 toward x_2, arriving along -w.
+        if (t >= 4) {
+            const V& z2 = camera[t - 3];  // x_2
+            const float pd = z.delta ? 1.f : eval_at(z, -w, -z.wo).pdf;
+            pdfs.from_light[2] = to_vertex_measure(pd, z.p, z2) * z.nulls_in * z2.event;
+        }
+        add(0, t, f, pdfs, std::isfinite(dist) ? hit.p : z.p, !std::isfinite(dist));
+    }
+
+    /// The densities of the path made of the camera subpath camera[0..count-1] and x_0 = y in
+    /// emitting medium `medium` (the collision estimator's and the segment technique's paths): y
+    /// reached from x_1 = camera[count - 1] with direction density pdf_dir, `nulls` the P_n of
+    /// the segment's nulls before y, `nulls_before` those of the pieces before y's, mu_bar the
+    /// majorant at y, `along` the segment technique's W on y's piece, `gamma` (per channel) the
+    /// shared factors up to y. False where y is x_1 itself (a flight of length 0: no direction).
+    template <class G>
+    bool emission_path_pdfs(int count, int medium, const Vec3& y, const P& nulls, const P& mu_bar, float pdf_dir,
+                            const P& nulls_before, float along, const G& gamma) {
+        using namespace bdpt;
+        if constexpr (!kEmissive) {
+            (void)count, (void)medium, (void)y, (void)nulls, (void)mu_bar, (void)pdf_dir, (void)nulls_before,
+                (void)along, (void)gamma;
+            return false;
+        } else {
+            const float p_y = sc.media[std::size_t(medium)].medium.emission_pdf(y);
+            if constexpr (kPerChannel) pdfs.gamma = gamma;
+            else (void)gamma;
+            const int t = count + 1;
+            if (t == 2) {  // seen from the camera: the collision estimator and the segment technique
+                pdfs.k = 1;
+                // Relative to the camera's density of the ray and 1 / d^2, the same for both.
+                pdfs.from_camera[0] = nulls * mu_bar;
+                pdfs.nee = pdfs.emit = 0.f;
+                pdfs.seg = seg_density(1.f, nulls_before, p_y, along);
+                return true;
+            }
+            const V& z = camera[count - 1];  // x_1
+            const Vec3 d = y - z.p;
+            const float d2 = glm::dot(d, d);
+            if (!(d2 > 0.f)) return false;
+            gather(0, t - 1, t - 1);
+            const float p_v = sc.emission_selection_pdf(medium) * p_y;
+            pdfs.from_camera[0] = pdf_dir / d2 * nulls * mu_bar;
+            pdfs.seg = seg_density(pdf_dir / d2, nulls_before, p_y, along);
+            pdfs.nee = p_v;
+            pdfs.emit = q_volume * p_v;
+            pdfs.from_light[1] = to_vertex_measure(kInv4Pi, y, z) * nulls * z.event;
+            if (t >= 4) {
+                const V& z2 = camera[count - 2];  // x_2
+                const float pd = z.delta ? 1.f : eval_at(z, -(d / std::sqrt(d2)), -z.wo).pdf;
+                pdfs.from_light[2] = to_vertex_measure(pd, z.p, z2) * z.nulls_in * z2.event;
+            }
+            return true;
+        }
+    }
+
+    /// s = 0 in an emissive medium: the camera subpath's tentative collision at y, after
+    /// camera[0..count-1], collects mu_a L_e / mu_bar (the collision estimator); as a path ending
+    /// at y its camera-side density is the direction pdf / d^2 x the nulls' P_n x mu_bar(y).
+    /// `mu_bar` the majorant at y (per channel: every channel's), `mu_sample` the sampling
+    /// channel's, `beta` the throughput up to y over the density of reaching it, `gamma` (per
+    /// channel) the shared factors up to y, `nulls_before` the nulls' P_n on the segment's pieces
+    /// before y's and `along` the segment technique's normaliser on y's piece.
+    template <class G>
+    void emission_collision(const V* path, int count, int medium, const Vec3& y,
+                            const Coefficients<typename Sc::Spectral>& c, const P& mu_bar, float mu_sample,
+                            const Spectrum& beta, const P& nulls, float pdf_dir, const G& gamma, const P& nulls_before,
+                            float along) {
+        if constexpr (kEmissive) {
+            const int t = count + 1;
+            if (t - 2 > depth || !(c.sigma_a > 0.f).any() || !(mu_sample > 0.f)) return;
+            const auto& m = sc.media[std::size_t(medium)].medium;
+            const Spectrum le = m.emission(y, lambda);
+            if (!(le > 0.f).any()) return;
+            const Spectrum f = beta * c.sigma_a * le / mu_sample;
+            (void)path;  // camera[], which emission_path_pdfs reads
+            if (emission_path_pdfs(count, medium, y, nulls, mu_bar, pdf_dir, nulls_before, along, gamma))
+                add(0, t, f, pdfs, y, false, true);
+        } else {
+            (void)path, (void)count, (void)medium, (void)y, (void)c, (void)mu_bar, (void)mu_sample, (void)beta,
+                (void)nulls, (void)pdf_dir, (void)gamma, (void)nulls_before, (void)along;
+        }
+    }
+
+    /// The equiangular strategy (THEORY 5.4 in 5.5) on the camera segment from z = path[count - 1]
+    /// along `ray` (in `medium`, throughput `beta` past z's direction sample): x drawn on the ray's
+    /// part in the media's box by equiangular sampling toward the lights' targets, the nulls before
+    /// it ratio-tracked, stored as z_t-1 = path[count] (the walk writes its own next vertex there
+    /// afterwards) and connected to the lights by NEE.
+    void equiangular(V* path, int count, const Ray& ray, int medium, float pdf_dir, const Spectrum& beta) {
+        using namespace bdpt;
+        const int t = count + 1;
+        if (!eq || t - 1 > depth) return;
+        const V& z = path[count - 1];
+        const Interval in = eq->box.clip(ray, 0.f, kInf);
+        if (in.empty()) return;
+        const float u_pick = rng.uniform(), u = rng.uniform();
+        const DistanceSample ds = eq->sample(sc, ray, in, u_pick, u);
+        if (!(ds.pdf > 0.f && ds.t > 0.f)) return;
+        const double before = detail::recorder_work(counter);
+        int at = -1;
+        const Shadow sh = shadow(ray, ds.t, medium, &at);
+        detail::record_shadow_walk(counter, before, false);
+        if (sh.status != Status::Ok) status = sh.status;
+        if (sh.status != Status::Ok || !(sh.tr != 0.f).any() || !sc.has_medium(at)) return;
+        const auto& m = sc.media[std::size_t(at)];
+        const auto c = detail::lookup_untracked(m.medium, m.majorant, ray, ds.t, lambda, counter);
+        if (!c) {
+            status = Status::Rejected;
+            return;
+        }
+        if (!(c->k.sigma_s > 0.f).any()) return;
+        V& x = path[count];
+        x = V{};
+        x.kind = VertexKind::Medium;
+        x.p = ray.at(ds.t);
+        x.medium = at;
+        x.wo = ray.d;
+        x.beta = beta * sh.tr * c->k.sigma_s / ds.pdf;
+        x.nulls_in = sh.nulls;
+        // Tracking's event density mu_bar P_s at x (per channel, every channel's).
+        if constexpr (kPerChannel)
+            x.event = channel_event_densities<A, typename Sc::Spectral>(c->k, majorants<P>(c->mu)).scatter;
+        else
+            x.event = c->mu * event_probabilities<A>(c->k, c->mu).scatter;
+        const float pd = z.kind == VertexKind::Camera && !(pdf_dir > 0.f) ? 1.f : pdf_dir;  // as the walk's
+        const float g = to_vertex_measure(pd, z.p, x);
+        x.pdf_fwd = g * sh.nulls * x.event;
+        x.eq = broadcast<P>(g * ds.pdf);
+        if constexpr (kPerChannel) x.gamma = path_gamma(z.gamma, sh.gamma);
+        if ((x.beta != 0.f).any()) light_nee(t, true);
+    }
+
+    /// The segment technique (THEORY 5.7 in 5.5) on a camera segment's piece in emitting medium
+    /// `medium` (from z = path[count - 1] along `ray` up to t_max; `pdf_dir` z's direction density,
+    /// `beta` the throughput at the piece's start, `nulls_before` the P_n of the segment's nulls
+    /// before it, `gamma` the shared factors up to it): x_0 drawn in proportion to the medium's
+    /// power grid along the piece (with the count EstimatorOptions::emission_segment_count), the
+    /// nulls before it ratio-tracked, mu_a L_e collected there. Returns the piece's normaliser W,
+    /// which the collision estimator's weights on the piece need (0: the technique does not run).
+    template <class G>
+    float segment(V* path, int count, const Ray& ray, int medium, float t_max, float pdf_dir, const Spectrum& beta,
+                  const P& nulls_before, const G& gamma) {
+        using namespace bdpt;
+        if constexpr (kEmissive) {
+            (void)path;  // camera[], which emission_path_pdfs reads
+            const int t = count + 1;
+            if (!seg_on || t - 2 > depth) return 0.f;
+            const auto& m = sc.media[std::size_t(medium)];
+            const float along = m.medium.emission_along(ray, 0.f, t_max);
+            if (!(along > 0.f) || !draw_technique(seg_count, rng)) return along;
+            // Its work is a fixed technique's to the learner: it runs whatever the learned counts.
+            const double before = detail::recorder_work(counter);
+            const DistanceSample ds = m.medium.sample_emission_along(ray, 0.f, t_max, along, rng.uniform());
+            if (!(ds.pdf > 0.f && ds.t > 0.f)) return along;
+            const Shadow sh = shadow(ray, ds.t, medium);
+            if (sh.status != Status::Ok) status = sh.status;
+            const auto c = sh.status == Status::Ok && (sh.tr != 0.f).any()
+                               ? detail::lookup_untracked(m.medium, m.majorant, ray, ds.t, lambda, counter)
+                               : std::nullopt;
+            detail::record_shadow_walk(counter, before, false);
+            if (sh.status != Status::Ok || !(sh.tr != 0.f).any()) return along;
+            if (!c) {
+                status = Status::Rejected;
+                return along;
+            }
+            if (!(c->k.sigma_a > 0.f).any()) return along;
+            const Vec3 y = ray.at(ds.t);
+            const Spectrum le = m.medium.emission(y, lambda);
+            if (!(le > 0.f).any()) return along;
+            const Spectrum f = beta * sh.tr * c->k.sigma_a * le / (seg_count * ds.pdf);
+            if (emission_path_pdfs(count, medium, y, P(nulls_before * sh.nulls), majorants<P>(c->mu), pdf_dir,
+                                   nulls_before, along, path_gamma(gamma, sh.gamma)))
+                add(kSeg, t, f, pdfs, y, false, true);
+            return along;
+        } else {
+            (void)path, (void)count, (void)ray, (void)medium, (void)t_max, (void)pdf_dir, (void)beta,
+                (void)nulls_before, (void)gamma;
+            return 0.f;
+        }
+    }
+
+    // ---- s = 1: next-event estimation -------------------------------------------------------
+
+    /// s = 1 from camera vertex z = camera[t - 1] toward the lights (THEORY 5.9: drawn with the
+    /// NEE count), or, `from_eq`, the equiangular strategy's NEE from its vertex there, which
+    /// always runs: no count.
+    void light_nee(int t, bool from_eq) {
+        using namespace bdpt;
+        const V& z = camera[t - 1];
+        const float count = from_eq ? 1.f : nee_count;
+        const double before = detail::recorder_work(counter);
+        const float u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
+        const SampledLight<typename Sc::Spectral> ls = sc.lights.sample(z.p, u0, u1, u2, lambda);
+        if (!(ls.sample.pdf > 0.f)) return;
+        const Vec3 w = ls.sample.wi;
+        const auto fz = eval_at(z, z.wo, w);
+        if (!(fz.value != 0.f).any()) return;
+        V y0;
+        y0.kind = VertexKind::Light;
+        y0.delta_position = ls.sample.delta;
+        const bool at_infinity = !std::isfinite(ls.sample.distance);
+        y0.p = at_infinity ? z.p : z.p + ls.sample.distance * w;
+        const Shadow sh = shadow(Ray{z.p, w}, ls.sample.distance, z.medium_toward(w));
+        detail::record_shadow_walk(counter, before, !from_eq);
+        if (sh.status != Status::Ok) status = sh.status;
+        if (sh.status != Status::Ok || !(sh.tr != 0.f).any()) return;
+        const P& nulls = sh.nulls;
+        const Spectrum f = z.beta * fz.value * sh.tr * ls.sample.radiance / (count * ls.sample.pdf);
+        gather(0, t, t);  // camera[0..t-1]; the light point is x_0
+        if constexpr (kPerChannel) pdfs.gamma = path_gamma(z.gamma, sh.gamma);
+        const float d2 = ls.sample.distance * ls.sample.distance;
+        if (ls.sample.delta) {  // a point or directional light: no path hits it
+            pdfs.from_camera[0] = broadcast<P>(0.f);
+            pdfs.eq_nee = ls.sample.pdf;
+            // Light subpaths from a directional light (given a BoundingSphere) start on the
+            // sphere's disk: pdf_pos its delta, pdf_dir per area across w.
+            const EmissionDensity e = sc.lights.emission_pdf(ls.light, at_infinity ? z.p : y0.p, -w);
+            pdfs.emit = q_lights * e.pdf_pos;
+            pdfs.from_light[1] = (at_infinity ? from_infinity_measure(e.pdf_dir, -w, z)
+                                              : to_vertex_measure(e.pdf_dir, y0.p, z)) *
+                                 nulls * z.event;
+        } else if (at_infinity) {
+            const EmissionDensity e = sc.lights.emission_pdf(ls.light, z.p, -w);
+            pdfs.from_camera[0] = fz.pdf * nulls;
+            pdfs.eq_nee = ls.sample.pdf;
+            pdfs.emit = q_lights * e.pdf_pos;
+            pdfs.from_light[1] = from_infinity_measure(e.pdf_dir, -w, z) * nulls * z.event;
+        } else {
+            const EmissionDensity e = sc.lights.emission_pdf(ls.light, y0.p, -w);
+            pdfs.from_camera[0] = fz.pdf * e.cos / d2 * nulls;
+            pdfs.eq_nee = ls.sample.pdf * e.cos / d2;
+            pdfs.emit = q_lights * e.pdf_pos;
+            pdfs.from_light[1] = to_vertex_measure(e.pdf_dir, y0.p, z) * nulls * z.event;
+        }
+        pdfs.nee = nee_count * pdfs.eq_nee;
+        pdfs.eq = z.eq;
+        if (t >= 3) {
+            const V& z2 = camera[t - 2];
+            pdfs.from_light[2] = to_vertex_measure(eval_at(z, w * -1.f, -z.wo).pdf, z.p, z2) * z.nulls_in * z2.event;
+        }
+        add(from_eq ? kEq : 1, t, f, pdfs, y0.p, at_infinity);
+    }
+
+    /// s = 1 toward the emitting volume (THEORY 5.7) from camera vertex z = camera[t - 1]: a point
+    /// drawn by the power grids, the shadow walk through every medium up to it.
+    void volume_nee(int t) {
+        using namespace bdpt;
+        if constexpr (kEmissive) {
+            const V& z = camera[t - 1];
+            if (!has_volume) return;
+            const auto e = detail::draw_emission_point(sc, z.p, rng);
+            if (!e) return;
+            const auto& m = sc.media[std::size_t(e->index)];
+            const auto fz = eval_at(z, z.wo, e->wi);
+            if (!(fz.value != 0.f).any()) return;
+            const EmissionShadowT sh = shadow_to_emission(Ray{z.p, e->wi}, e->dist, z.medium_toward(e->wi), e->index);
+            if (sh.status != Status::Ok) status = sh.status;
+            if (!(sh.status == Status::Ok && sh.reached && (sh.tr != 0.f).any())) return;
+            const auto c = detail::lookup_untracked(m.medium, m.majorant, sh.last, sh.t_last, lambda, counter);
+            if (!c) {
+                status = Status::Rejected;
+                return;
+            }
+            if (!((c->k.sigma_a > 0.f).any() && majorant_at(c->mu, channel) > 0.f)) return;
+            const float p_v = e->select * e->y.pdf;
+            const Spectrum f =
+                z.beta * fz.value * sh.tr * c->k.sigma_a * m.medium.emission(e->y.p, lambda) / (e->dist2 * p_v);
+            const P& nulls = sh.nulls;
+            gather(0, t, t);  // camera[0..t-1]; the emission point is x_0
+            if constexpr (kPerChannel) pdfs.gamma = path_gamma(z.gamma, sh.gamma);
+            pdfs.from_camera[0] = fz.pdf / e->dist2 * nulls * majorants<P>(c->mu);
+            pdfs.seg = seg_density(fz.pdf / e->dist2, sh.nulls_before, e->y.pdf, sh.along);
+            pdfs.nee = p_v;
+            pdfs.emit = q_volume * p_v;
+            pdfs.from_light[1] = to_vertex_measure(kInv4Pi, e->y.p, z) * nulls * z.event;
+            if (t >= 3) {
+                const V& z2 = camera[t - 2];
+                pdfs.from_light[2] =
+                    to_vertex_measure(eval_at(z, -e->wi, -z.wo).pdf, z.p, z2) * z.nulls_in * z2.event;
+            }
+            add(1, t, f, pdfs, e->y.p, false, true);
+        } else {
+            (void)t;
+        }
+    }
+
+    // ---- The light subpath and the strategies that use it -----------------------------------
+
+    /// The light subpath, traced with probability light_probability_ (THEORY 5.9): from the
+    /// emitting volume (light_from_volume) or from a light (light_from_emitter).
+    void trace_light_subpath() {
+        const int light_vertices = kLightTracing ? depth + 1 : depth;
+        const bool traced = draw_technique(est.light_probability_, rng);
+        const double light_work_before = detail::recorder_work(counter);
+        if (traced && depth >= (kLightTracing ? 1 : 2)) {
+            const float uq = q_volume_share > 0.f && q_volume_share < 1.f ? rng.uniform() : 0.f;
+            if (q_volume_share > 0.f && uq < q_volume_share) light_from_volume(light_vertices);
+            else light_from_emitter(light_vertices);
+        }
+        if (traced) detail::record_light_walk(counter, light_work_before);
+    }
+
+    /// A light subpath of at most light_vertices vertices from a point y_0 drawn in the emitting
+    /// volume by the media's power, with y_0's densities for NEE and the segment technique.
+    void light_from_volume(int light_vertices) {
+        using namespace bdpt;
+        if constexpr (kEmissive) {
+            const float us = rng.uniform(), u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform(),
+                        u3 = rng.uniform(), u4 = rng.uniform(), u5 = rng.uniform();
+            const int i = sc.select_emission(us);
+            const float select = sc.emission_selection_pdf(i);
+            const auto& m = sc.media[std::size_t(i)];
+            const VolumeSample yv = m.medium.sample_emission(u0, u1, u2, u3);
+            const Vec3 w = uniform_sphere(u4, u5);
+            // The point counts only inside medium i's surfaces: the first boundary ahead of it
+            // must be one it leaves medium i through (as the camera side's NEE walk checks).
+            const int start = light_start_medium(sc, yv.p, w);
+            if (start == -3) status = Status::InvalidInput;
+            const bool inside = start == i;
+            if (!(i >= 0 && select > 0.f && yv.pdf > 0.f && inside)) return;
+            const auto c = detail::lookup_untracked(m.medium, m.majorant, Ray{yv.p, w}, 0.f, lambda, counter);
+            if (!c) {
+                status = Status::Rejected;
+                return;
+            }
+            if (!((c->k.sigma_a > 0.f).any() && majorant_at(c->mu, channel) > 0.f)) return;
+            const Spectrum source = c->k.sigma_a * m.medium.emission(yv.p, lambda);
+            if (!(source > 0.f).any()) return;
+            V& y0 = light[0] = V{};
+            y0.kind = VertexKind::Medium;
+            y0.p = yv.p;
+            y0.medium = i;
+            y0.event = majorants<P>(c->mu);  // a tentative collision's density there: mu_bar
+            if constexpr (kPerChannel) y0.gamma = Spectrum::Ones();
+            emit_y0 = q_volume * select * yv.pdf;
+            y0.pdf_fwd = broadcast<P>(emit_y0);
+            y0.beta = source / emit_y0;
+            nl = est.walk(sc, light, 1, light_vertices, Ray{yv.p, w}, i, kInv4Pi, Spectrum(y0.beta * (4.f * kPi)),
+                          lambda, channel, rng, counter, [](auto&&...) {}, status, eq, false, NoEmission{},
+                          NoSegment{}, NoSegment{}, seg_on ? &first_segment : nullptr);
+            nee_y0 = select * yv.pdf;
+            if (seg_on && nl >= 2) {
+                // y_0's piece seen from y_1: from the last surface between them (the walk's first
+                // piece's end, else y_1) through y_0 to the first surface beyond it.
+                const float dist = glm::length(light[1].p - yv.p);
+                const SurfaceHit behind = sc.geometry.intersect(Ray{yv.p, -w}, kInf);
+                if (!detail::usable_hit(sc, behind)) {
+                    status = Status::InvalidInput;
+                } else {
+                    const float a = std::min(first_segment.first_piece_end, dist);
+                    const float b = behind.found() ? behind.t : kInf;
+                    const float along = m.medium.emission_along(Ray{yv.p + a * w, -w}, 0.f, a + b);
+                    seg_y0_unit = seg_density(1.f, first_segment.later_nulls, yv.pdf, along);
+                }
+            }
+        } else {
+            (void)light_vertices;
+        }
+    }
+
+    /// A light subpath of at most light_vertices vertices from a light's emission sample, with
+    /// y_0's densities for NEE (and the equiangular strategy's NEE).
+    void light_from_emitter(int light_vertices) {
+        using namespace bdpt;
+        const float u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform(), u3 = rng.uniform(),
+                    u4 = rng.uniform();
+        volume_start = false;
+        const EmittedLight<typename Sc::Spectral> e = sc.lights.sample_emission(u0, u1, u2, u3, u4, lambda);
+        if (!(e.emission.pdf_pos > 0.f && e.emission.pdf_dir > 0.f && (e.emission.radiance != 0.f).any())) return;
+        V& y0 = light[0] = V{};
+        y0.kind = VertexKind::Light;
+        y0.p = e.emission.p;
+        y0.ng = y0.ns = e.emission.n;
+        y0.light = e.light;
+        y0.delta_position = e.emission.delta_position;
+        y0.at_infinity = e.emission.at_infinity;
+        emit_y0 = q_lights * e.emission.pdf_pos;
+        y0.pdf_fwd = broadcast<P>(emit_y0);
+        y0.beta = e.emission.radiance / (q_lights * e.emission.pdf_pos);
+        if constexpr (kPerChannel) y0.gamma = Spectrum::Ones();
+        const int start = light_start_medium(sc, e.emission.p, e.emission.w);
+        if (start == -3) status = Status::InvalidInput;
+        else
+            nl = est.walk(sc, light, 1, light_vertices, Ray{e.emission.p, e.emission.w}, start, e.emission.pdf_dir,
+                          Spectrum(y0.beta * (e.emission.cos / e.emission.pdf_dir)), lambda, channel, rng, counter,
+                          [](auto&&...) {}, status, eq, false);
+        if (nl >= 2) {
+            const Vec3 d = y0.p - light[1].p;
+            const float d2 = glm::dot(d, d);
+            eq_nee_y0 = y0.delta_position ? sc.lights.selection_pdf(y0.light)  // a point or a direction
+                        : y0.at_infinity  ? sc.lights.pdf(y0.light, light[1].p, -e.emission.w)  // solid angle
+                                            : sc.lights.pdf(y0.light, light[1].p, d / std::sqrt(d2)) *
+                                                  std::abs(glm::dot(y0.ng, d)) / (d2 * std::sqrt(d2));
+            nee_y0 = nee_count * eq_nee_y0;
+        }
+    }
+
+    /// s >= 2: connects every light vertex y = y_{s-1} to camera vertex z = camera[t - 1].
+    void connect(int t) {
+        using namespace bdpt;
+        const V& z = camera[t - 1];
+        for (int s = 2; s <= nl && s + t - 2 <= depth; ++s) {
+            const V& y = light[s - 1];
+            if (y.delta) continue;
+            const Vec3 d = z.p - y.p;
+            const float d2 = glm::dot(d, d);
+            if (!(d2 > 0.f)) continue;
+            const Vec3 w = d / std::sqrt(d2);
+            const auto fy = eval_at(y, y.wo, w);
+            if (!(fy.value != 0.f).any()) continue;
+            const auto fz = eval_at(z, z.wo, -w);
+            if (!(fz.value != 0.f).any()) continue;
+            P nulls = broadcast<P>(1.f);
+            GammaT gamma = unit_gamma<P>();
+            const Spectrum tr = transmit(y, z, nulls, gamma);
+            if (!(tr != 0.f).any()) continue;
+            const Spectrum f = y.beta * fy.value * tr * fz.value * z.beta / d2;
+            gather(s, t, s + t - 1);
+            if constexpr (kPerChannel) pdfs.gamma = path_gamma(y.gamma, gamma, z.gamma);
+            pdfs.emit = emit_y0;
+            pdfs.nee = nee_y0;
+            // The four densities the connection changes.
+            pdfs.from_light[s] = to_vertex_measure(fy.pdf, y.p, z) * nulls * z.event;
+            pdfs.from_camera[s - 1] = to_vertex_measure(fz.pdf, z.p, y) * nulls * y.event;
+            if (t >= 3) {
+                const V& z2 = camera[t - 2];
+                pdfs.from_light[s + 1] = to_vertex_measure(eval_at(z, w, -z.wo).pdf, z.p, z2) * z.nulls_in * z2.event;
+            }
+            const V& y2 = light[s - 2];
+            const float pd_y2 = eval_at(y, -w, -y.wo).pdf;
+            pdfs.from_camera[s - 2] = to_vertex_measure(pd_y2, y.p, y2) * y.nulls_in * y2.event;
+            // x_1 = y_1 as the equiangular strategy draws it, from x_2 (z, y_2 toward the connection,
+            // or y_2 as its light subpath stored).
+            pdfs.eq_nee = eq_nee_y0;
+            pdfs.eq = s == 2 ? eq_from(z.p, fz.pdf, y) : s == 3 ? eq_from(y.p, pd_y2, y2) : light[1].eq;
+            // x_0 = y_0 as the segment technique draws it from x_1 = y_1, arriving there from x_2
+            // (z, or y_2 as the light subpath drew it).
+            pdfs.seg = seg_y0_unit * (s == 2 ? to_vertex_measure(pd_y2, y.p, y2) : first_segment.y0_reverse);
+            add(s, t, f, pdfs, light[0].p, light[0].at_infinity, volume_start);
+        }
+    }
+
+    /// t = 1 (light tracing): every light vertex y = y_{s-1} seen by the camera, splatted where it
+    /// appears on the image.
+    void light_trace() {
+        using namespace bdpt;
+        if constexpr (kLightTracing) {
+            const Vec3 eye = cam->position();
+            for (int s = 2; s <= nl && s - 1 <= depth; ++s) {
+                const V& y = light[s - 1];
+                if (y.delta) continue;
+                const Vec3 d = eye - y.p;
+                const float d2 = glm::dot(d, d);
+                if (!(d2 > 0.f)) continue;
+                const Vec3 w = d / std::sqrt(d2);  // from y toward the camera
+                float u = 0.f, v = 0.f;
+                const float pc = cam->pdf_dir(-w);
+                if (!(pc > 0.f) || !cam->raster(-w, u, v)) continue;
+                const auto fy = eval_at(y, y.wo, w);
+                if (!(fy.value != 0.f).any()) continue;
+                V eye_vertex;
+                eye_vertex.p = eye;
+                P nulls = broadcast<P>(1.f);
+                GammaT gamma = unit_gamma<P>();
+                const Spectrum tr = transmit(y, eye_vertex, nulls, gamma);
+                if (!(tr != 0.f).any()) continue;
+                const Spectrum f = y.beta * fy.value * tr * (pc / d2);
+                gather(s, 0, s);
+                if constexpr (kPerChannel) pdfs.gamma = path_gamma(y.gamma, gamma);
+                pdfs.emit = emit_y0;
+                pdfs.nee = nee_y0;
+                pdfs.from_camera[s - 1] = to_vertex_measure(pc, eye, y) * nulls * y.event;
+                const V& y2 = light[s - 2];
+                const float pd_y2 = eval_at(y, -w, -y.wo).pdf;
+                pdfs.from_camera[s - 2] = to_vertex_measure(pd_y2, y.p, y2) * y.nulls_in * y2.event;
+                pdfs.eq_nee = eq_nee_y0;
+                pdfs.eq = s == 2 ? eq_from(eye, pc, y) : s == 3 ? eq_from(y.p, pd_y2, y2) : light[1].eq;
+                pdfs.seg = seg_y0_unit * (s == 2 ? to_vertex_measure(pd_y2, y.p, y2) : first_segment.y0_reverse);
+                const float wt = weight_of(pdfs, s);
+                record(s, f, pdfs, volume_start, true);
+                observe(s, 1, f, wt, pdfs,
+                        PathVertices<typename Sc::Spectral, P>{light, s, camera, 1, light[0].p, light[0].at_infinity});
+                const Spectrum value = f * wt;
+                if (all_finite(value)) splat(u, v, value);
+                else status = Status::NonFinite;
+            }
+        }
+    }
+};
+
+}  // namespace nsp
