@@ -20,9 +20,10 @@ namespace nsp {
 /// light sampling cannot reach the path). Returns a failed walk's status (NonFinite: an overflowed
 /// flight, the caller discards the path).
 template <class State, class Sc, class StartMedium, UniformRng R, LookupCounter C>
-[[gnu::always_inline]] inline Status light_nee(const State& st, const Sc& sc, const SceneVertex& v, const Vec3& x, const Vec3& wo,
-                 const VertexRecord<typename State::P, typename Sc::Spectral>& x_rec, StartMedium&& start_medium,
-                 const typename Sc::Spectral::Wavelengths& lambda, R& rng, C& counter, typename Sc::Spectrum& L) {
+[[gnu::always_inline]] inline Status light_nee(
+    const State& st, const Sc& sc, const SceneVertex& v, const Vec3& x, const Vec3& wo,
+    const VertexRecord<typename State::P, typename Sc::Spectral>& x_rec, StartMedium&& start_medium,
+    const typename Sc::Spectral::Wavelengths& lambda, R& rng, C& counter, typename Sc::Spectrum& L) {
     using P = typename State::P;
     using S = typename Sc::Spectral;
     using Spectrum = typename Sc::Spectrum;

@@ -71,8 +71,9 @@ struct VertexDirection {
 
 /// The value and pdf of direction wi at vertex v for a path that arrived along wo.
 template <class Sc>
-[[gnu::always_inline]] inline VertexDirection<typename Sc::Spectral> eval_vertex(const Sc& sc, const SceneVertex& v, const Vec3& wo, const Vec3& wi,
-                                                   const typename Sc::Spectral::Wavelengths& lambda) noexcept {
+[[gnu::always_inline]] inline VertexDirection<typename Sc::Spectral> eval_vertex(
+    const Sc& sc, const SceneVertex& v, const Vec3& wo, const Vec3& wi,
+    const typename Sc::Spectral::Wavelengths& lambda) noexcept {
     VertexDirection<typename Sc::Spectral> out;
     out.wi = wi;
     if (v.on_surface()) {
@@ -91,8 +92,9 @@ template <class Sc>
 /// The next direction at vertex v from (u1, u2): the BSDF's or the phase function's sample; pdf
 /// 0 when there is none.
 template <class Sc>
-[[gnu::always_inline]] inline VertexDirection<typename Sc::Spectral> sample_vertex(const Sc& sc, const SceneVertex& v, const Vec3& wo, float u1,
-                                                     float u2, const typename Sc::Spectral::Wavelengths& lambda) noexcept {
+[[gnu::always_inline]] inline VertexDirection<typename Sc::Spectral> sample_vertex(
+    const Sc& sc, const SceneVertex& v, const Vec3& wo, float u1, float u2,
+    const typename Sc::Spectral::Wavelengths& lambda) noexcept {
     VertexDirection<typename Sc::Spectral> out;
     if (v.on_surface()) {
         sc.materials.visit(v.material, [&](const auto& b) {
@@ -165,7 +167,8 @@ namespace nsp {
 /// (`end.target`) the end lies in another medium; a failed flight's status, or InvalidInput for a
 /// hit the estimators cannot use.
 template <class P, class Sc, class Piece>
-[[gnu::always_inline]] inline ShadowWalk<P, typename Sc::Spectral> walk_shadow(const Sc& sc, Ray r, int medium, const WalkEnd& end, Piece&& piece) {
+[[gnu::always_inline]] inline ShadowWalk<P, typename Sc::Spectral> walk_shadow(const Sc& sc, Ray r, int medium,
+                                                                                const WalkEnd& end, Piece&& piece) {
     using S = typename Sc::Spectral;
     using Spec = typename S::Spectrum;
     ShadowWalk<P, S> out;
