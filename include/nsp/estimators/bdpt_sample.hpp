@@ -1,7 +1,8 @@
 // nsp/estimators/bdpt_sample.hpp: one sample of BdptEstimator::trace (bdpt.hpp) as named parts:
-// the camera and light subpaths, each strategy family (s = 0 at an emitter and by emission as
+// the state the strategies share, the path's densities, weights and records, the shadow walks and
+// the camera subpath here; each strategy family (s = 0 at an emitter and by emission as
 // collision, the equiangular and segment strategies, NEE toward the lights and the volume, s >= 2
-// connections, light tracing) and the weights, records and shadow walks they share. Included by
+// connections, light tracing) declared here and defined in bdpt_strategies.hpp. Included by
 // bdpt.hpp, after the estimator's declaration.
 #pragma once
 
@@ -383,69 +384,13 @@ struct BdptEstimator<Mis, H, A, MaxDepth, Ch>::BdptSample {
     /// infinity.
     template <class G>
     void hit_emitter(V* path, int count, const SurfaceHit& hit, const Ray& ray, const P& nulls, const Spectrum& beta,
-                     const G& gamma) {
-        const int t = count + 1;  // the emitter is z_{t-1}
-        if (t - 2 > depth) return;
-        const V& z = path[count - 1];  // the vertex the segment left (x_1)
-        if (!hit.found()) {
-            for (const int i : sc.lights.infinite())
-                hit_one_emitter(t, z, hit, ray, nulls, beta, gamma, i, sc.lights.emitted(i, ray.d, lambda), kInf);
-        } else {
-            hit_one_emitter(t, z, hit, ray, nulls, beta, gamma, hit.light, sc.lights.emitted(hit.light, ray.d, lambda),
-                            hit.t);
-        }
-    }
+                     const G& gamma);
 
     /// s = 0 for one light: its emission Le toward the camera subpath's vertex z = x_1, at
     /// distance `dist` (kInf: a light at infinity).
     template <class G>
     void hit_one_emitter(int t, const V& z, const SurfaceHit& hit, const Ray& ray, const P& nulls,
-                         const Spectrum& beta, const G& gamma, int light_index, const Spectrum& Le, float dist) {
-        using namespace bdpt;
-        if (!(Le != 0.f).any()) return;
-        const Spectrum f = beta * Le;
-        if constexpr (kPerChannel) pdfs.gamma = gamma;
-        else (void)gamma;
-        if (t == 2) {  // the camera sees the emitter: the only strategy
-            pdfs.k = 1;
-            // Per channel its nulls' P_n,c still weigh the channels; grey, 1 (one strategy).
-            if constexpr (kPerChannel) pdfs.from_camera[0] = nulls;
-            else pdfs.from_camera[0] = 1.f;
-            pdfs.nee = pdfs.emit = 0.f;
-            pdfs.seg = broadcast<P>(0.f);
-            add(0, 2, f, pdfs, std::isfinite(dist) ? hit.p : z.p, !std::isfinite(dist));
-            return;
-        }
-        gather(0, t - 1, t - 1);  // camera[0..t-2]; the emitter is x_0
-        const Vec3 w = ray.d;  // from x_1 toward x_0
-        const float pdf_dir_z = z.kind == VertexKind::Camera ? 0.f : eval_at(z, z.wo, w).pdf;
-        if (std::isfinite(dist)) {
-            const Vec3 d = hit.p - z.p;
-            const float d2 = glm::dot(d, d);
-            const EmissionDensity e = sc.lights.emission_pdf(light_index, hit.p, -w);
-            const float cos0 = std::abs(glm::dot(hit.ng, w));
-            pdfs.from_camera[0] = (z.delta ? 1.f : pdf_dir_z) * cos0 / d2 * nulls;
-            pdfs.emit = q_lights * e.pdf_pos;
-            pdfs.eq_nee = sc.lights.pdf(light_index, z.p, w) * cos0 / d2;
-            pdfs.nee = nee_count * pdfs.eq_nee;
-            pdfs.from_light[1] = to_vertex_measure(e.pdf_dir, hit.p, z) * nulls * z.event;
-        } else {  // x_0 is the direction w; light subpaths (if any) reach z along -w
-            const EmissionDensity e = sc.lights.emission_pdf(light_index, z.p, -w);
-            pdfs.from_camera[0] = (z.delta ? 1.f : pdf_dir_z) * nulls;
-            pdfs.emit = q_lights * e.pdf_pos;
-            pdfs.eq_nee = sc.lights.pdf(light_index, z.p, w);
-            pdfs.nee = nee_count * pdfs.eq_nee;
-            pdfs.from_light[1] = from_infinity_measure(e.pdf_dir, -w, z) * nulls * z.event;
-        }
-        pdfs.eq = z.eq;
-        // z's own density from the light side: from x_1 toward x_2, arriving along -w.
-        if (t >= 4) {
-            const V& z2 = camera[t - 3];  // x_2
-            const float pd = z.delta ? 1.f : eval_at(z, -w, -z.wo).pdf;
-            pdfs.from_light[2] = to_vertex_measure(pd, z.p, z2) * z.nulls_in * z2.event;
-        }
-        add(0, t, f, pdfs, std::isfinite(dist) ? hit.p : z.p, !std::isfinite(dist));
-    }
+                         const Spectrum& beta, const G& gamma, int light_index, const Spectrum& Le, float dist);
 
     /// The densities of the path made of the camera subpath camera[0..count-1] and x_0 = y in
     /// emitting medium `medium` (the collision estimator's and the segment technique's paths): y
@@ -455,44 +400,7 @@ struct BdptEstimator<Mis, H, A, MaxDepth, Ch>::BdptSample {
     /// shared factors up to y. False where y is x_1 itself (a flight of length 0: no direction).
     template <class G>
     bool emission_path_pdfs(int count, int medium, const Vec3& y, const P& nulls, const P& mu_bar, float pdf_dir,
-                            const P& nulls_before, float along, const G& gamma) {
-        using namespace bdpt;
-        if constexpr (!kEmissive) {
-            (void)count, (void)medium, (void)y, (void)nulls, (void)mu_bar, (void)pdf_dir, (void)nulls_before,
-                (void)along, (void)gamma;
-            return false;
-        } else {
-            const float p_y = sc.media[std::size_t(medium)].medium.emission_pdf(y);
-            if constexpr (kPerChannel) pdfs.gamma = gamma;
-            else (void)gamma;
-            const int t = count + 1;
-            if (t == 2) {  // seen from the camera: the collision estimator and the segment technique
-                pdfs.k = 1;
-                // Relative to the camera's density of the ray and 1 / d^2, the same for both.
-                pdfs.from_camera[0] = nulls * mu_bar;
-                pdfs.nee = pdfs.emit = 0.f;
-                pdfs.seg = seg_density(1.f, nulls_before, p_y, along);
-                return true;
-            }
-            const V& z = camera[count - 1];  // x_1
-            const Vec3 d = y - z.p;
-            const float d2 = glm::dot(d, d);
-            if (!(d2 > 0.f)) return false;
-            gather(0, t - 1, t - 1);
-            const float p_v = sc.emission_selection_pdf(medium) * p_y;
-            pdfs.from_camera[0] = pdf_dir / d2 * nulls * mu_bar;
-            pdfs.seg = seg_density(pdf_dir / d2, nulls_before, p_y, along);
-            pdfs.nee = p_v;
-            pdfs.emit = q_volume * p_v;
-            pdfs.from_light[1] = to_vertex_measure(kInv4Pi, y, z) * nulls * z.event;
-            if (t >= 4) {
-                const V& z2 = camera[count - 2];  // x_2
-                const float pd = z.delta ? 1.f : eval_at(z, -(d / std::sqrt(d2)), -z.wo).pdf;
-                pdfs.from_light[2] = to_vertex_measure(pd, z.p, z2) * z.nulls_in * z2.event;
-            }
-            return true;
-        }
-    }
+                            const P& nulls_before, float along, const G& gamma);
 
     /// s = 0 in an emissive medium: the camera subpath's tentative collision at y, after
     /// camera[0..count-1], collects mu_a L_e / mu_bar (the collision estimator); as a path ending
@@ -505,71 +413,14 @@ struct BdptEstimator<Mis, H, A, MaxDepth, Ch>::BdptSample {
     void emission_collision(const V* path, int count, int medium, const Vec3& y,
                             const Coefficients<typename Sc::Spectral>& c, const P& mu_bar, float mu_sample,
                             const Spectrum& beta, const P& nulls, float pdf_dir, const G& gamma, const P& nulls_before,
-                            float along) {
-        if constexpr (kEmissive) {
-            const int t = count + 1;
-            if (t - 2 > depth || !(c.sigma_a > 0.f).any() || !(mu_sample > 0.f)) return;
-            const auto& m = sc.media[std::size_t(medium)].medium;
-            const Spectrum le = m.emission(y, lambda);
-            if (!(le > 0.f).any()) return;
-            const Spectrum f = beta * c.sigma_a * le / mu_sample;
-            (void)path;  // camera[], which emission_path_pdfs reads
-            if (emission_path_pdfs(count, medium, y, nulls, mu_bar, pdf_dir, nulls_before, along, gamma))
-                add(0, t, f, pdfs, y, false, true);
-        } else {
-            (void)path, (void)count, (void)medium, (void)y, (void)c, (void)mu_bar, (void)mu_sample, (void)beta,
-                (void)nulls, (void)pdf_dir, (void)gamma, (void)nulls_before, (void)along;
-        }
-    }
+                            float along);
 
     /// The equiangular strategy (THEORY 5.4 in 5.5) on the camera segment from z = path[count - 1]
     /// along `ray` (in `medium`, throughput `beta` past z's direction sample): x drawn on the ray's
     /// part in the media's box by equiangular sampling toward the lights' targets, the nulls before
     /// it ratio-tracked, stored as z_t-1 = path[count] (the walk writes its own next vertex there
     /// afterwards) and connected to the lights by NEE.
-    void equiangular(V* path, int count, const Ray& ray, int medium, float pdf_dir, const Spectrum& beta) {
-        using namespace bdpt;
-        const int t = count + 1;
-        if (!eq || t - 1 > depth) return;
-        const V& z = path[count - 1];
-        const Interval in = eq->box.clip(ray, 0.f, kInf);
-        if (in.empty()) return;
-        const float u_pick = rng.uniform(), u = rng.uniform();
-        const DistanceSample ds = eq->sample(sc, ray, in, u_pick, u);
-        if (!(ds.pdf > 0.f && ds.t > 0.f)) return;
-        const double before = detail::recorder_work(counter);
-        int at = -1;
-        const Shadow sh = shadow(ray, ds.t, medium, &at);
-        detail::record_shadow_walk(counter, before, false);
-        if (sh.status != Status::Ok) status = sh.status;
-        if (sh.status != Status::Ok || !(sh.tr != 0.f).any() || !sc.has_medium(at)) return;
-        const auto& m = sc.media[std::size_t(at)];
-        const auto c = detail::lookup_untracked(m.medium, m.majorant, ray, ds.t, lambda, counter);
-        if (!c) {
-            status = Status::Rejected;
-            return;
-        }
-        if (!(c->k.sigma_s > 0.f).any()) return;
-        V& x = path[count];
-        x = V{};
-        x.kind = VertexKind::Medium;
-        x.p = ray.at(ds.t);
-        x.medium = at;
-        x.wo = ray.d;
-        x.beta = beta * sh.tr * c->k.sigma_s / ds.pdf;
-        x.nulls_in = sh.nulls;
-        // Tracking's event density mu_bar P_s at x (per channel, every channel's).
-        if constexpr (kPerChannel)
-            x.event = channel_event_densities<A, typename Sc::Spectral>(c->k, majorants<P>(c->mu)).scatter;
-        else
-            x.event = c->mu * event_probabilities<A>(c->k, c->mu).scatter;
-        const float pd = z.kind == VertexKind::Camera && !(pdf_dir > 0.f) ? 1.f : pdf_dir;  // as the walk's
-        const float g = to_vertex_measure(pd, z.p, x);
-        x.pdf_fwd = g * sh.nulls * x.event;
-        x.eq = broadcast<P>(g * ds.pdf);
-        if constexpr (kPerChannel) x.gamma = path_gamma(z.gamma, sh.gamma);
-        if ((x.beta != 0.f).any()) light_nee(t, true);
-    }
+    void equiangular(V* path, int count, const Ray& ray, int medium, float pdf_dir, const Spectrum& beta);
 
     /// The segment technique (THEORY 5.7 in 5.5) on a camera segment's piece in emitting medium
     /// `medium` (from z = path[count - 1] along `ray` up to t_max; `pdf_dir` z's direction density,
@@ -580,353 +431,41 @@ struct BdptEstimator<Mis, H, A, MaxDepth, Ch>::BdptSample {
     /// which the collision estimator's weights on the piece need (0: the technique does not run).
     template <class G>
     float segment(V* path, int count, const Ray& ray, int medium, float t_max, float pdf_dir, const Spectrum& beta,
-                  const P& nulls_before, const G& gamma) {
-        using namespace bdpt;
-        if constexpr (kEmissive) {
-            (void)path;  // camera[], which emission_path_pdfs reads
-            const int t = count + 1;
-            if (!seg_on || t - 2 > depth) return 0.f;
-            const auto& m = sc.media[std::size_t(medium)];
-            const float along = m.medium.emission_along(ray, 0.f, t_max);
-            if (!(along > 0.f) || !draw_technique(seg_count, rng)) return along;
-            // Its work is a fixed technique's to the learner: it runs whatever the learned counts.
-            const double before = detail::recorder_work(counter);
-            const DistanceSample ds = m.medium.sample_emission_along(ray, 0.f, t_max, along, rng.uniform());
-            if (!(ds.pdf > 0.f && ds.t > 0.f)) return along;
-            const Shadow sh = shadow(ray, ds.t, medium);
-            if (sh.status != Status::Ok) status = sh.status;
-            const auto c = sh.status == Status::Ok && (sh.tr != 0.f).any()
-                               ? detail::lookup_untracked(m.medium, m.majorant, ray, ds.t, lambda, counter)
-                               : std::nullopt;
-            detail::record_shadow_walk(counter, before, false);
-            if (sh.status != Status::Ok || !(sh.tr != 0.f).any()) return along;
-            if (!c) {
-                status = Status::Rejected;
-                return along;
-            }
-            if (!(c->k.sigma_a > 0.f).any()) return along;
-            const Vec3 y = ray.at(ds.t);
-            const Spectrum le = m.medium.emission(y, lambda);
-            if (!(le > 0.f).any()) return along;
-            const Spectrum f = beta * sh.tr * c->k.sigma_a * le / (seg_count * ds.pdf);
-            if (emission_path_pdfs(count, medium, y, P(nulls_before * sh.nulls), majorants<P>(c->mu), pdf_dir,
-                                   nulls_before, along, path_gamma(gamma, sh.gamma)))
-                add(kSeg, t, f, pdfs, y, false, true);
-            return along;
-        } else {
-            (void)path, (void)count, (void)ray, (void)medium, (void)t_max, (void)pdf_dir, (void)beta,
-                (void)nulls_before, (void)gamma;
-            return 0.f;
-        }
-    }
+                  const P& nulls_before, const G& gamma);
 
     // ---- s = 1: next-event estimation -------------------------------------------------------
 
     /// s = 1 from camera vertex z = camera[t - 1] toward the lights (THEORY 5.9: drawn with the
     /// NEE count), or, `from_eq`, the equiangular strategy's NEE from its vertex there, which
     /// always runs: no count.
-    void light_nee(int t, bool from_eq) {
-        using namespace bdpt;
-        const V& z = camera[t - 1];
-        const float count = from_eq ? 1.f : nee_count;
-        const double before = detail::recorder_work(counter);
-        const float u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
-        const SampledLight<typename Sc::Spectral> ls = sc.lights.sample(z.p, u0, u1, u2, lambda);
-        if (!(ls.sample.pdf > 0.f)) return;
-        const Vec3 w = ls.sample.wi;
-        const auto fz = eval_at(z, z.wo, w);
-        if (!(fz.value != 0.f).any()) return;
-        V y0;
-        y0.kind = VertexKind::Light;
-        y0.delta_position = ls.sample.delta;
-        const bool at_infinity = !std::isfinite(ls.sample.distance);
-        y0.p = at_infinity ? z.p : z.p + ls.sample.distance * w;
-        const Shadow sh = shadow(Ray{z.p, w}, ls.sample.distance, z.medium_toward(w));
-        detail::record_shadow_walk(counter, before, !from_eq);
-        if (sh.status != Status::Ok) status = sh.status;
-        if (sh.status != Status::Ok || !(sh.tr != 0.f).any()) return;
-        const P& nulls = sh.nulls;
-        const Spectrum f = z.beta * fz.value * sh.tr * ls.sample.radiance / (count * ls.sample.pdf);
-        gather(0, t, t);  // camera[0..t-1]; the light point is x_0
-        if constexpr (kPerChannel) pdfs.gamma = path_gamma(z.gamma, sh.gamma);
-        const float d2 = ls.sample.distance * ls.sample.distance;
-        if (ls.sample.delta) {  // a point or directional light: no path hits it
-            pdfs.from_camera[0] = broadcast<P>(0.f);
-            pdfs.eq_nee = ls.sample.pdf;
-            // Light subpaths from a directional light (given a BoundingSphere) start on the
-            // sphere's disk: pdf_pos its delta, pdf_dir per area across w.
-            const EmissionDensity e = sc.lights.emission_pdf(ls.light, at_infinity ? z.p : y0.p, -w);
-            pdfs.emit = q_lights * e.pdf_pos;
-            pdfs.from_light[1] = (at_infinity ? from_infinity_measure(e.pdf_dir, -w, z)
-                                              : to_vertex_measure(e.pdf_dir, y0.p, z)) *
-                                 nulls * z.event;
-        } else if (at_infinity) {
-            const EmissionDensity e = sc.lights.emission_pdf(ls.light, z.p, -w);
-            pdfs.from_camera[0] = fz.pdf * nulls;
-            pdfs.eq_nee = ls.sample.pdf;
-            pdfs.emit = q_lights * e.pdf_pos;
-            pdfs.from_light[1] = from_infinity_measure(e.pdf_dir, -w, z) * nulls * z.event;
-        } else {
-            const EmissionDensity e = sc.lights.emission_pdf(ls.light, y0.p, -w);
-            pdfs.from_camera[0] = fz.pdf * e.cos / d2 * nulls;
-            pdfs.eq_nee = ls.sample.pdf * e.cos / d2;
-            pdfs.emit = q_lights * e.pdf_pos;
-            pdfs.from_light[1] = to_vertex_measure(e.pdf_dir, y0.p, z) * nulls * z.event;
-        }
-        pdfs.nee = nee_count * pdfs.eq_nee;
-        pdfs.eq = z.eq;
-        if (t >= 3) {
-            const V& z2 = camera[t - 2];
-            pdfs.from_light[2] = to_vertex_measure(eval_at(z, w * -1.f, -z.wo).pdf, z.p, z2) * z.nulls_in * z2.event;
-        }
-        add(from_eq ? kEq : 1, t, f, pdfs, y0.p, at_infinity);
-    }
+    void light_nee(int t, bool from_eq);
 
     /// s = 1 toward the emitting volume (THEORY 5.7) from camera vertex z = camera[t - 1]: a point
     /// drawn by the power grids, the shadow walk through every medium up to it.
-    void volume_nee(int t) {
-        using namespace bdpt;
-        if constexpr (kEmissive) {
-            const V& z = camera[t - 1];
-            if (!has_volume) return;
-            const auto e = detail::draw_emission_point(sc, z.p, rng);
-            if (!e) return;
-            const auto& m = sc.media[std::size_t(e->index)];
-            const auto fz = eval_at(z, z.wo, e->wi);
-            if (!(fz.value != 0.f).any()) return;
-            const EmissionShadowT sh = shadow_to_emission(Ray{z.p, e->wi}, e->dist, z.medium_toward(e->wi), e->index);
-            if (sh.status != Status::Ok) status = sh.status;
-            if (!(sh.status == Status::Ok && sh.reached && (sh.tr != 0.f).any())) return;
-            const auto c = detail::lookup_untracked(m.medium, m.majorant, sh.last, sh.t_last, lambda, counter);
-            if (!c) {
-                status = Status::Rejected;
-                return;
-            }
-            if (!((c->k.sigma_a > 0.f).any() && majorant_at(c->mu, channel) > 0.f)) return;
-            const float p_v = e->select * e->y.pdf;
-            const Spectrum f =
-                z.beta * fz.value * sh.tr * c->k.sigma_a * m.medium.emission(e->y.p, lambda) / (e->dist2 * p_v);
-            const P& nulls = sh.nulls;
-            gather(0, t, t);  // camera[0..t-1]; the emission point is x_0
-            if constexpr (kPerChannel) pdfs.gamma = path_gamma(z.gamma, sh.gamma);
-            pdfs.from_camera[0] = fz.pdf / e->dist2 * nulls * majorants<P>(c->mu);
-            pdfs.seg = seg_density(fz.pdf / e->dist2, sh.nulls_before, e->y.pdf, sh.along);
-            pdfs.nee = p_v;
-            pdfs.emit = q_volume * p_v;
-            pdfs.from_light[1] = to_vertex_measure(kInv4Pi, e->y.p, z) * nulls * z.event;
-            if (t >= 3) {
-                const V& z2 = camera[t - 2];
-                pdfs.from_light[2] =
-                    to_vertex_measure(eval_at(z, -e->wi, -z.wo).pdf, z.p, z2) * z.nulls_in * z2.event;
-            }
-            add(1, t, f, pdfs, e->y.p, false, true);
-        } else {
-            (void)t;
-        }
-    }
+    void volume_nee(int t);
 
     // ---- The light subpath and the strategies that use it -----------------------------------
 
     /// The light subpath, traced with probability light_probability_ (THEORY 5.9): from the
     /// emitting volume (light_from_volume) or from a light (light_from_emitter).
-    void trace_light_subpath() {
-        const int light_vertices = kLightTracing ? depth + 1 : depth;
-        const bool traced = draw_technique(est.light_probability_, rng);
-        const double light_work_before = detail::recorder_work(counter);
-        if (traced && depth >= (kLightTracing ? 1 : 2)) {
-            const float uq = q_volume_share > 0.f && q_volume_share < 1.f ? rng.uniform() : 0.f;
-            if (q_volume_share > 0.f && uq < q_volume_share) light_from_volume(light_vertices);
-            else light_from_emitter(light_vertices);
-        }
-        if (traced) detail::record_light_walk(counter, light_work_before);
-    }
+    void trace_light_subpath();
 
     /// A light subpath of at most light_vertices vertices from a point y_0 drawn in the emitting
     /// volume by the media's power, with y_0's densities for NEE and the segment technique.
-    void light_from_volume(int light_vertices) {
-        using namespace bdpt;
-        if constexpr (kEmissive) {
-            const float us = rng.uniform(), u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform(),
-                        u3 = rng.uniform(), u4 = rng.uniform(), u5 = rng.uniform();
-            const int i = sc.select_emission(us);
-            const float select = sc.emission_selection_pdf(i);
-            const auto& m = sc.media[std::size_t(i)];
-            const VolumeSample yv = m.medium.sample_emission(u0, u1, u2, u3);
-            const Vec3 w = uniform_sphere(u4, u5);
-            // The point counts only inside medium i's surfaces: the first boundary ahead of it
-            // must be one it leaves medium i through (as the camera side's NEE walk checks).
-            const int start = light_start_medium(sc, yv.p, w);
-            if (start == -3) status = Status::InvalidInput;
-            const bool inside = start == i;
-            if (!(i >= 0 && select > 0.f && yv.pdf > 0.f && inside)) return;
-            const auto c = detail::lookup_untracked(m.medium, m.majorant, Ray{yv.p, w}, 0.f, lambda, counter);
-            if (!c) {
-                status = Status::Rejected;
-                return;
-            }
-            if (!((c->k.sigma_a > 0.f).any() && majorant_at(c->mu, channel) > 0.f)) return;
-            const Spectrum source = c->k.sigma_a * m.medium.emission(yv.p, lambda);
-            if (!(source > 0.f).any()) return;
-            V& y0 = light[0] = V{};
-            y0.kind = VertexKind::Medium;
-            y0.p = yv.p;
-            y0.medium = i;
-            y0.event = majorants<P>(c->mu);  // a tentative collision's density there: mu_bar
-            if constexpr (kPerChannel) y0.gamma = Spectrum::Ones();
-            emit_y0 = q_volume * select * yv.pdf;
-            y0.pdf_fwd = broadcast<P>(emit_y0);
-            y0.beta = source / emit_y0;
-            nl = est.walk(sc, light, 1, light_vertices, Ray{yv.p, w}, i, kInv4Pi, Spectrum(y0.beta * (4.f * kPi)),
-                          lambda, channel, rng, counter, [](auto&&...) {}, status, eq, false, NoEmission{},
-                          NoSegment{}, NoSegment{}, seg_on ? &first_segment : nullptr);
-            nee_y0 = select * yv.pdf;
-            if (seg_on && nl >= 2) {
-                // y_0's piece seen from y_1: from the last surface between them (the walk's first
-                // piece's end, else y_1) through y_0 to the first surface beyond it.
-                const float dist = glm::length(light[1].p - yv.p);
-                const SurfaceHit behind = sc.geometry.intersect(Ray{yv.p, -w}, kInf);
-                if (!detail::usable_hit(sc, behind)) {
-                    status = Status::InvalidInput;
-                } else {
-                    const float a = std::min(first_segment.first_piece_end, dist);
-                    const float b = behind.found() ? behind.t : kInf;
-                    const float along = m.medium.emission_along(Ray{yv.p + a * w, -w}, 0.f, a + b);
-                    seg_y0_unit = seg_density(1.f, first_segment.later_nulls, yv.pdf, along);
-                }
-            }
-        } else {
-            (void)light_vertices;
-        }
-    }
+    void light_from_volume(int light_vertices);
 
     /// A light subpath of at most light_vertices vertices from a light's emission sample, with
     /// y_0's densities for NEE (and the equiangular strategy's NEE).
-    void light_from_emitter(int light_vertices) {
-        using namespace bdpt;
-        const float u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform(), u3 = rng.uniform(),
-                    u4 = rng.uniform();
-        volume_start = false;
-        const EmittedLight<typename Sc::Spectral> e = sc.lights.sample_emission(u0, u1, u2, u3, u4, lambda);
-        if (!(e.emission.pdf_pos > 0.f && e.emission.pdf_dir > 0.f && (e.emission.radiance != 0.f).any())) return;
-        V& y0 = light[0] = V{};
-        y0.kind = VertexKind::Light;
-        y0.p = e.emission.p;
-        y0.ng = y0.ns = e.emission.n;
-        y0.light = e.light;
-        y0.delta_position = e.emission.delta_position;
-        y0.at_infinity = e.emission.at_infinity;
-        emit_y0 = q_lights * e.emission.pdf_pos;
-        y0.pdf_fwd = broadcast<P>(emit_y0);
-        y0.beta = e.emission.radiance / (q_lights * e.emission.pdf_pos);
-        if constexpr (kPerChannel) y0.gamma = Spectrum::Ones();
-        const int start = light_start_medium(sc, e.emission.p, e.emission.w);
-        if (start == -3) status = Status::InvalidInput;
-        else
-            nl = est.walk(sc, light, 1, light_vertices, Ray{e.emission.p, e.emission.w}, start, e.emission.pdf_dir,
-                          Spectrum(y0.beta * (e.emission.cos / e.emission.pdf_dir)), lambda, channel, rng, counter,
-                          [](auto&&...) {}, status, eq, false);
-        if (nl >= 2) {
-            const Vec3 d = y0.p - light[1].p;
-            const float d2 = glm::dot(d, d);
-            eq_nee_y0 = y0.delta_position ? sc.lights.selection_pdf(y0.light)  // a point or a direction
-                        : y0.at_infinity  ? sc.lights.pdf(y0.light, light[1].p, -e.emission.w)  // solid angle
-                                            : sc.lights.pdf(y0.light, light[1].p, d / std::sqrt(d2)) *
-                                                  std::abs(glm::dot(y0.ng, d)) / (d2 * std::sqrt(d2));
-            nee_y0 = nee_count * eq_nee_y0;
-        }
-    }
+    void light_from_emitter(int light_vertices);
 
     /// s >= 2: connects every light vertex y = y_{s-1} to camera vertex z = camera[t - 1].
-    void connect(int t) {
-        using namespace bdpt;
-        const V& z = camera[t - 1];
-        for (int s = 2; s <= nl && s + t - 2 <= depth; ++s) {
-            const V& y = light[s - 1];
-            if (y.delta) continue;
-            const Vec3 d = z.p - y.p;
-            const float d2 = glm::dot(d, d);
-            if (!(d2 > 0.f)) continue;
-            const Vec3 w = d / std::sqrt(d2);
-            const auto fy = eval_at(y, y.wo, w);
-            if (!(fy.value != 0.f).any()) continue;
-            const auto fz = eval_at(z, z.wo, -w);
-            if (!(fz.value != 0.f).any()) continue;
-            P nulls = broadcast<P>(1.f);
-            GammaT gamma = unit_gamma<P>();
-            const Spectrum tr = transmit(y, z, nulls, gamma);
-            if (!(tr != 0.f).any()) continue;
-            const Spectrum f = y.beta * fy.value * tr * fz.value * z.beta / d2;
-            gather(s, t, s + t - 1);
-            if constexpr (kPerChannel) pdfs.gamma = path_gamma(y.gamma, gamma, z.gamma);
-            pdfs.emit = emit_y0;
-            pdfs.nee = nee_y0;
-            // The four densities the connection changes.
-            pdfs.from_light[s] = to_vertex_measure(fy.pdf, y.p, z) * nulls * z.event;
-            pdfs.from_camera[s - 1] = to_vertex_measure(fz.pdf, z.p, y) * nulls * y.event;
-            if (t >= 3) {
-                const V& z2 = camera[t - 2];
-                pdfs.from_light[s + 1] = to_vertex_measure(eval_at(z, w, -z.wo).pdf, z.p, z2) * z.nulls_in * z2.event;
-            }
-            const V& y2 = light[s - 2];
-            const float pd_y2 = eval_at(y, -w, -y.wo).pdf;
-            pdfs.from_camera[s - 2] = to_vertex_measure(pd_y2, y.p, y2) * y.nulls_in * y2.event;
-            // x_1 = y_1 as the equiangular strategy draws it, from x_2 (z, y_2 toward the connection,
-            // or y_2 as its light subpath stored).
-            pdfs.eq_nee = eq_nee_y0;
-            pdfs.eq = s == 2 ? eq_from(z.p, fz.pdf, y) : s == 3 ? eq_from(y.p, pd_y2, y2) : light[1].eq;
-            // x_0 = y_0 as the segment technique draws it from x_1 = y_1, arriving there from x_2
-            // (z, or y_2 as the light subpath drew it).
-            pdfs.seg = seg_y0_unit * (s == 2 ? to_vertex_measure(pd_y2, y.p, y2) : first_segment.y0_reverse);
-            add(s, t, f, pdfs, light[0].p, light[0].at_infinity, volume_start);
-        }
-    }
+    void connect(int t);
 
     /// t = 1 (light tracing): every light vertex y = y_{s-1} seen by the camera, splatted where it
     /// appears on the image.
-    void light_trace() {
-        using namespace bdpt;
-        if constexpr (kLightTracing) {
-            const Vec3 eye = cam->position();
-            for (int s = 2; s <= nl && s - 1 <= depth; ++s) {
-                const V& y = light[s - 1];
-                if (y.delta) continue;
-                const Vec3 d = eye - y.p;
-                const float d2 = glm::dot(d, d);
-                if (!(d2 > 0.f)) continue;
-                const Vec3 w = d / std::sqrt(d2);  // from y toward the camera
-                float u = 0.f, v = 0.f;
-                const float pc = cam->pdf_dir(-w);
-                if (!(pc > 0.f) || !cam->raster(-w, u, v)) continue;
-                const auto fy = eval_at(y, y.wo, w);
-                if (!(fy.value != 0.f).any()) continue;
-                V eye_vertex;
-                eye_vertex.p = eye;
-                P nulls = broadcast<P>(1.f);
-                GammaT gamma = unit_gamma<P>();
-                const Spectrum tr = transmit(y, eye_vertex, nulls, gamma);
-                if (!(tr != 0.f).any()) continue;
-                const Spectrum f = y.beta * fy.value * tr * (pc / d2);
-                gather(s, 0, s);
-                if constexpr (kPerChannel) pdfs.gamma = path_gamma(y.gamma, gamma);
-                pdfs.emit = emit_y0;
-                pdfs.nee = nee_y0;
-                pdfs.from_camera[s - 1] = to_vertex_measure(pc, eye, y) * nulls * y.event;
-                const V& y2 = light[s - 2];
-                const float pd_y2 = eval_at(y, -w, -y.wo).pdf;
-                pdfs.from_camera[s - 2] = to_vertex_measure(pd_y2, y.p, y2) * y.nulls_in * y2.event;
-                pdfs.eq_nee = eq_nee_y0;
-                pdfs.eq = s == 2 ? eq_from(eye, pc, y) : s == 3 ? eq_from(y.p, pd_y2, y2) : light[1].eq;
-                pdfs.seg = seg_y0_unit * (s == 2 ? to_vertex_measure(pd_y2, y.p, y2) : first_segment.y0_reverse);
-                const float wt = weight_of(pdfs, s);
-                record(s, f, pdfs, volume_start, true);
-                observe(s, 1, f, wt, pdfs,
-                        PathVertices<typename Sc::Spectral, P>{light, s, camera, 1, light[0].p, light[0].at_infinity});
-                const Spectrum value = f * wt;
-                if (all_finite(value)) splat(u, v, value);
-                else status = Status::NonFinite;
-            }
-        }
-    }
+    void light_trace();
 };
 
 }  // namespace nsp
+
+#include "bdpt_strategies.hpp"
