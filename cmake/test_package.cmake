@@ -1,14 +1,16 @@
 # ctest script: install nsp from the build tree into a scratch prefix, then build and run the
 # consumer project against it with find_package, and again with add_subdirectory. Both builds
-# compile and run the code snippets of the README (cmake/consumer/CMakeLists.txt): the installed
-# build is given the README's path, the subdirectory build finds it in NSP_SOURCE_DIR. Last, the
+# compile and run the code snippets of README.md and docs/integration.md (cmake/consumer/
+# CMakeLists.txt): the installed build is given their paths in the source tree (nothing of them
+# is installed), the subdirectory build finds them in NSP_SOURCE_DIR. Last, the
 # example host renderer examples/host against the installed package, and its --compare check.
 # Both builds also build and run consumer_volumes (cmake/consumer/volume_files.cpp: a .vol, .nvdb
 # files with each codec and a .vdb read back through nsp::nanovdb / nsp::openvdb), and the
 # package's components are checked where they cannot be found: a required one fails find_package
 # with a message naming the Debian package, an optional one is left out.
 # Inputs: NSP_SOURCE_DIR, NSP_BINARY_DIR, WORK_DIR, GENERATOR; optional NSP_README (default
-# ${NSP_SOURCE_DIR}/README.md) and NSP_EXPECT_NANOVDB / _OPENVDB / _ZIP / _BLOSC (ON when nsp's
+# ${NSP_SOURCE_DIR}/README.md), NSP_INTEGRATION_DOC (default ${NSP_SOURCE_DIR}/docs/integration.md)
+# and NSP_EXPECT_NANOVDB / _OPENVDB / _ZIP / _BLOSC (ON when nsp's
 # build found them: the consumer then requires them; the top-level CMakeLists.txt passes them).
 foreach(v NSP_SOURCE_DIR NSP_BINARY_DIR WORK_DIR)
     if(NOT DEFINED ${v})
@@ -17,6 +19,9 @@ foreach(v NSP_SOURCE_DIR NSP_BINARY_DIR WORK_DIR)
 endforeach()
 if(NOT DEFINED NSP_README)
     set(NSP_README ${NSP_SOURCE_DIR}/README.md)
+endif()
+if(NOT DEFINED NSP_INTEGRATION_DOC)
+    set(NSP_INTEGRATION_DOC ${NSP_SOURCE_DIR}/docs/integration.md)
 endif()
 file(REMOVE_RECURSE ${WORK_DIR})
 
@@ -35,7 +40,8 @@ endforeach()
 
 run(${CMAKE_COMMAND} --install ${NSP_BINARY_DIR} --prefix ${WORK_DIR}/prefix)
 run(${CMAKE_COMMAND} -S ${NSP_SOURCE_DIR}/cmake/consumer -B ${WORK_DIR}/installed -G ${GENERATOR}
-    -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH=${WORK_DIR}/prefix -DNSP_README=${NSP_README} ${expect})
+    -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH=${WORK_DIR}/prefix -DNSP_README=${NSP_README}
+    -DNSP_INTEGRATION_DOC=${NSP_INTEGRATION_DOC} ${expect})
 run(${CMAKE_COMMAND} --build ${WORK_DIR}/installed)
 run(${WORK_DIR}/installed/consumer)
 if(NSP_EXPECT_NANOVDB)
