@@ -373,218 +373,15 @@ private:
              C& counter, OnHit on_hit, Status& status, const EqRegion* eq, bool camera_side,
              OnEmission on_emission = {}, OnSegment on_segment = {}, OnPiece on_piece = {},
              FirstSegment<Sc>* first = nullptr) const;
+    /// One walk's state and its steps (bdpt_walk.hpp).
+    template <class Sc, class R, class C>
+    struct SubpathWalk;
 
     Kernels kernels_;
     float light_probability_ = 1.f;
 };
 
 // ---------------------------------------------------------------------------------------------
-
-template <bdpt::MisPolicy Mis, mis::CombiningHeuristic H, AbsorptionPolicy A, int MaxDepth, bdpt::ChannelAxis Ch>
-template <class Sc, UniformRng R, LookupCounter C, class OnHit, class OnEmission, class OnSegment, class OnPiece>
-int BdptEstimator<Mis, H, A, MaxDepth, Ch>::walk(const Sc& sc, VertexT<Sc>* path, int count, int max_vertices,
-                                                 Ray ray, int medium, float pdf_dir, typename Sc::Spectrum beta,
-                                                 const typename Sc::Spectral::Wavelengths& lambda, int channel, R& rng,
-                                                 C& counter, OnHit on_hit, Status& status, const EqRegion* eq,
-                                                 bool camera_side, OnEmission on_emission, OnSegment on_segment,
-                                                 OnPiece on_piece, FirstSegment<Sc>* first) const {
-    using namespace bdpt;
-    using V = VertexT<Sc>;
-    using S = typename Sc::Spectral;
-    using Spectrum = typename Sc::Spectrum;
-    using P = PdfType<Ch, S>;
-    const float beta_scale = float(beta.abs().maxCoeff());
-    P nulls = broadcast<P>(1.f);
-    int crossings = 0;
-    // Per channel: the segment's state since the last real vertex (f_c and p_c of channel c's
-    // tracking, and in its nee slot the factor every strategy shares, prod mu_bar_c(n_j) Tbar_c:
-    // ratio tracking's pdf of the nulls, which the tracking kernel keeps there as NEE's
-    // alternative, times the real vertex's Tbar_c, multiplied in where it scatters), and the
-    // throughput where the segment started (THEORY 5.3 with 5.5).
-    using State = std::conditional_t<kPerChannel, ChannelPathState<S>, NoGamma>;
-    [[maybe_unused]] State st{};
-    [[maybe_unused]] Spectrum beta0 = beta;
-    if constexpr (kPerChannel) st.nee = Spectrum::Ones();
-    // Per channel: the product of the subpath's forward densities (the shared factors apart),
-    // relative to the largest channel's: with the vertex's gamma, every channel's density of the
-    // subpath, for roulette on the one-sample spectral MIS estimate of its throughput.
-    [[maybe_unused]] P prefix = broadcast<P>(1.f);
-    // The subpath's shared factors up to the segment's start, and to where it is now.
-    auto gamma_here = [&]() {
-        if constexpr (kPerChannel) return relative_to_largest<Spectrum>(path[count - 1].gamma * st.nee);
-        else return NoGamma{};
-    };
-    bool segment_start = true;
-    while (count < max_vertices) {
-        if constexpr (!std::is_same_v<OnSegment, NoSegment>) {
-            if (segment_start) on_segment(path, count, ray, medium, pdf_dir, beta);
-        }
-        segment_start = false;
-        const SurfaceHit hit = sc.geometry.intersect(ray, kInf);
-        if (!detail::usable_hit(sc, hit)) {
-            status = Status::InvalidInput;
-            return count;
-        }
-        if (first && count == 1 && crossings == 0) first->first_piece_end = hit.t;
-        V v;
-        bool scattered = false;
-        // The segment technique's normaliser on this piece (0: it does not run here).
-        float along = 0.f;
-        (void)along;
-        if constexpr (!std::is_same_v<OnPiece, NoSegment>) {
-            if (sc.has_medium(medium)) along = on_piece(path, count, ray, medium, hit.t, pdf_dir, beta, nulls, gamma_here());
-        }
-        if constexpr (kPerChannel) {
-            if (sc.has_medium(medium)) {
-                const auto& m = sc.media[std::size_t(medium)];
-                detail::DoubleSpectrum<Spectrum> piece_nulls = detail::DoubleSpectrum<Spectrum>::Ones();
-                Spectrum last_null = Spectrum::Ones(), last_event = Spectrum::Ones(), last_tbar = Spectrum::Ones();
-                bool pending = false;
-                const ChannelTrack seg = track_channels_delta_visiting<Ch, A>(
-                    m.medium, m.majorant, ray, hit.t, lambda, channel, st, true, rng, counter,
-                    ChannelWalkVisit<Sc, OnEmission>{{&piece_nulls, &last_null, &last_event, &last_tbar, &pending},
-                                                     &on_emission, path, count, medium, channel, ray, beta0, nulls,
-                                                     pdf_dir, along});
-                if (const Status fs = flight_status(seg.end); fs != Status::Ok) {
-                    status = fs;
-                    return count;
-                }
-                if (seg.end != SegmentEnd::Scattered && seg.end != SegmentEnd::Passed) return count;  // absorbed, or no pdf left
-                if (seg.end == SegmentEnd::Passed && pending) piece_nulls *= last_null.template cast<double>();
-                nulls *= piece_nulls.template cast<float>();
-                if (first && count == 1 && crossings > 0) first->later_nulls *= piece_nulls.template cast<float>();
-                beta = beta0 * st.f / st.uni[channel];
-                if (seg.end == SegmentEnd::Scattered) {
-                    scattered = true;
-                    v.kind = VertexKind::Medium;
-                    v.p = ray.at(seg.t);
-                    v.medium = medium;
-                    v.event = last_event;
-                    st.nee *= last_tbar;  // the real vertex's Tbar_c (not a null's: no mu_bar_c)
-                }
-            }
-        } else if (sc.has_medium(medium)) {  // grey: one pdf for every channel
-            const auto& m = sc.media[std::size_t(medium)];
-            DeltaTrack<typename Sc::Spectral> seg;
-            if constexpr (!std::is_same_v<OnEmission, NoEmission>) {
-                // The collision estimator of volume emission: every tentative collision, with the
-                // throughput and null product of the nulls before it (THEORY 5.7).
-                seg = kernels_.track_visiting(
-                    m.medium, m.majorant, ray, hit.t, lambda, rng, counter,
-                    EmissionVisitor<Sc, OnEmission>{on_emission, path, count, medium, ray, beta, nulls, pdf_dir, along});
-            } else {
-                seg = kernels_.track(m.medium, m.majorant, ray, hit.t, lambda, rng, counter);
-            }
-            if (const Status fs = flight_status(seg.end); fs != Status::Ok) {
-                status = fs;
-                return count;
-            }
-            beta *= seg.weight;
-            if constexpr (Mis::null_pdfs) {
-                nulls *= seg.null_pdf_product;
-                if (first && count == 1 && crossings > 0) first->later_nulls *= seg.null_pdf_product;
-            }
-            if (seg.end == SegmentEnd::Scattered) {
-                scattered = true;
-                v.kind = VertexKind::Medium;
-                v.p = ray.at(seg.t);
-                v.medium = medium;
-                if constexpr (Mis::null_pdfs) v.event = seg.event_density;
-            } else if (seg.end != SegmentEnd::Passed) {
-                return count;  // absorbed
-            }
-        }
-        if (!scattered) {
-            if (!hit.found()) {
-                on_hit(path, count, hit, ray, nulls, beta, gamma_here());  // the lights at infinity
-                return count;
-            }
-            if (hit.light >= 0) on_hit(path, count, hit, ray, nulls, beta, gamma_here());
-            if (detail::crosses(sc, hit)) {
-                if (++crossings > detail::kMaxInterfaceCrossings) {
-                    status = Status::InvalidInput;
-                    return count;
-                }
-                medium = hit.medium_entered(ray.d);
-                ray.o = hit.p;
-                continue;
-            }
-            if (hit.material < 0 || sc.materials.passes_through(hit.material)) return count;  // an emitter alone
-            v.kind = VertexKind::Surface;
-            v.p = hit.p;
-            v.ng = hit.ng;
-            v.ns = hit.ns;
-            v.material = hit.material;
-            v.medium_front = hit.medium_front;
-            v.medium_back = hit.medium_back;
-        }
-        V& prev = path[count - 1];
-        v.wo = ray.d;
-        v.beta = beta;
-        v.nulls_in = nulls;
-        // From the camera: its own density of the ray (light tracing), or a stand-in of 1 for it,
-        // a factor of every strategy with t >= 2 (the equiangular one too), so it cancels.
-        const float pd = prev.kind == VertexKind::Camera && !(pdf_dir > 0.f) ? 1.f : pdf_dir;
-        if (prev.at_infinity) {
-            v.pdf_fwd = from_infinity_measure(pd, ray.d, v) * nulls * v.event;
-        } else {
-            const float g = to_vertex_measure(pd, prev.p, v);
-            v.pdf_fwd = g * nulls * v.event;
-            if (camera_side && eq && v.kind == VertexKind::Medium)
-                v.eq = broadcast<P>(g * eq->density(sc, prev.p, ray.d, glm::length(v.p - prev.p)));
-        }
-        if constexpr (kPerChannel) v.gamma = gamma_here();
-        path[count] = v;
-        V& cur = path[count++];
-        if (count >= max_vertices) return count;
-        // Roulette on the throughput relative to the subpath's start (a light subpath starts at
-        // Le / pdf, not 1). Per channel on the estimate the one-sample MIS over channels makes of
-        // it, f / sum_c' q_c' p_c' = beta p_c / sum_c' q_c' p_c' (q_c' = 1 / C), as
-        // SpectralPathEstimator's roulette: on beta = f / p_c alone, the sampling channel's, the
-        // chromatic cloud under a sky (nsp_room, C1) had 1.2x the variance.
-        Spectrum rr_beta = beta;
-        if constexpr (kPerChannel) {
-            prefix = relative_to_largest<Spectrum>(prefix * cur.pdf_fwd);
-            const Spectrum pc = prefix * cur.gamma;
-            const float mean = pc.mean();
-            if (pc[channel] > 0.f && mean > 0.f) rr_beta *= pc[channel] / mean;
-        }
-        const float q = kernels_.survival(count - 1, rr_beta / (beta_scale > 0.f ? beta_scale : 1.f));
-        if (q < 1.f) {
-            if (!(rng.uniform() < q)) return count;
-            beta /= q;
-        }
-        const SceneVertex sv{cur.material, cur.medium, cur.ns};
-        const float u1 = rng.uniform(), u2 = rng.uniform();
-        const auto next = sample_vertex(sc, sv, ray.d, u1, u2, lambda);
-        if (!(next.pdf > 0.f)) return count;
-        cur.delta = next.delta;
-        // The density with which the other side, arriving along -next.wi, draws prev from cur.
-        const float rev = next.delta ? next.pdf : eval_vertex(sc, sv, -next.wi, -ray.d, lambda).pdf;
-        const float g_rev = to_vertex_measure(rev, cur.p, prev);
-        prev.pdf_rev = g_rev * nulls * prev.event;
-        if (first && count == 2) first->y0_reverse = g_rev;
-        if (!camera_side && eq && count == 3 && prev.kind == VertexKind::Medium) {  // y_1, drawn from y_2
-            const Vec3 d = prev.p - cur.p;
-            const float len = glm::length(d);
-            prev.eq = broadcast<P>(len > 0.f ? g_rev * eq->density(sc, cur.p, d / len, len) : 0.f);
-        }
-        beta *= next.value / next.pdf;
-        if (!(beta != 0.f).any()) return count;
-        if (cur.kind == VertexKind::Surface) medium = cur.medium_toward(next.wi);
-        pdf_dir = next.pdf;
-        nulls = broadcast<P>(1.f);
-        if constexpr (kPerChannel) {
-            beta0 = beta;
-            st = State{};
-            st.nee = Spectrum::Ones();
-        }
-        crossings = 0;
-        ray = Ray{cur.p, next.wi};
-        segment_start = true;
-    }
-    return count;
-}
 
 template <bdpt::MisPolicy Mis, mis::CombiningHeuristic H, AbsorptionPolicy A, int MaxDepth, bdpt::ChannelAxis Ch>
 template <class Sc, class Cam, UniformRng R, LookupCounter C, class Splat, class Observe>
@@ -629,5 +426,7 @@ using SpectralBdptEstimator = BdptEstimator<bdpt::NullScattering, H, A, MaxDepth
 
 }  // namespace nsp
 
-// Each sample's named parts, after the declaration of the estimator they belong to.
+// The subpath walk and each sample's named parts, after the declaration of the estimator they
+// belong to.
+#include "bdpt_walk.hpp"
 #include "bdpt_sample.hpp"
