@@ -58,6 +58,9 @@ struct NoSurfaces {
 /// Media in empty space with an optional sphere light (nsp::Scene's geometry): the sphere is the
 /// only surface, reported with light handle `light` and no material (what reaches it ends there);
 /// medium `medium` lies on both of its sides, as it fills space (tracking clips it to its box).
+/// The sphere lies outside every medium's bounds (SurfaceScene refuses it otherwise), so a
+/// segment from a point inside a medium leaves the medium's box before it can reach the sphere:
+/// the path loop looks for the sphere only where such a segment passes its medium.
 struct EmptySpace {
     static constexpr bool is_empty_space = true;
     bool has_sphere = false;
@@ -87,6 +90,11 @@ struct EmptySpace {
     }
     /// Whether light `light` is the sphere: a walk to a point sampled on its visible cap.
     bool ends_on(int l) const noexcept { return has_sphere && l >= 0 && l == light; }
+    /// Whether the sphere (if any) lies apart from `box`: its centre farther from the box than
+    /// its radius.
+    bool apart_from(const Box& box) const noexcept {
+        return !has_sphere || glm::length(glm::clamp(center, box.lo, box.hi) - center) > radius;
+    }
 };
 
 /// True for a geometry with no surface that bounds a medium (NoSurfaces, EmptySpace).

@@ -39,7 +39,7 @@ using SceneBase = SurfaceScene<EmptySpace, M, Maj, P, NoMaterials<typename M::Sp
 /// Medium M tracked with majorant policy Maj, scattering with phase function P, lit by `lights`,
 /// in empty space: a SurfaceScene (media[0] the medium, filling space; the sphere light its one
 /// surface; the lights in a LightSampler). The sphere light must lie outside the medium's bounds
-/// (checked).
+/// (the SurfaceScene checks it).
 template <Medium M, MajorantPolicy<M> Maj, PhaseFunction P>
 struct Scene : detail::SceneBase<M, Maj, P> {
     using Base = detail::SceneBase<M, Maj, P>;
@@ -51,15 +51,7 @@ struct Scene : detail::SceneBase<M, Maj, P> {
     /// bound::Guaranteed), or one under which a flight would run away (majorants/crossing.hpp).
     Scene(M m, Maj maj, P p, const Lights<Spectral>& l)
         : Base(geometry_of(l), media_of(std::move(m), std::move(maj), std::move(p)), NoMaterials<Spectral>(),
-               lights_of(l), 0) {
-        if (const auto& s = l.sphere()) {
-            const Box b = this->media[0].medium.bounds();
-            const Vec3 nearest = glm::clamp(s->center, b.lo, b.hi);
-            if (glm::length(nearest - s->center) <= s->radius)
-                detail::fail("SphereLight (centre ", s->center.x, ", ", s->center.y, ", ", s->center.z, ", radius ",
-                             s->radius, ") overlaps the medium bounds; lights must lie outside the medium");
-        }
-    }
+               lights_of(l), 0) {}
 
     /// The medium, its majorant and its phase function.
     const M& medium() const noexcept { return this->media[0].medium; }

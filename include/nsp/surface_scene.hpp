@@ -138,6 +138,13 @@ struct SurfaceScene {
         }
         if constexpr (requires(const Ls& x) { x.bounding_sphere(); })
             if (lights.emits_from_infinity()) check_inside(lights.bounding_sphere());
+        if constexpr (std::is_same_v<G, EmptySpace>) {
+            for (const auto& s : media)
+                if (!geometry.apart_from(s.medium.bounds()))
+                    detail::fail("SphereLight (centre ", geometry.center.x, ", ", geometry.center.y, ", ",
+                                 geometry.center.z, ", radius ", geometry.radius,
+                                 ") overlaps the medium bounds; lights must lie outside the medium");
+        }
         build_emission_selection();
     }
 

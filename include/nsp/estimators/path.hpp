@@ -65,10 +65,19 @@ RadianceSample<typename Sc::Spectral> trace_path(const K& k, const Sc& sc, const
     int medium = sc.camera_medium;
     st.prev = ray.o;
     int crossings = 0;
+    // Media in empty space (Scene): its surface, a sphere light, lies outside every medium, so a
+    // segment from a medium vertex leaves the medium's box before it can reach it. Such a segment
+    // looks for the surface only where it passes its medium, not on every segment (NoSurfaces has
+    // none to look for).
+    constexpr bool kEmptySpace = is_empty_space_v<typename Sc::GeometryType>;
+    constexpr bool kSphereLater = std::is_same_v<typename Sc::GeometryType, EmptySpace>;
+    bool from_medium_vertex = false;
     for (int depth = 0;;) {
-        const SurfaceHit hit = sc.geometry.intersect(ray, kInf);
+        SurfaceHit hit;  // t = kInf until the geometry is asked
+        const bool surface_later = kSphereLater && from_medium_vertex;
+        if (!surface_later) hit = sc.geometry.intersect(ray, kInf);
         // nsp's own empty space (Scene) reports only hits it built; a host's are checked.
-        if constexpr (!is_empty_space_v<typename Sc::GeometryType>) {
+        if constexpr (!kEmptySpace) {
             if (!usable_hit(sc, hit)) {
                 status = Status::InvalidInput;
                 break;
@@ -136,6 +145,7 @@ RadianceSample<typename Sc::Spectral> trace_path(const K& k, const Sc& sc, const
         if (in_medium) {
             x = ray.at(t_medium);
         } else {
+            if (surface_later) hit = sc.geometry.intersect(ray, kInf);
             // An emitter reached: weighed against NEE from the last real vertex where it exists.
             auto add_emitter = [&](int light) {
                 const Spectrum le = sc.lights.emitted(light, ray.d, lambda);
@@ -155,6 +165,7 @@ RadianceSample<typename Sc::Spectral> trace_path(const K& k, const Sc& sc, const
                 medium = hit.medium_entered(ray.d);
                 ray.o = hit.p;
                 st.walked += hit.t;
+                from_medium_vertex = false;
                 continue;
             }
             if (hit.material < 0 || sc.materials.passes_through(hit.material))
@@ -193,6 +204,7 @@ RadianceSample<typename Sc::Spectral> trace_path(const K& k, const Sc& sc, const
             break;
         }
         crossings = 0;
+        from_medium_vertex = in_medium;
         ray = Ray{x, next.wi};
     }
     // A flight or path state that overflowed (NonFinite) had a value beyond float's range: the
