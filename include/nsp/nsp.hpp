@@ -15,6 +15,7 @@
 #include "geometry.hpp"
 #include "light.hpp"
 #include "light_sampler.hpp"
+#include "lights/image_environment.hpp"
 #include "majorant.hpp"
 #include "majorants/grid.hpp"
 #include "majorants/tree.hpp"
