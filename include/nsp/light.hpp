@@ -74,7 +74,8 @@ concept EmittingLight = SpectralMode<S> && requires(const L& l, const Vec3& v, f
 /// for direction w (0 for a delta light, or where w misses it); `emitted(w, lambda)` what a ray
 /// travelling along w receives when it reaches the light; `power(scene_radius)` a grey measure of
 /// its emitted power for light selection by power. Models: PointLight, SphereLight, QuadLight,
-/// EnvironmentLight; LightSampler chooses among any number of them.
+/// EnvironmentLight, ImageEnvironmentLight (lights/image_environment.hpp); LightSampler chooses
+/// among any number of them.
 template <class L, class S>
 concept Light = SpectralMode<S> && requires(const L& l, const Vec3& v, float u, const typename S::Wavelengths& lambda) {
     { l.sample(v, u, u, lambda, u) } -> std::same_as<LightSample<S>>;

@@ -173,7 +173,8 @@ public:
 
 private:
     static constexpr int channels = S::channels;
-    static_assert(channels == 1 || channels == 3, "nsp::ImageEnvironmentLight: Mono or Rgb channels");
+    static_assert(is_hero_v<S> || channels == 1 || channels == 3,
+                  "nsp::ImageEnvironmentLight: a mode of 1 channel (grey, the luminance) or 3 (RGB)");
 
     /// The bin of a cumulative table `cdf` (n + 1 entries, 0 ... 1) that holds u, and u's
     /// position inside it in `frac`; never a bin of width 0.
