@@ -359,21 +359,7 @@ private:
         float y0_reverse = 0.f;
     };
 
-    /// Tracks a subpath from path[count - 1] (see trace). With `eq` (the equiangular strategy on),
-    /// stores its densities: a camera subpath's (`camera_side`) at each medium vertex, a light
-    /// subpath's at y_1; `on_segment(path, count, ray, medium, pdf_dir, beta)` runs at the start of
-    /// every segment, before it is tracked; `on_piece(path, count, ray, medium, t_max, pdf_dir,
-    /// beta, nulls, gamma)` before every piece in a medium is tracked, returning the segment
-    /// technique's normaliser on it (which `on_emission` then gets). `first`, if given, receives
-    /// the first segment's FirstSegment.
-    template <class Sc, UniformRng R, LookupCounter C, class OnHit, class OnEmission = NoEmission,
-              class OnSegment = NoSegment, class OnPiece = NoSegment>
-    int walk(const Sc& sc, VertexT<Sc>* path, int count, int max_vertices, Ray ray, int medium, float pdf_dir,
-             typename Sc::Spectrum beta, const typename Sc::Spectral::Wavelengths& lambda, int channel, R& rng,
-             C& counter, OnHit on_hit, Status& status, const EqRegion* eq, bool camera_side,
-             OnEmission on_emission = {}, OnSegment on_segment = {}, OnPiece on_piece = {},
-             FirstSegment<Sc>* first = nullptr) const;
-    /// One walk's state and its steps (bdpt_walk.hpp).
+    /// A subpath's walk (bdpt_walk.hpp): its state and its steps.
     template <class Sc, class R, class C>
     struct SubpathWalk;
 

@@ -339,6 +339,14 @@ struct BdptEstimator<Mis, H, A, MaxDepth, Ch>::BdptSample {
         else return bdpt::NoGamma{};
     }
 
+    /// The walk of a subpath from path[0] (the camera or y_0) along `ray`, in `medium`, with
+    /// direction density `pdf_dir` and throughput `beta` (SubpathWalk).
+    SubpathWalk<Sc, R, C> subpath(V* path, int max_vertices, const Ray& ray, int medium, float pdf_dir,
+                                  const Spectrum& beta, bool camera_side, FirstSegment<Sc>* first = nullptr) {
+        return {est, sc, path, 1, max_vertices, ray, medium, pdf_dir, beta, lambda, channel, rng, counter, status, eq,
+                camera_side, first};
+    }
+
     // ---- The camera subpath and the strategies that run while it is tracked -----------------
 
     /// Tracks the camera subpath from camera_ray; s = 0 (hit_emitter, emission_collision), the
@@ -372,11 +380,11 @@ struct BdptEstimator<Mis, H, A, MaxDepth, Ch>::BdptSample {
                                    const Spectrum& beta, const P& nulls_before, const auto& gamma) -> float {
                 return segment(path, count, ray, medium, t_max, pdf_dir, beta, nulls_before, gamma);
             };
-            nc = est.walk(sc, camera, 1, depth + 2, camera_ray, sc.camera_medium, camera_pdf, Spectrum::Ones(), lambda,
-                          channel, rng, counter, on_hit, status, eq, true, on_emission, on_segment, on_piece);
+            nc = subpath(camera, depth + 2, camera_ray, sc.camera_medium, camera_pdf, Spectrum::Ones(), true)
+                     .run(on_hit, on_emission, on_segment, on_piece);
         } else {
-            nc = est.walk(sc, camera, 1, depth + 2, camera_ray, sc.camera_medium, camera_pdf, Spectrum::Ones(), lambda,
-                          channel, rng, counter, on_hit, status, eq, true, NoEmission{}, on_segment);
+            nc = subpath(camera, depth + 2, camera_ray, sc.camera_medium, camera_pdf, Spectrum::Ones(), true)
+                     .run(on_hit, NoEmission{}, on_segment);
         }
     }
 

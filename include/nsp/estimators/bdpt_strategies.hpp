@@ -392,9 +392,9 @@ void BdptEstimator<Mis, H, A, MaxDepth, Ch>::BdptSample<Sc, Cam, R, C, Splat, Ob
         emit_y0 = q_volume * select * yv.pdf;
         y0.pdf_fwd = broadcast<P>(emit_y0);
         y0.beta = source / emit_y0;
-        nl = est.walk(sc, light, 1, light_vertices, Ray{yv.p, w}, i, kInv4Pi, Spectrum(y0.beta * (4.f * kPi)),
-                      lambda, channel, rng, counter, [](auto&&...) {}, status, eq, false, NoEmission{},
-                      NoSegment{}, NoSegment{}, seg_on ? &first_segment : nullptr);
+        nl = subpath(light, light_vertices, Ray{yv.p, w}, i, kInv4Pi, Spectrum(y0.beta * (4.f * kPi)), false,
+                     seg_on ? &first_segment : nullptr)
+                 .run([](auto&&...) {});
         nee_y0 = select * yv.pdf;
         if (seg_on && nl >= 2) {
             // y_0's piece seen from y_1: from the last surface between them (the walk's first
@@ -439,9 +439,9 @@ void BdptEstimator<Mis, H, A, MaxDepth, Ch>::BdptSample<Sc, Cam, R, C, Splat, Ob
     const int start = light_start_medium(sc, e.emission.p, e.emission.w);
     if (start == -3) status = Status::InvalidInput;
     else
-        nl = est.walk(sc, light, 1, light_vertices, Ray{e.emission.p, e.emission.w}, start, e.emission.pdf_dir,
-                      Spectrum(y0.beta * (e.emission.cos / e.emission.pdf_dir)), lambda, channel, rng, counter,
-                      [](auto&&...) {}, status, eq, false);
+        nl = subpath(light, light_vertices, Ray{e.emission.p, e.emission.w}, start, e.emission.pdf_dir,
+                     Spectrum(y0.beta * (e.emission.cos / e.emission.pdf_dir)), false)
+                 .run([](auto&&...) {});
     if (nl >= 2) {
         const Vec3 d = y0.p - light[1].p;
         const float d2 = glm::dot(d, d);

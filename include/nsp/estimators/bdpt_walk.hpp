@@ -10,8 +10,11 @@
 
 namespace nsp {
 
-/// One walk (see walk): the subpath it extends, the segment it is on and, per channel, that
-/// segment's tracking state.
+/// A subpath's walk from path[count - 1] (see trace): the subpath it extends, the segment it is
+/// on and, per channel, that segment's tracking state. With `eq` (the equiangular strategy on) it
+/// stores the strategy's densities: a camera subpath's (`camera_side`) at each medium vertex, a
+/// light subpath's at y_1. `first`, if given, receives the first segment's FirstSegment.
+/// BdptSample::subpath builds one from the sample's state.
 template <bdpt::MisPolicy Mis, mis::CombiningHeuristic H, AbsorptionPolicy A, int MaxDepth, bdpt::ChannelAxis Ch>
 template <class Sc, class R, class C>
 struct BdptEstimator<Mis, H, A, MaxDepth, Ch>::SubpathWalk {
@@ -67,9 +70,14 @@ struct BdptEstimator<Mis, H, A, MaxDepth, Ch>::SubpathWalk {
     }
 
     /// The walk: segments from path[count - 1] until the subpath has max_vertices vertices or
-    /// ends; returns its vertex count.
-    template <class OnHit, class OnEmission, class OnSegment, class OnPiece>
-    int run(OnHit& on_hit, OnEmission& on_emission, OnSegment& on_segment, OnPiece& on_piece) {
+    /// ends; returns its vertex count. `on_hit(path, count, hit, ray, nulls, beta, gamma)` where a
+    /// segment reaches an emitter or leaves the scene; `on_emission` at every tentative collision
+    /// in an emissive medium (EmissionVisitor, ChannelWalkVisit); `on_segment(path, count, ray,
+    /// medium, pdf_dir, beta)` at the start of every segment, before it is tracked; `on_piece(path,
+    /// count, ray, medium, t_max, pdf_dir, beta, nulls, gamma)` before every piece in a medium is
+    /// tracked, returning the segment technique's normaliser on it (which `on_emission` then gets).
+    template <class OnHit, class OnEmission = NoEmission, class OnSegment = NoSegment, class OnPiece = NoSegment>
+    int run(OnHit on_hit, OnEmission on_emission = {}, OnSegment on_segment = {}, OnPiece on_piece = {}) {
         bool segment_start = true;
         while (count < max_vertices) {
             if constexpr (!std::is_same_v<OnSegment, NoSegment>) {
@@ -276,18 +284,5 @@ struct BdptEstimator<Mis, H, A, MaxDepth, Ch>::SubpathWalk {
         return true;
     }
 };
-
-template <bdpt::MisPolicy Mis, mis::CombiningHeuristic H, AbsorptionPolicy A, int MaxDepth, bdpt::ChannelAxis Ch>
-template <class Sc, UniformRng R, LookupCounter C, class OnHit, class OnEmission, class OnSegment, class OnPiece>
-int BdptEstimator<Mis, H, A, MaxDepth, Ch>::walk(const Sc& sc, VertexT<Sc>* path, int count, int max_vertices,
-                                                 Ray ray, int medium, float pdf_dir, typename Sc::Spectrum beta,
-                                                 const typename Sc::Spectral::Wavelengths& lambda, int channel, R& rng,
-                                                 C& counter, OnHit on_hit, Status& status, const EqRegion* eq,
-                                                 bool camera_side, OnEmission on_emission, OnSegment on_segment,
-                                                 OnPiece on_piece, FirstSegment<Sc>* first) const {
-    SubpathWalk<Sc, R, C> w{*this, sc,      path,    count,  max_vertices, ray, medium, pdf_dir, beta, lambda, channel,
-                            rng,   counter, status,  eq,     camera_side,  first};
-    return w.run(on_hit, on_emission, on_segment, on_piece);
-}
 
 }  // namespace nsp
