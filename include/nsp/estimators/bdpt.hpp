@@ -67,6 +67,7 @@
 #include "../recorder.hpp"
 #include "../vertex.hpp"
 #include "emission.hpp"
+#include "nee.hpp"
 #include "bdpt_pdfs.hpp"
 #include "bdpt_vertex.hpp"
 #include "scene_walk.hpp"

@@ -245,72 +245,39 @@ struct BdptEstimator<Mis, H, A, MaxDepth, Ch>::BdptSample {
     /// The shadow walk along r up to `distance` from medium `start`. `end_medium`, if given,
     /// receives the medium the ray ends in.
     Shadow shadow(const Ray& r, float distance, int start, int* end_medium = nullptr) {
-        using namespace bdpt;
-        Shadow out;
         const auto sh = walk_shadow<P>(sc, r, start, WalkEnd{distance}, pieces());
-        out.status = sh.status;
-        if (sh.status != Status::Ok || !sh.reached) return out;
-        if (end_medium) *end_medium = sh.end_medium;
+        if (end_medium && sh.status == Status::Ok && sh.reached) *end_medium = sh.end_medium;
+        return as_shadow(sh);
+    }
+
+    /// A walk's or one piece's products (f, nee, uni, on one scale: walk_shadow) as a Shadow: per
+    /// channel f_lambda / p_c* and the nulls' P_n relative to the sampling channel's NEE density.
+    Shadow as_shadow(Status walked, bool reached, const Spectrum& f, const P& nee, const P& uni) const {
+        Shadow out;
+        out.status = walked;
+        if (walked != Status::Ok || !reached) return out;
         if constexpr (kPerChannel) {
             // A sampling channel's density below float's range beside another's: its weight is 0.
-            if (!(sh.f != 0.f).any() || !(sh.nee[channel] > 0.f)) return out;
-            out.tr = sh.f / sh.nee[channel];
-            out.nulls = (sh.nee > 0.f).select(sh.uni / sh.nee, 0.f);
-            out.gamma = relative_to_largest<Spectrum>(sh.nee);
+            if (!(f != 0.f).any() || !(nee[channel] > 0.f)) return out;
+            out.tr = f / nee[channel];
+            out.nulls = (nee > 0.f).select(uni / nee, 0.f);
+            out.gamma = relative_to_largest<Spectrum>(nee);
         } else {
-            out.tr = sh.f;
-            out.nulls = Mis::null_pdfs ? sh.uni : 1.f;
+            (void)nee;
+            out.tr = f;
+            out.nulls = Mis::null_pdfs ? uni : 1.f;
         }
         return out;
+    }
+
+    /// A shadow walk's (walk_shadow's) Shadow.
+    Shadow as_shadow(const ShadowWalk<P, typename Sc::Spectral>& sh) const {
+        return as_shadow(sh.status, sh.reached, sh.f, sh.nee, sh.uni);
     }
 
     /// shadow_piece as the callable walk_shadow takes.
     auto pieces() {
         return [this](int m, const Ray& r, float t_max, const Spectrum& f) { return shadow_piece(m, r, t_max, f); };
-    }
-
-    /// A shadow ray toward a point drawn in emitting medium `target` (NEE toward the volume): its
-    /// throughput, nulls and shared factors as `shadow`'s, whether it reached the point inside
-    /// `target`, the point's piece (the point is last.at(t_last)) and, with the segment technique
-    /// on, the P_n of the nulls on the pieces before the point's and the technique's normaliser W
-    /// on the point's piece.
-    struct EmissionShadowT {
-        Status status = Status::Ok;
-        bool reached = false;
-        Spectrum tr = Spectrum::Zero();
-        P nulls = bdpt::broadcast<P>(1.f);
-        P nulls_before = bdpt::broadcast<P>(1.f);
-        GammaT gamma = bdpt::unit_gamma<P>();
-        Ray last{};
-        float t_last = 0.f;
-        float along = 0.f;
-    };
-    EmissionShadowT shadow_to_emission(const Ray& r, float distance, int start, int target) {
-        EmissionShadowT out;
-        if constexpr (!kEmissive) {
-            (void)r, (void)distance, (void)start, (void)target;
-        } else {
-            const auto sh = walk_shadow<P>(sc, r, start, WalkEnd{distance, target, false, seg_on}, pieces());
-            out.status = sh.status;
-            if (sh.status != Status::Ok || !sh.reached || !(sh.f != 0.f).any()) return out;
-            if constexpr (kPerChannel) {
-                if (!(sh.nee[channel] > 0.f)) return out;
-                out.tr = sh.f / sh.nee[channel];
-                out.nulls = (sh.nee > 0.f).select(sh.uni / sh.nee, 0.f);
-                // sh.seg is uni of the pieces before the point's times nee of its own.
-                out.nulls_before = (sh.nee > 0.f).select(sh.seg / sh.nee, 0.f);
-                out.gamma = relative_to_largest<Spectrum>(sh.nee);
-            } else {
-                out.tr = sh.f;
-                out.nulls = Mis::null_pdfs ? sh.uni : 1.f;
-                out.nulls_before = Mis::null_pdfs ? sh.seg : 1.f;
-            }
-            out.reached = true;
-            out.last = sh.last;
-            out.t_last = sh.t_last;
-            out.along = sh.along;
-        }
-        return out;
     }
 
     /// Transmittance of a connection a -> b through the scene, with its nulls' P_n product and

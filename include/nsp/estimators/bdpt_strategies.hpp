@@ -202,33 +202,23 @@ float BdptEstimator<Mis, H, A, MaxDepth, Ch>::BdptSample<Sc, Cam, R, C, Splat, O
         (void)path;  // camera[], which emission_path_pdfs reads
         const int t = count + 1;
         if (!seg_on || t - 2 > depth) return 0.f;
-        const auto& m = sc.media[std::size_t(medium)];
-        const float along = m.medium.emission_along(ray, 0.f, t_max);
-        if (!(along > 0.f) || !draw_technique(seg_count, rng)) return along;
         // Its work is a fixed technique's to the learner: it runs whatever the learned counts.
         const double before = detail::recorder_work(counter);
-        const DistanceSample ds = m.medium.sample_emission_along(ray, 0.f, t_max, along, rng.uniform());
-        if (!(ds.pdf > 0.f && ds.t > 0.f)) return along;
-        const Shadow sh = shadow(ray, ds.t, medium);
+        const auto d = draw_segment<P>(
+            sc, medium, ray, t_max, seg_count,
+            [&](const Ray& r, float t_y) { return shadow_piece(medium, r, t_y, Spectrum::Ones()); }, lambda, rng, counter);
+        if (d.ran) detail::record_shadow_walk(counter, before, false);
+        const Shadow sh = as_shadow(d.status, true, d.piece.f, d.piece.nee, d.piece.uni);
         if (sh.status != Status::Ok) status = sh.status;
-        const auto c = sh.status == Status::Ok && (sh.tr != 0.f).any()
-                           ? detail::lookup_untracked(m.medium, m.majorant, ray, ds.t, lambda, counter)
-                           : std::nullopt;
-        detail::record_shadow_walk(counter, before, false);
-        if (sh.status != Status::Ok || !(sh.tr != 0.f).any()) return along;
-        if (!c) {
-            status = Status::Rejected;
-            return along;
-        }
-        if (!(c->k.sigma_a > 0.f).any()) return along;
-        const Vec3 y = ray.at(ds.t);
-        const Spectrum le = m.medium.emission(y, lambda);
-        if (!(le > 0.f).any()) return along;
-        const Spectrum f = beta * sh.tr * c->k.sigma_a * le / (seg_count * ds.pdf);
-        if (emission_path_pdfs(count, medium, y, P(nulls_before * sh.nulls), majorants<P>(c->mu), pdf_dir,
-                               nulls_before, along, path_gamma(gamma, sh.gamma)))
+        if (!d.drawn || !(sh.tr != 0.f).any()) return d.along;
+        const Vec3 y = ray.at(d.distance.t);
+        const Spectrum le = sc.media[std::size_t(medium)].medium.emission(y, lambda);
+        if (!(le > 0.f).any()) return d.along;
+        const Spectrum f = beta * sh.tr * d.c.k.sigma_a * le / (seg_count * d.distance.pdf);
+        if (emission_path_pdfs(count, medium, y, P(nulls_before * sh.nulls), majorants<P>(d.c.mu), pdf_dir,
+                               nulls_before, d.along, path_gamma(gamma, sh.gamma)))
             add(kSeg, t, f, pdfs, y, false, true);
-        return along;
+        return d.along;
     } else {
         (void)path, (void)count, (void)ray, (void)medium, (void)t_max, (void)pdf_dir, (void)beta,
             (void)nulls_before, (void)gamma;
@@ -244,22 +234,22 @@ void BdptEstimator<Mis, H, A, MaxDepth, Ch>::BdptSample<Sc, Cam, R, C, Splat, Ob
     using namespace bdpt;
     const V& z = camera[t - 1];
     const float count = from_eq ? 1.f : nee_count;
-    const double before = detail::recorder_work(counter);
-    const float u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
-    const SampledLight<typename Sc::Spectral> ls = sc.lights.sample(z.p, u0, u1, u2, lambda);
-    if (!(ls.sample.pdf > 0.f)) return;
+    const auto d = draw_light_nee<P>(
+        sc, SceneVertex{z.material, z.medium, z.ns}, z.p, z.wo, [&](const Vec3& wi) { return z.medium_toward(wi); },
+        [&](int m, const Ray& r, float t_max, const Spectrum& f, bool) { return shadow_piece(m, r, t_max, f); },
+        !from_eq, lambda, rng, counter);
+    if (!d) return;
+    const Shadow sh = as_shadow(d->walk);
+    if (sh.status != Status::Ok) status = sh.status;
+    if (sh.status != Status::Ok || !(sh.tr != 0.f).any()) return;
+    const SampledLight<typename Sc::Spectral>& ls = d->light;
+    const auto& fz = d->vertex;
     const Vec3 w = ls.sample.wi;
-    const auto fz = eval_at(z, z.wo, w);
-    if (!(fz.value != 0.f).any()) return;
     V y0;
     y0.kind = VertexKind::Light;
     y0.delta_position = ls.sample.delta;
     const bool at_infinity = !std::isfinite(ls.sample.distance);
     y0.p = at_infinity ? z.p : z.p + ls.sample.distance * w;
-    const Shadow sh = shadow(Ray{z.p, w}, ls.sample.distance, z.medium_toward(w));
-    detail::record_shadow_walk(counter, before, !from_eq);
-    if (sh.status != Status::Ok) status = sh.status;
-    if (sh.status != Status::Ok || !(sh.tr != 0.f).any()) return;
     const P& nulls = sh.nulls;
     const Spectrum f = z.beta * fz.value * sh.tr * ls.sample.radiance / (count * ls.sample.pdf);
     gather(0, t, t);  // camera[0..t-1]; the light point is x_0
@@ -304,37 +294,37 @@ void BdptEstimator<Mis, H, A, MaxDepth, Ch>::BdptSample<Sc, Cam, R, C, Splat, Ob
     if constexpr (kEmissive) {
         const V& z = camera[t - 1];
         if (!has_volume) return;
-        const auto e = detail::draw_emission_point(sc, z.p, rng);
-        if (!e) return;
-        const auto& m = sc.media[std::size_t(e->index)];
-        const auto fz = eval_at(z, z.wo, e->wi);
-        if (!(fz.value != 0.f).any()) return;
-        const EmissionShadowT sh = shadow_to_emission(Ray{z.p, e->wi}, e->dist, z.medium_toward(e->wi), e->index);
-        if (sh.status != Status::Ok) status = sh.status;
-        if (!(sh.status == Status::Ok && sh.reached && (sh.tr != 0.f).any())) return;
-        const auto c = detail::lookup_untracked(m.medium, m.majorant, sh.last, sh.t_last, lambda, counter);
-        if (!c) {
-            status = Status::Rejected;
-            return;
-        }
-        if (!((c->k.sigma_a > 0.f).any() && majorant_at(c->mu, channel) > 0.f)) return;
-        const float p_v = e->select * e->y.pdf;
-        const Spectrum f =
-            z.beta * fz.value * sh.tr * c->k.sigma_a * m.medium.emission(e->y.p, lambda) / (e->dist2 * p_v);
+        const auto d = draw_volume_nee<P>(
+            sc, SceneVertex{z.material, z.medium, z.ns}, z.p, z.wo, [&](const Vec3& wi) { return z.medium_toward(wi); },
+            seg_on, pieces(), lambda, rng, counter);
+        if (d.status != Status::Ok) status = d.status;
+        const Shadow sh = as_shadow(d.walk);
+        if (!d.drawn || !(sh.tr != 0.f).any() || !(majorant_at(d.c.mu, channel) > 0.f)) return;
+        const detail::EmissionPoint& e = d.point;
+        const float p_v = e.select * e.y.pdf;
+        const Spectrum f = z.beta * d.vertex.value * sh.tr * d.c.k.sigma_a *
+                           sc.media[std::size_t(e.index)].medium.emission(e.y.p, lambda) / (e.dist2 * p_v);
         const P& nulls = sh.nulls;
+        // The segment technique's P_n of the nulls before the point's piece: uni of the pieces
+        // before it times nee of its own (walk_shadow's seg), relative as sh.nulls.
+        P nulls_before;
+        if constexpr (kPerChannel)
+            nulls_before = (d.walk.nee > 0.f).select(d.walk.seg / d.walk.nee, 0.f);
+        else
+            nulls_before = Mis::null_pdfs ? d.walk.seg : 1.f;
         gather(0, t, t);  // camera[0..t-1]; the emission point is x_0
         if constexpr (kPerChannel) pdfs.gamma = path_gamma(z.gamma, sh.gamma);
-        pdfs.from_camera[0] = fz.pdf / e->dist2 * nulls * majorants<P>(c->mu);
-        pdfs.seg = seg_density(fz.pdf / e->dist2, sh.nulls_before, e->y.pdf, sh.along);
+        pdfs.from_camera[0] = d.vertex.pdf / e.dist2 * nulls * majorants<P>(d.c.mu);
+        pdfs.seg = seg_density(d.vertex.pdf / e.dist2, nulls_before, e.y.pdf, d.walk.along);
         pdfs.nee = p_v;
         pdfs.emit = q_volume * p_v;
-        pdfs.from_light[1] = to_vertex_measure(kInv4Pi, e->y.p, z) * nulls * z.event;
+        pdfs.from_light[1] = to_vertex_measure(kInv4Pi, e.y.p, z) * nulls * z.event;
         if (t >= 3) {
             const V& z2 = camera[t - 2];
             pdfs.from_light[2] =
-                to_vertex_measure(eval_at(z, -e->wi, -z.wo).pdf, z.p, z2) * z.nulls_in * z2.event;
+                to_vertex_measure(eval_at(z, -e.wi, -z.wo).pdf, z.p, z2) * z.nulls_in * z2.event;
         }
-        add(1, t, f, pdfs, e->y.p, false, true);
+        add(1, t, f, pdfs, e.y.p, false, true);
     } else {
         (void)t;
     }

@@ -64,7 +64,56 @@ std::optional<EmissionPoint> draw_emission_point(const Sc& sc, const Vec3& x, R&
     return e;
 }
 
+/// The lookup at an emission point y = ray.at(t) that a technique drew and reached (the draw d,
+/// a SegmentDraw or VolumeDraw, in medium entry m): d.c, d.drawn where y emits (sigma_a > 0),
+/// or d.status Rejected (detail::lookup_untracked).
+template <class D, class Entry, class W, LookupCounter C>
+void look_up_emission_point(D& d, const Entry& m, const Ray& ray, float t, const W& lambda, C& counter) {
+    const auto c = lookup_untracked(m.medium, m.majorant, ray, t, lambda, counter);
+    if (!c) {
+        d.status = Status::Rejected;
+        return;
+    }
+    d.c = *c;
+    d.drawn = (c->k.sigma_a > 0.f).any();
+}
+
 }  // namespace detail
+
+/// The segment technique's draw on the piece `ray` over [0, t_max) through emissive medium
+/// `index`, which the path state's kernel below and BDPT's segment strategy share: W on the piece
+/// (`along`; 0: the technique does not run there); whether it ran there (`ran`, with the expected
+/// count `count`, THEORY 5.9); the point y = ray.at(distance.t) drawn by the power grid along the
+/// piece, the nulls before it tracked by `piece(ray, t)` (a ShadowPiece through the medium) and
+/// the lookup at y. `drawn`: y was reached with sigma_a > 0 there; `status` a failed flight's, or
+/// Rejected.
+template <class P, SpectralMode S, class U>
+struct SegmentDraw {
+    Status status = Status::Ok;
+    float along = 0.f;
+    bool ran = false;  ///< the technique ran on the piece (its work is recorded)
+    bool drawn = false;
+    DistanceSample distance;
+    ShadowPiece<P, S> piece;
+    U c{};
+};
+
+template <class P, class Sc, class Piece, UniformRng R, LookupCounter C>
+auto draw_segment(const Sc& sc, int index, const Ray& ray, float t_max, float count, Piece&& piece,
+                  const typename Sc::Spectral::Wavelengths& lambda, R& rng, C& counter) {
+    const auto& m = sc.media[std::size_t(index)];
+    SegmentDraw<P, typename Sc::Spectral, detail::SceneUntracked<Sc>> d;
+    d.along = m.medium.emission_along(ray, 0.f, t_max);
+    if (!(d.along > 0.f) || !draw_technique(count, rng)) return d;
+    d.ran = true;
+    d.distance = m.medium.sample_emission_along(ray, 0.f, t_max, d.along, rng.uniform());
+    if (!(d.distance.pdf > 0.f && d.distance.t > 0.f)) return d;
+    d.piece = piece(ray, d.distance.t);
+    d.status = d.piece.status;
+    if (d.status != Status::Ok || !(d.piece.f != 0.f).any()) return d;
+    detail::look_up_emission_point(d, m, ray, d.distance.t, lambda, counter);
+    return d;
+}
 
 /// The segment technique on the piece `ray` over [0, t_max) through emissive medium `index`
 /// (combining strategies, EstimatorOptions::emission_along_segments): y drawn with the expected
@@ -86,38 +135,65 @@ float emission_segment(const State& st, const Sc& sc, int index, const Ray& ray,
         const auto& m = sc.media[std::size_t(index)];
         const EstimatorOptions& opts = st.options();
         if (!opts.emission_along_segments) return 0.f;
-        const float along = m.medium.emission_along(ray, 0.f, t_max);
-        // With the expected count EstimatorOptions::emission_segment_count (THEORY 5.9).
-        if (!(along > 0.f) || !draw_technique(opts.emission_segment_count, rng)) return along;
         const double before = detail::recorder_work(counter);
-        const DistanceSample ds = m.medium.sample_emission_along(ray, 0.f, t_max, along, rng.uniform());
-        if (ds.pdf > 0.f) {
-            const auto piece = st.shadow_piece(m.medium, m.majorant, ray, ds.t, st.walk_weights(), true, lambda, rng,
-                                               counter);
-            if (piece.status != Status::Ok) {
-                status = piece.status;
-            } else if ((piece.f != 0.f).any()) {
-                const auto v = detail::lookup_untracked(m.medium, m.majorant, ray, ds.t, lambda, counter);
-                if (!v) {
-                    status = Status::Rejected;
-                } else if ((v->k.sigma_a > 0.f).any()) {
-                    const Vec3 y = ray.at(ds.t);
-                    EmissionPoint<P, S, ShadowPiece<P, S>> e;
-                    e.source = v->k.sigma_a * m.medium.emission(y, lambda);
-                    e.mu_bar = detail::majorant_as<P>(v->mu);
-                    e.p_v = m.medium.emission_pdf(y);  // at the point's own cell, as every technique evaluates it
-                    e.select = St::samples_lights ? sc.emission_selection_pdf(index) : 0.f;
-                    e.along = along;
-                    e.distance = ds.t;
-                    e.sampled_pdf = ds.pdf;
-                    e.walk = piece;
-                    L += st.add_segment(e, counter);
-                }
-            }
+        const auto d = draw_segment<P>(
+            sc, index, ray, t_max, opts.emission_segment_count,
+            [&](const Ray& r, float t) {
+                return detail::state_shadow_piece(st, sc, index, r, t, st.walk_weights(), true, lambda, rng, counter);
+            },
+            lambda, rng, counter);
+        if (d.status != Status::Ok) status = d.status;
+        if (d.drawn) {
+            const Vec3 y = ray.at(d.distance.t);
+            EmissionPoint<P, S, ShadowPiece<P, S>> e;
+            e.source = d.c.k.sigma_a * m.medium.emission(y, lambda);
+            e.mu_bar = detail::majorant_as<P>(d.c.mu);
+            e.p_v = m.medium.emission_pdf(y);  // at the point's own cell, as every technique evaluates it
+            e.select = St::samples_lights ? sc.emission_selection_pdf(index) : 0.f;
+            e.along = d.along;
+            e.distance = d.distance.t;
+            e.sampled_pdf = d.distance.pdf;
+            e.walk = d.piece;
+            L += st.add_segment(e, counter);
         }
-        detail::record_segment_walk(counter, before);
-        return along;
+        if (d.ran) detail::record_segment_walk(counter, before);
+        return d.along;
     }
+}
+
+/// NEE's draw toward the emitting volume, which the path state's kernel below and BDPT's volume
+/// NEE share: the point (detail::draw_emission_point, five random numbers), the vertex's value
+/// and pdf toward it, the shadow walk to it (each medium tracked by `piece(medium_index, ray,
+/// t_max, f_so_far)`, a ShadowPiece; W on the point's piece where `with_along`) and the lookup at
+/// the point. `drawn`: the point was reached inside its medium with sigma_a > 0 there; `status` a
+/// failed walk's or Rejected.
+template <class P, SpectralMode S, class U>
+struct VolumeDraw {
+    Status status = Status::Ok;
+    bool drawn = false;
+    detail::EmissionPoint point;
+    VertexDirection<S> vertex;
+    ShadowWalk<P, S> walk;
+    U c{};
+};
+
+template <class P, class Sc, class StartMedium, class Piece, UniformRng R, LookupCounter C>
+auto draw_volume_nee(const Sc& sc, const SceneVertex& v, const Vec3& x, const Vec3& wo, StartMedium&& start_medium,
+                     bool with_along, Piece&& piece, const typename Sc::Spectral::Wavelengths& lambda, R& rng,
+                     C& counter) {
+    VolumeDraw<P, typename Sc::Spectral, detail::SceneUntracked<Sc>> d;
+    const auto point = detail::draw_emission_point(sc, x, rng);
+    if (!point) return d;
+    d.point = *point;
+    const auto& m = sc.media[std::size_t(point->index)];
+    d.vertex = eval_vertex(sc, v, wo, point->wi, lambda);
+    if (!(d.vertex.value != 0.f).any()) return d;
+    d.walk = walk_shadow<P>(sc, Ray{x, point->wi}, start_medium(point->wi),
+                            WalkEnd{point->dist, point->index, false, with_along}, piece);
+    d.status = d.walk.status;
+    if (d.status != Status::Ok || !d.walk.reached || !(d.walk.f != 0.f).any()) return d;
+    detail::look_up_emission_point(d, m, d.walk.last, d.walk.t_last, lambda, counter);
+    return d;
 }
 
 /// NEE toward the emitting volume from real vertex v at x (arrived along wo; `x_rec` its record,
@@ -131,33 +207,22 @@ Status volume_nee(const State& st, const Sc& sc, const SceneVertex& v, const Vec
     using P = typename State::P;
     using S = typename Sc::Spectral;
     using Spectrum = typename Sc::Spectrum;
-    const auto point = detail::draw_emission_point(sc, x, rng);
-    if (!point) return Status::Ok;
-    const auto& m = sc.media[std::size_t(point->index)];
-    const auto fv = eval_vertex(sc, v, wo, point->wi, lambda);
-    if (!(fv.value != 0.f).any()) return Status::Ok;
-    const bool with_along = St::combines && st.options().emission_along_segments;
-    const auto walk = walk_shadow<P>(
-        sc, Ray{x, point->wi}, start_medium(point->wi), WalkEnd{point->dist, point->index, false, with_along},
-        [&](int i, const Ray& r, float t_max, const Spectrum& f) {
-            const auto& med = sc.media[std::size_t(i)];
-            return st.shadow_piece(med.medium, med.majorant, r, t_max, Spectrum(x_rec.f * f), true, lambda, rng,
-                                   counter);
-        });
-    if (walk.status != Status::Ok) return walk.status;
-    if (!walk.reached || !(walk.f != 0.f).any()) return Status::Ok;
-    const auto c = detail::lookup_untracked(m.medium, m.majorant, walk.last, walk.t_last, lambda, counter);
-    if (!c) return Status::Rejected;
-    if (!(c->k.sigma_a > 0.f).any()) return Status::Ok;
+    const auto d = draw_volume_nee<P>(
+        sc, v, x, wo, start_medium, St::combines && st.options().emission_along_segments,
+        [&](int m, const Ray& r, float t_max, const Spectrum& f) {
+            return detail::state_shadow_piece(st, sc, m, r, t_max, Spectrum(x_rec.f * f), true, lambda, rng, counter);
+        },
+        lambda, rng, counter);
+    if (!d.drawn) return d.status;
     EmissionPoint<P, S> e;
-    e.source = c->k.sigma_a * m.medium.emission(point->y.p, lambda);
-    e.mu_bar = detail::majorant_as<P>(c->mu);
-    e.p_v = point->y.pdf;
-    e.select = point->select;
-    e.along = walk.along;
-    e.distance = point->dist;
-    e.walk = walk;
-    L += st.add_volume_nee(x_rec, fv.value, fv.pdf, e, counter);
+    e.source = d.c.k.sigma_a * sc.media[std::size_t(d.point.index)].medium.emission(d.point.y.p, lambda);
+    e.mu_bar = detail::majorant_as<P>(d.c.mu);
+    e.p_v = d.point.y.pdf;
+    e.select = d.point.select;
+    e.along = d.walk.along;
+    e.distance = d.point.dist;
+    e.walk = d.walk;
+    L += st.add_volume_nee(x_rec, d.vertex.value, d.vertex.pdf, e, counter);
     return Status::Ok;
 }
 

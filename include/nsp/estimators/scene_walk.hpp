@@ -12,6 +12,7 @@
 #include <type_traits>
 
 #include "../core/counter.hpp"
+#include "../core/rng.hpp"
 #include "../geometry.hpp"
 #include "../media/emissive.hpp"
 #include "../path_state.hpp"
@@ -118,6 +119,20 @@ struct UntrackedVertex {
     Coefficients<typename M::Spectral> k;  ///< the lookup, clamped to the majorant under bound::Clamp
     MajorantValue<Maj, M> mu;              ///< the majorant there (grey or per channel)
 };
+
+/// Path state st's piece of a shadow walk through medium m of SurfaceScene sc (State::shadow_piece
+/// with the walk's weights f and whether tracking's null pdfs are wanted, `uni`).
+template <class State, class Sc, UniformRng R, LookupCounter C>
+auto state_shadow_piece(const State& st, const Sc& sc, int m, const Ray& r, float t_max,
+                        const typename Sc::Spectrum& f, bool uni, const typename Sc::Spectral::Wavelengths& lambda,
+                        R& rng, C& counter) {
+    const auto& med = sc.media[std::size_t(m)];
+    return st.shadow_piece(med.medium, med.majorant, r, t_max, f, uni, lambda, rng, counter);
+}
+
+/// An UntrackedVertex of SurfaceScene Sc's media.
+template <class Sc>
+using SceneUntracked = UntrackedVertex<typename Sc::MediumType, typename Sc::MajorantType>;
 
 /// One density lookup (counted) at distance t on `ray` with the majorant there, treated as
 /// free_flight treats its lookups: clamped under bound::Clamp; std::nullopt under bound::Reject
