@@ -231,6 +231,47 @@ TEST_CASE("bdpt: nested media behind null interfaces, the camera outside and ins
     });
 }
 
+TEST_CASE("bdpt: a surface that keeps the medium (kSameMedium), a null interface and an opaque ball") {
+    // As the path tracer's test: exp(-1) from z = -3, exp(-0.5) from the sphere's centre.
+    Sc sc = sphere_keeping_medium();
+    for_each_bdpt([&](const auto& est, const char* name) {
+        CAPTURE(std::string(name));
+        const Stat outside = estimate(est, sc, 4000, 3, [](Pcg32&) { return Ray{Vec3(0.f, 0.f, -3.f), Vec3(0.f, 0.f, 1.f)}; });
+        CAPTURE(outside.mean);
+        CHECK(std::abs(outside.mean - std::exp(-1.0)) <= kSigmas * outside.se() + 1e-6);
+        sc.camera_medium = 0;
+        const Stat inside = estimate(est, sc, 4000, 4, [](Pcg32&) { return Ray{Vec3(0.f), Vec3(0.f, 0.f, 1.f)}; });
+        sc.camera_medium = -1;
+        CAPTURE(inside.mean);
+        CHECK(std::abs(inside.mean - std::exp(-0.5)) <= kSigmas * inside.se() + 1e-6);
+    });
+    // The opaque ball named or kept: the same paths, the same estimate to the last bit.
+    const Sc named = cube_with_ball(false), kept = cube_with_ball(true);
+    for_each_bdpt([&](const auto& est, const char* name) {
+        CAPTURE(std::string(name));
+        const Stat a = estimate(est, named, 1000, 23, cube_camera);
+        const Stat b = estimate(est, kept, 1000, 23, cube_camera);
+        CHECK(a.mean > 0.0);
+        CHECK(a.mean == b.mean);
+        CHECK(a.se() == b.se());
+    });
+    // A light subpath's first medium: inside the kept sphere, medium 0 beyond it; outside a sphere
+    // that keeps its outside and holds medium 0 inside, the box's medium 0 behind the point; with
+    // nothing but kept surfaces on the line, vacuum.
+    CHECK(bdpt::light_start_medium(sc, Vec3(0.f), Vec3(0.f, 0.f, 1.f)) == 0);
+    Shapes shapes;
+    shapes.boxes.push_back({Vec3(-1.f), Vec3(1.f), {-1, -1, 0, -1}});
+    shapes.spheres.push_back({Vec3(0.f), 0.5f, {-1, -1, 0, kSameMedium}});
+    const Sc holder(shapes, {medium(Box{Vec3(-1.f), Vec3(1.f)}, 0.5f, 0.f)}, materials(),
+                    Ls(LightSelection::Uniform, 3.f, {}, {EnvironmentLight<S>{Spectrum::Constant(1.f)}}), -1);
+    CHECK(bdpt::light_start_medium(holder, Vec3(0.f, 0.f, -0.75f), Vec3(0.f, 0.f, 1.f)) == 0);
+    Shapes loose;
+    loose.spheres.push_back({Vec3(0.f), 0.5f, {-1, -1, kSameMedium, kSameMedium}});
+    const Sc open(loose, {}, materials(), Ls(LightSelection::Uniform, 3.f, {}, {EnvironmentLight<S>{Spectrum::Constant(1.f)}}),
+                  -1);
+    CHECK(bdpt::light_start_medium(open, Vec3(0.f), Vec3(1.f, 0.f, 0.f)) == -1);
+}
+
 TEST_CASE("bdpt: a mirror behind an absorbing slab reflects the light behind the camera") {
     // L = 0.5 exp(-0.4 x 2) Le: a delta vertex, reached by the camera subpath alone.
     Shapes shapes;

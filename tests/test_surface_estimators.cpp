@@ -110,6 +110,34 @@ TEST_CASE("surface estimators: nested media behind null interfaces, the camera o
     });
 }
 
+TEST_CASE("surface estimators: a surface that keeps the medium (kSameMedium), a null interface and an opaque ball") {
+    // The sphere inside the absorbing box keeps medium 0 on both sides: L = exp(-0.5 x 2) from
+    // z = -3, exp(-0.5) from its centre (camera in medium 0), as if it were not there.
+    Sc sc = sphere_keeping_medium();
+    for_each_strategy([&](const auto& est, const char* name) {
+        CAPTURE(std::string(name));
+        const Stat outside = estimate(est, sc, 20000, 3, [](Pcg32&) { return Ray{Vec3(0.f, 0.f, -3.f), Vec3(0.f, 0.f, 1.f)}; });
+        CAPTURE(outside.mean);
+        CHECK(std::abs(outside.mean - std::exp(-1.0)) <= kSigmas * outside.se() + 1e-6);
+        sc.camera_medium = 0;
+        const Stat inside = estimate(est, sc, 20000, 4, [](Pcg32&) { return Ray{Vec3(0.f), Vec3(0.f, 0.f, 1.f)}; });
+        sc.camera_medium = -1;
+        CAPTURE(inside.mean);
+        CHECK(std::abs(inside.mean - std::exp(-0.5)) <= kSigmas * inside.se() + 1e-6);
+    });
+    // An opaque ball in the scattering cube, its media named or kept: one scene, the same paths,
+    // so the same estimate to the last bit (a side resolved to another medium would change it).
+    const Sc named = cube_with_ball(false), kept = cube_with_ball(true);
+    for_each_strategy([&](const auto& est, const char* name) {
+        CAPTURE(std::string(name));
+        const Stat a = estimate(est, named, 4000, 23, cube_camera);
+        const Stat b = estimate(est, kept, 4000, 23, cube_camera);
+        CHECK(a.mean > 0.0);
+        CHECK(a.mean == b.mean);
+        CHECK(a.se() == b.se());
+    });
+}
+
 TEST_CASE("surface estimators: a mirror behind an absorbing slab reflects the light behind the camera") {
     // Camera at z = -1 looking +z through a slab z in [0.5, 1.5] (sigma_a 0.4) at a mirror at z = 2
     // of reflectance 0.5; the ray comes back through the slab, past the camera, to a light at

@@ -14,6 +14,13 @@
 namespace nsp {
 
 /// What a ray reaches first among a host's surfaces.
+/// A SurfaceHit side's medium that the surface does not change: a ray crossing into that side
+/// keeps the medium it is in, and a path leaving a vertex there into that side stays in the
+/// medium it arrived in (an object inside a medium whose geometry does not name it, or a thin
+/// surface in one). On both sides: the surface bounds no medium. The estimators replace it by
+/// the ray's medium where the hit is found (SurfaceHit::keep_media).
+inline constexpr int kSameMedium = -2;
+
 struct SurfaceHit {
     float t = kInf;            ///< distance along the ray; kInf: nothing
     Vec3 p{0.f};               ///< the point
@@ -21,8 +28,8 @@ struct SurfaceHit {
     Vec3 ns{0.f, 0.f, 1.f};    ///< unit shading normal (what a BSDF is given)
     int material = -1;         ///< the host's BSDF at p; -1: none, an index-matched medium boundary
     int light = -1;            ///< the light emitting at p (e.g. a LightSampler index); -1: none
-    int medium_front = -1;     ///< the medium on the side ng points to; -1: vacuum
-    int medium_back = -1;      ///< the medium on the other side; -1: vacuum
+    int medium_front = -1;     ///< the medium on the side ng points to; -1: vacuum; kSameMedium
+    int medium_back = -1;      ///< the medium on the other side; -1: vacuum; kSameMedium
 
     bool found() const noexcept { return t < kInf; }
     /// A boundary a path crosses without a vertex: no BSDF and no light there.
@@ -31,6 +38,11 @@ struct SurfaceHit {
     int medium_entered(const Vec3& d) const noexcept { return glm::dot(d, ng) > 0.f ? medium_front : medium_back; }
     /// The medium a ray travelling along d was in before reaching p.
     int medium_left(const Vec3& d) const noexcept { return glm::dot(d, ng) > 0.f ? medium_back : medium_front; }
+    /// This hit's kSameMedium sides as `current`, the medium of the ray that found it.
+    void keep_media(int current) noexcept {
+        if (medium_front == kSameMedium) medium_front = current;
+        if (medium_back == kSameMedium) medium_back = current;
+    }
 };
 
 /// A host's geometry: `intersect(ray, t_max)` is the closest surface on (0, t_max) (t = kInf if

@@ -71,6 +71,19 @@ inline Sc nested_media() {
               materials(), Ls(LightSelection::Uniform, 3.f, {lamp}, {}), -1);
 }
 
+/// The nested media's box of absorbing medium 0 (sigma_a 0.5) with its sphere a null interface
+/// that keeps the medium on both sides (kSameMedium): medium 0 throughout, so L = exp(-1) from
+/// z = -3 toward the light and exp(-0.5) from the sphere's centre.
+inline Sc sphere_keeping_medium() {
+    Shapes shapes;
+    shapes.boxes.push_back({Vec3(-1.f), Vec3(1.f), {-1, -1, 0, -1}});
+    shapes.spheres.push_back({Vec3(0.f), 0.5f, {-1, -1, kSameMedium, kSameMedium}});
+    const QuadLight<S> lamp{Vec3(-2.f, -2.f, 2.f), Vec3(0.f, 4.f, 0.f), Vec3(4.f, 0.f, 0.f), Spectrum::Constant(1.f)};
+    shapes.quads.push_back({lamp.corner, lamp.edge_u, lamp.edge_v, {-1, 0, -1, -1}});
+    return Sc(shapes, {medium(Box{Vec3(-1.f), Vec3(1.f)}, 0.5f, 0.f)}, materials(), Ls(LightSelection::Uniform, 3.f, {lamp}, {}),
+              -1);
+}
+
 /// The scattering cube (albedo 0.8, HG 0.6, behind null interfaces) over a Lambertian floor,
 /// under a quad lamp (`lamp_size` on a side, its power that of 1.2 at radiance 12) and (when
 /// `sky`) a dim sky; the camera in front of it. `tight_majorant`: the cube's majorant is its
@@ -87,6 +100,16 @@ inline Sc cube_over_floor(bool sky, float lamp_size = 1.2f, bool tight_majorant 
     if (sky) env.push_back(EnvironmentLight<S>{Spectrum::Constant(0.05f)});
     return Sc(shapes, {medium(Box{Vec3(-1.f), Vec3(1.f)}, 0.3f, 1.2f, 0.6f, tight_majorant)}, materials(0.6f),
               Ls(LightSelection::Power, 4.f, {lamp}, env), -1);
+}
+
+/// The scattering cube of cube_over_floor holding an opaque Lambertian ball of radius 0.4: its
+/// media named (inside vacuum, outside the cube's medium 0) or, `keep`, kSameMedium on both
+/// sides. Paths reach only its outside, so both describe one scene and sample the same paths.
+inline Sc cube_with_ball(bool keep) {
+    Sc base = cube_over_floor(true);
+    Shapes shapes = base.geometry;
+    shapes.spheres.push_back({Vec3(0.f), 0.4f, {0, -1, keep ? kSameMedium : -1, keep ? kSameMedium : 0}});
+    return Sc(shapes, base.media, base.materials, base.lights, -1);
 }
 
 inline Ray cube_camera(Pcg32& rng) {

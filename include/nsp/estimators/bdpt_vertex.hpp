@@ -95,19 +95,30 @@ float from_infinity_measure(float pdf_perpendicular, const Vec3& w, const Vertex
 }
 
 /// The medium a light subpath starting at p along w is in (-3 where the host's hits cannot be
-/// used): the side of the first surface ahead that the ray leaves, else of the first surface
-/// behind it that faces p, else, where no surface lies on the whole line, the scene's unbounded
-/// region: the camera's medium when the geometry has no surface that bounds a medium (nsp::NoSurfaces, nsp::EmptySpace: media
-/// in empty space fill it), vacuum otherwise. The camera side's walks see the same media, so both
-/// sides of every connection agree.
+/// used): the side facing p of the first surface ahead that names it (across surfaces that bound
+/// no medium, kSameMedium on both sides), else likewise behind p, else the scene's unbounded
+/// region: the camera's medium when the geometry has no surface that bounds a medium
+/// (nsp::NoSurfaces, nsp::EmptySpace: media in empty space fill it), vacuum otherwise. A surface
+/// whose side facing p keeps the medium (kSameMedium) and whose other side names one says nothing
+/// of p's medium. The camera side's walks see the same media, so both sides of every connection
+/// agree.
 template <class Sc>
 int light_start_medium(const Sc& sc, const Vec3& p, const Vec3& w) noexcept {
-    const SurfaceHit ahead = sc.geometry.intersect(Ray{p, w}, kInf);
-    if (!detail::usable_hit(sc, ahead)) return -3;
-    if (ahead.found()) return ahead.medium_left(w);
-    const SurfaceHit behind = sc.geometry.intersect(Ray{p, -w}, kInf);
-    if (!detail::usable_hit(sc, behind)) return -3;
-    if (behind.found()) return behind.medium_left(-w);
+    constexpr int kUnknown = -4;
+    auto facing = [&](const Vec3& d) {
+        Ray r{p, d};
+        for (int crossing = 0; crossing <= detail::kMaxInterfaceCrossings; ++crossing) {
+            const SurfaceHit h = sc.geometry.intersect(r, kInf);
+            if (!detail::usable_hit(sc, h)) return -3;
+            if (!h.found()) return kUnknown;
+            if (const int left = h.medium_left(d); left != kSameMedium) return left;
+            if (h.medium_entered(d) != kSameMedium) return kUnknown;
+            r.o = h.p;  // a surface that bounds no medium: p's medium goes on beyond it
+        }
+        return -3;  // the host reports the same surface again and again
+    };
+    if (const int m = facing(w); m != kUnknown) return m;
+    if (const int m = facing(-w); m != kUnknown) return m;
     if constexpr (is_empty_space_v<typename Sc::GeometryType>) return sc.camera_medium;
     else return -1;
 }

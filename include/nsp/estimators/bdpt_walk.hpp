@@ -84,11 +84,12 @@ struct BdptEstimator<Mis, H, A, MaxDepth, Ch>::SubpathWalk {
                 if (segment_start) on_segment(path, count, ray, medium, pdf_dir, beta);
             }
             segment_start = false;
-            const SurfaceHit hit = sc.geometry.intersect(ray, kInf);
+            SurfaceHit hit = sc.geometry.intersect(ray, kInf);
             if (!detail::usable_hit(sc, hit)) {
                 status = Status::InvalidInput;
                 return count;
             }
+            hit.keep_media(medium);
             if (first && count == 1 && crossings == 0) first->first_piece_end = hit.t;
             V v;
             // The segment technique's normaliser on this piece (0: it does not run here).

@@ -82,6 +82,7 @@ RadianceSample<typename Sc::Spectral> trace_path(const K& k, const Sc& sc, const
                 status = Status::InvalidInput;
                 break;
             }
+            hit.keep_media(medium);
         }
         bool in_medium = false;
         float t_medium = 0.f;

@@ -28,7 +28,7 @@ inline constexpr int kMaxInterfaceCrossings = 256;
 
 /// Whether a hit from the host's geometry is one the estimator can use: a distance that is not
 /// NaN or negative, and where something was found a finite point, unit normals and handles
-/// inside the scene's tables.
+/// inside the scene's tables (a medium, -1 or kSameMedium on each side).
 template <class Sc>
 bool usable_hit(const Sc& sc, const SurfaceHit& h) noexcept {
     if (std::isnan(h.t) || h.t < 0.f) return false;
@@ -36,7 +36,7 @@ bool usable_hit(const Sc& sc, const SurfaceHit& h) noexcept {
     if (!finite(h.p) || !unit_length(h.ng) || !unit_length(h.ns)) return false;
     if (h.material != -1 && !sc.materials.contains(h.material)) return false;
     if (h.light != -1 && !(h.light >= 0 && h.light < sc.lights.count())) return false;
-    auto medium_ok = [&](int m) { return m == -1 || sc.has_medium(m); };
+    auto medium_ok = [&](int m) { return m == -1 || m == kSameMedium || sc.has_medium(m); };
     return medium_ok(h.medium_front) && medium_ok(h.medium_back);
 }
 
@@ -255,8 +255,9 @@ template <class P, class Sc, class Piece>
         return reached(r, t);
     } else {
         for (int crossing = 0; crossing <= detail::kMaxInterfaceCrossings; ++crossing) {
-            const SurfaceHit h = sc.geometry.intersect(r, end.with_along ? kInf : distance - margin);
+            SurfaceHit h = sc.geometry.intersect(r, end.with_along ? kInf : distance - margin);
             if (!detail::usable_hit(sc, h)) return fail(Status::InvalidInput);
+            h.keep_media(medium);
             const bool last = !h.found() || h.t >= distance - margin;
             // A surface that is not a null interface before the end blocks the ray: nothing to track.
             if (!last && !detail::crosses(sc, h)) return fail(Status::Ok);
