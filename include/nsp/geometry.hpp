@@ -13,7 +13,6 @@
 
 namespace nsp {
 
-/// What a ray reaches first among a host's surfaces.
 /// A SurfaceHit side's medium that the surface does not change: a ray crossing into that side
 /// keeps the medium it is in, and a path leaving a vertex there into that side stays in the
 /// medium it arrived in (an object inside a medium whose geometry does not name it, or a thin
@@ -21,6 +20,7 @@ namespace nsp {
 /// the ray's medium where the hit is found (SurfaceHit::keep_media).
 inline constexpr int kSameMedium = -2;
 
+/// What a ray reaches first among a host's surfaces.
 struct SurfaceHit {
     float t = kInf;            ///< distance along the ray; kInf: nothing
     Vec3 p{0.f};               ///< the point
