@@ -208,9 +208,10 @@ float BdptEstimator<Mis, H, A, MaxDepth, Ch>::BdptSample<Sc, Cam, R, C, Splat, O
             sc, medium, ray, t_max, seg_count,
             [&](const Ray& r, float t_y) { return shadow_piece(medium, r, t_y, Spectrum::Ones()); }, lambda, rng, counter);
         if (d.ran) detail::record_shadow_walk(counter, before, false);
-        const Shadow sh = as_shadow(d.status, true, d.piece.f, d.piece.nee, d.piece.uni);
-        if (sh.status != Status::Ok) status = sh.status;
-        if (!d.drawn || !(sh.tr != 0.f).any()) return d.along;
+        if (d.status != Status::Ok) status = d.status;
+        if (!d.drawn) return d.along;  // (the piece is tracked only where y was drawn)
+        const Shadow sh = as_shadow(Status::Ok, true, d.piece.f, d.piece.nee, d.piece.uni);
+        if (!(sh.tr != 0.f).any()) return d.along;
         const Vec3 y = ray.at(d.distance.t);
         const Spectrum le = sc.media[std::size_t(medium)].medium.emission(y, lambda);
         if (!(le > 0.f).any()) return d.along;
