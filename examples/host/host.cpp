@@ -124,7 +124,8 @@ Spectrum radiance(const Kernels& k, const Scene& sc, nsp::Ray ray, nsp::Pcg32& r
             const int light = hit.found() ? hit.light : 2;
             if (light >= 0) {
                 if (st.counts_hits())
-                    L += st.light_hit(sc.lights.emitted(light, ray.d, lambda),
+                    L += st.light_hit(hit.found() ? sc.lights.emitted(light, hit.shading(), ray.d, lambda)
+                                              : sc.lights.emitted(light, ray.d, lambda),
                                       st.nee_alternative() ? sc.lights.pdf(light, st.prev, ray.d) : 0.f, counter);
                 break;
             }
@@ -133,15 +134,14 @@ Spectrum radiance(const Kernels& k, const Scene& sc, nsp::Ray ray, nsp::Pcg32& r
         }
         if (++depth > k.options().max_depth) break;
         const float q = st.survival(depth);  // decided before NEE: the continuing path carries it
-        const nsp::SceneVertex v{material, 0, hit.ns};
+        const nsp::SceneVertex v{material, 0, hit.shading()};
         if (st.draw_nee(rng) &&
             nsp::light_nee(st, sc, v, x, ray.d, st.vertex(q, eq_x), cloud_side, lambda, rng, counter, L) != nsp::Status::Ok)
             return Spectrum::Zero();
         if (nsp::volume_nee(st, sc, v, x, ray.d, st.vertex(q, eq_x), cloud_side, lambda, rng, counter, L) != nsp::Status::Ok)
             return Spectrum::Zero();
         if (!st.roulette(q, rng)) break;
-        const float v1 = rng.uniform(), v2 = rng.uniform();
-        const auto next = nsp::sample_vertex(sc, v, ray.d, v1, v2, lambda);
+        const auto next = nsp::sample_vertex(sc, v, ray.d, rng, lambda);
         if (!(next.pdf > 0.f)) break;
         if (const nsp::StateScale r = st.scatter(next, q, eq_x, x); r != nsp::StateScale::Ok) {
             if (r == nsp::StateScale::Overflowed) return Spectrum::Zero();

@@ -3,10 +3,16 @@
 // delta lobe) and a null interface (the index-matched boundary of a medium, which a path crosses
 // without a real vertex).
 //
+// A BSDF comes in one of two forms. A shading BSDF sees the hit (a ShadingPoint: position, uv,
+// shading frame, the host's datum) and samples from three uniforms, enough for a rough lobe
+// chosen among several; a simple BSDF sees only the shading normal and samples from two. The
+// estimators take either (detail::sample_bsdf and its siblings) and draw the third uniform only
+// for a shading BSDF.
+//
 // Directions follow propagation, as for phase functions (phase.hpp): `wo` is the direction the
 // path travelled to reach the surface (the ray's direction), `wi` the direction it leaves in. `n`
-// is the unit shading normal, of either orientation: a one-sided model decides the side from `wo`
-// (a normal that is NaN or not of unit length gives no sample: pdf 0).
+// (ShadingPoint::ns) is the unit shading normal, of either orientation: a one-sided model decides
+// the side from `wo` (a normal that is NaN or not of unit length gives no sample: pdf 0).
 // A BSDF's `value` is f_s(wo, wi) |n . wi|, the cosine of the outgoing direction included, so
 // that a path's throughput is multiplied by value / pdf at a surface vertex exactly as by
 // f_p / pdf at a medium vertex, and NEE adds value / light_pdf at either.
@@ -17,6 +23,8 @@
 
 #include "core/error.hpp"
 #include "core/math.hpp"
+#include "core/rng.hpp"
+#include "geometry.hpp"
 #include "media/validate.hpp"
 #include "spectrum.hpp"
 
@@ -33,19 +41,37 @@ struct BsdfSample {
     bool delta = false;                     ///< a delta lobe: light sampling cannot produce wi
 };
 
-/// A BSDF provides `sample(wo, n, u1, u2, lambda)`, `eval(wo, wi, n, lambda)` (f_s |n . wi|; 0
-/// for the directions of a delta lobe, which no other technique reaches) and `pdf(wo, wi, n)` of
+/// A simple BSDF provides `sample(wo, n, u1, u2, lambda)`, `eval(wo, wi, n, lambda)` (f_s |n . wi|;
+/// 0 for the directions of a delta lobe, which no other technique reaches) and `pdf(wo, wi, n)` of
 /// its own sampling (0 for delta lobes). `passes_through` is true for a null interface: the path
 /// crosses it as it would cross empty space, with no real vertex (its MIS state carries on).
 /// Optional: `static constexpr bool is_delta = true` on a model all of whose lobes are delta
 /// lobes (MirrorBsdf), so that an estimator skips light sampling there.
 template <class B, class S>
-concept Bsdf = SpectralMode<S> && requires(const B& b, const Vec3& w, float u, const typename S::Wavelengths& l) {
+concept SimpleBsdf = SpectralMode<S> && requires(const B& b, const Vec3& w, float u, const typename S::Wavelengths& l) {
     { b.sample(w, w, u, u, l) } -> std::same_as<BsdfSample<S>>;
     { b.eval(w, w, w, l) } -> std::same_as<typename S::Spectrum>;
     { b.pdf(w, w, w) } -> std::same_as<float>;
     { B::passes_through } -> std::convertible_to<bool>;
 };
+
+/// A shading BSDF sees the hit: `sample(sp, wo, u, lambda)` with u a 3D sample in [0, 1)^3 (two
+/// for the direction, one to pick a lobe, or however the model spends them), `eval(sp, wo, wi,
+/// lambda)` and `pdf(sp, wo, wi)`, with the same meaning as a simple BSDF's, `passes_through` and
+/// the optional `is_delta` likewise. A texture reads sp.uv (or sp.user), an anisotropic lobe
+/// sp.dpdu.
+template <class B, class S>
+concept ShadingBsdf = SpectralMode<S> &&
+    requires(const B& b, const ShadingPoint& sp, const Vec3& w, const typename S::Wavelengths& l) {
+        { b.sample(sp, w, w, l) } -> std::same_as<BsdfSample<S>>;
+        { b.eval(sp, w, w, l) } -> std::same_as<typename S::Spectrum>;
+        { b.pdf(sp, w, w) } -> std::same_as<float>;
+        { B::passes_through } -> std::convertible_to<bool>;
+    };
+
+/// A BSDF of either form.
+template <class B, class S>
+concept Bsdf = ShadingBsdf<B, S> || SimpleBsdf<B, S>;
 
 namespace detail {
 /// Whether BSDF model B says every lobe is a delta lobe (its optional `is_delta`).
@@ -54,6 +80,31 @@ inline constexpr bool bsdf_delta_v = [] {
     if constexpr (requires { B::is_delta; }) return bool(B::is_delta);
     else return false;
 }();
+
+/// BSDF b's sample at sp from (u1, u2), and from a third uniform drawn from rng if b is a
+/// shading BSDF (a simple one draws none: its paths keep their random streams).
+template <SpectralMode S, class B, UniformRng R>
+    requires Bsdf<B, S>
+[[gnu::always_inline]] inline BsdfSample<S> sample_bsdf(const B& b, const ShadingPoint& sp, const Vec3& wo, float u1,
+                                                         float u2, R& rng, const typename S::Wavelengths& lambda) noexcept {
+    if constexpr (ShadingBsdf<B, S>) return b.sample(sp, wo, Vec3(u1, u2, rng.uniform()), lambda);
+    else return b.sample(wo, sp.ns, u1, u2, lambda);
+}
+/// BSDF b's value f_s |n . wi| at sp.
+template <SpectralMode S, class B>
+    requires Bsdf<B, S>
+[[gnu::always_inline]] inline typename S::Spectrum eval_bsdf(const B& b, const ShadingPoint& sp, const Vec3& wo,
+                                                              const Vec3& wi, const typename S::Wavelengths& lambda) noexcept {
+    if constexpr (ShadingBsdf<B, S>) return b.eval(sp, wo, wi, lambda);
+    else return b.eval(wo, wi, sp.ns, lambda);
+}
+/// BSDF b's sampling pdf of wi at sp.
+template <SpectralMode S, class B>
+    requires Bsdf<B, S>
+[[gnu::always_inline]] inline float bsdf_pdf(const B& b, const ShadingPoint& sp, const Vec3& wo, const Vec3& wi) noexcept {
+    if constexpr (ShadingBsdf<B, S>) return b.pdf(sp, wo, wi);
+    else return b.pdf(wo, wi, sp.ns);
+}
 
 /// The unit normal on the side of the surface the path arrived from (opposite to wo).
 inline Vec3 facing(const Vec3& wo, const Vec3& n) noexcept { return glm::dot(wo, n) > 0.f ? -n : n; }
@@ -143,16 +194,42 @@ struct OneSided {
     static constexpr bool is_delta = detail::bsdf_delta_v<B>;
     B bsdf;
 
+    // B's form: a simple BSDF's three functions.
     BsdfSample<S> sample(const Vec3& wo, const Vec3& n, float u1, float u2,
-                         const typename S::Wavelengths& lambda = {}) const noexcept {
+                         const typename S::Wavelengths& lambda = {}) const noexcept
+        requires(!ShadingBsdf<B, S>)
+    {
         return glm::dot(wo, n) < 0.f ? bsdf.sample(wo, n, u1, u2, lambda) : BsdfSample<S>{};
     }
     typename S::Spectrum eval(const Vec3& wo, const Vec3& wi, const Vec3& n,
-                              const typename S::Wavelengths& lambda = {}) const noexcept {
+                              const typename S::Wavelengths& lambda = {}) const noexcept
+        requires(!ShadingBsdf<B, S>)
+    {
         return glm::dot(wo, n) < 0.f ? bsdf.eval(wo, wi, n, lambda) : typename S::Spectrum(S::Spectrum::Zero());
     }
-    float pdf(const Vec3& wo, const Vec3& wi, const Vec3& n) const noexcept {
+    float pdf(const Vec3& wo, const Vec3& wi, const Vec3& n) const noexcept
+        requires(!ShadingBsdf<B, S>)
+    {
         return glm::dot(wo, n) < 0.f ? bsdf.pdf(wo, wi, n) : 0.f;
+    }
+
+    // Or a shading BSDF's, the side read from sp.ns.
+    BsdfSample<S> sample(const ShadingPoint& sp, const Vec3& wo, const Vec3& u,
+                         const typename S::Wavelengths& lambda = {}) const noexcept
+        requires ShadingBsdf<B, S>
+    {
+        return glm::dot(wo, sp.ns) < 0.f ? bsdf.sample(sp, wo, u, lambda) : BsdfSample<S>{};
+    }
+    typename S::Spectrum eval(const ShadingPoint& sp, const Vec3& wo, const Vec3& wi,
+                              const typename S::Wavelengths& lambda = {}) const noexcept
+        requires ShadingBsdf<B, S>
+    {
+        return glm::dot(wo, sp.ns) < 0.f ? bsdf.eval(sp, wo, wi, lambda) : typename S::Spectrum(S::Spectrum::Zero());
+    }
+    float pdf(const ShadingPoint& sp, const Vec3& wo, const Vec3& wi) const noexcept
+        requires ShadingBsdf<B, S>
+    {
+        return glm::dot(wo, sp.ns) < 0.f ? bsdf.pdf(sp, wo, wi) : 0.f;
     }
 };
 
@@ -172,7 +249,8 @@ struct NullInterface {
     float pdf(const Vec3&, const Vec3&, const Vec3&) const noexcept { return 0.f; }
 };
 
-static_assert(Bsdf<LambertianBsdf<Mono>, Mono> && Bsdf<MirrorBsdf<Rgb>, Rgb> && Bsdf<NullInterface<Mono>, Mono> &&
+static_assert(SimpleBsdf<LambertianBsdf<Mono>, Mono> && !ShadingBsdf<LambertianBsdf<Mono>, Mono> &&
+              Bsdf<LambertianBsdf<Mono>, Mono> && Bsdf<MirrorBsdf<Rgb>, Rgb> && Bsdf<NullInterface<Mono>, Mono> &&
               Bsdf<OneSided<Rgb, LambertianBsdf<Rgb>>, Rgb> && Bsdf<OneSided<Mono, MirrorBsdf<Mono>>, Mono>);
 
 }  // namespace nsp

@@ -20,6 +20,19 @@ namespace nsp {
 /// the ray's medium where the hit is found (SurfaceHit::keep_media).
 inline constexpr int kSameMedium = -2;
 
+/// What a BSDF sees of the surface point it scatters at: the point, its normals, the host's
+/// shading tangent and surface parameters, and one datum of the host's own (a primitive or
+/// texture index) that nsp carries without reading. A textured, anisotropic or position-dependent
+/// BSDF reads what it needs; a simple one reads only `ns`.
+struct ShadingPoint {
+    Vec3 p{0.f};               ///< the point
+    Vec3 ng{0.f, 0.f, 1.f};    ///< unit geometric normal
+    Vec3 ns{0.f, 0.f, 1.f};    ///< unit shading normal
+    Vec3 dpdu{0.f};            ///< the host's shading tangent along u (0: none given)
+    Vec2 uv{0.f};              ///< surface parameters (texture coordinates)
+    int user = -1;             ///< the host's own datum for this hit; nsp never reads it
+};
+
 /// What a ray reaches first among a host's surfaces.
 struct SurfaceHit {
     float t = kInf;            ///< distance along the ray; kInf: nothing
@@ -30,6 +43,9 @@ struct SurfaceHit {
     int light = -1;            ///< the light emitting at p (e.g. a LightSampler index); -1: none
     int medium_front = -1;     ///< the medium on the side ng points to; -1: vacuum; kSameMedium
     int medium_back = -1;      ///< the medium on the other side; -1: vacuum; kSameMedium
+    Vec2 uv{0.f};              ///< surface parameters at p, for the BSDF (ShadingPoint)
+    Vec3 dpdu{0.f};            ///< shading tangent along u, for the BSDF (0: none given)
+    int user = -1;             ///< the host's own datum, handed to the BSDF untouched
 
     bool found() const noexcept { return t < kInf; }
     /// A boundary a path crosses without a vertex: no BSDF and no light there.
@@ -38,6 +54,8 @@ struct SurfaceHit {
     int medium_entered(const Vec3& d) const noexcept { return glm::dot(d, ng) > 0.f ? medium_front : medium_back; }
     /// The medium a ray travelling along d was in before reaching p.
     int medium_left(const Vec3& d) const noexcept { return glm::dot(d, ng) > 0.f ? medium_back : medium_front; }
+    /// What the BSDF at p is given.
+    ShadingPoint shading() const noexcept { return {p, ng, ns, dpdu, uv, user}; }
     /// This hit's kSameMedium sides as `current`, the medium of the ray that found it.
     void keep_media(int current) noexcept {
         if (medium_front == kSameMedium) medium_front = current;

@@ -12,6 +12,7 @@
 
 #include "core/error.hpp"
 #include "core/math.hpp"
+#include "geometry.hpp"
 #include "media/validate.hpp"
 #include "spectrum.hpp"
 
@@ -68,22 +69,40 @@ concept EmittingLight = SpectralMode<S> && requires(const L& l, const Vec3& v, f
     { l.emission_pdf(v, v) } -> std::same_as<EmissionDensity>;
 };
 
+/// A light whose emitted radiance depends only on the direction of the ray that reaches it:
+/// `emitted(w, lambda)`.
+template <class L, class S>
+concept DirectionEmitter = requires(const L& l, const Vec3& w, const typename S::Wavelengths& lambda) {
+    { l.emitted(w, lambda) } -> std::same_as<typename S::Spectrum>;
+};
+
+/// A light on a host's surface that sees where a ray reaches it: `emitted(sp, w, lambda)`, sp the
+/// hit on the light (its point, normals, uv and the host's datum, SurfaceHit::shading()), for a
+/// textured or one-sided emitter. Its `sample` and `sample_emission` give the radiance at the
+/// points they draw themselves.
+template <class L, class S>
+concept SurfaceEmitter = requires(const L& l, const ShadingPoint& sp, const Vec3& w, const typename S::Wavelengths& lambda) {
+    { l.emitted(sp, w, lambda) } -> std::same_as<typename S::Spectrum>;
+};
+
 /// A light a host's loop samples for NEE and may hit (THEORY 5.8). `sample(x, u1, u2, lambda,
 /// selection)` draws a direction from x toward it with its solid-angle pdf times `selection` (the
 /// probability with which the caller picked this light); `pdf(x, w, selection)` is that density
-/// for direction w (0 for a delta light, or where w misses it); `emitted(w, lambda)` what a ray
-/// travelling along w receives when it reaches the light; `power(scene_radius)` a grey measure of
-/// its emitted power for light selection by power. Models: PointLight, SphereLight, QuadLight,
-/// EnvironmentLight, ImageEnvironmentLight (lights/image_environment.hpp); LightSampler chooses
-/// among any number of them.
+/// for direction w (0 for a delta light, or where w misses it); `emitted(w, lambda)` or
+/// `emitted(sp, w, lambda)` (DirectionEmitter, SurfaceEmitter) what a ray travelling along w
+/// receives when it reaches the light; `power(scene_radius)` a grey measure of its emitted power
+/// for light selection by power. Models: PointLight, SphereLight, QuadLight, EnvironmentLight,
+/// ImageEnvironmentLight (lights/image_environment.hpp); LightSampler chooses among any number of
+/// them. A light at infinity (`is_infinite`) is reached by rays that leave the scene, where there
+/// is no hit: it is a DirectionEmitter.
 template <class L, class S>
-concept Light = SpectralMode<S> && requires(const L& l, const Vec3& v, float u, const typename S::Wavelengths& lambda) {
-    { l.sample(v, u, u, lambda, u) } -> std::same_as<LightSample<S>>;
-    { l.pdf(v, v, u) } -> std::same_as<float>;
-    { l.emitted(v, lambda) } -> std::same_as<typename S::Spectrum>;
-    { l.power(u) } -> std::same_as<float>;
-    { L::is_delta } -> std::convertible_to<bool>;
-};
+concept Light = SpectralMode<S> && (DirectionEmitter<L, S> || SurfaceEmitter<L, S>) &&
+    requires(const L& l, const Vec3& v, float u, const typename S::Wavelengths& lambda) {
+        { l.sample(v, u, u, lambda, u) } -> std::same_as<LightSample<S>>;
+        { l.pdf(v, v, u) } -> std::same_as<float>;
+        { l.power(u) } -> std::same_as<float>;
+        { L::is_delta } -> std::convertible_to<bool>;
+    };
 
 /// An isotropic point light with radiant intensity `intensity` (W/sr). Reachable by NEE only.
 template <SpectralMode S>

@@ -90,6 +90,9 @@ private:
     }
     LightSampler(Checked, LightSelection selection, float scene_radius, BoundingSphere sphere, std::vector<Ls>... lights)
         : lights_(std::move(lights)...), sphere_(sphere), uniform_(selection == LightSelection::Uniform) {
+        static_assert(((!is_infinite<Ls>() || DirectionEmitter<Ls, S>) && ...),
+                      "nsp::LightSampler: a light at infinity (is_infinite) is reached where there is no hit; it "
+                      "must give emitted(w, lambda) (DirectionEmitter)");
         double total = 0.0;
         for_each_light([&](const auto& l, int kind, int index) {
             validate(l);
@@ -267,10 +270,26 @@ public:
         return p;
     }
 
-    /// What a ray travelling along w receives when it reaches light `light`.
+    /// What a ray travelling along w receives when it reaches light `light` with no hit: a light at
+    /// infinity (a SurfaceEmitter, which needs its hit, gives 0 here).
     typename S::Spectrum emitted(int light, const Vec3& w, const typename S::Wavelengths& lambda = {}) const noexcept {
         typename S::Spectrum v = S::Spectrum::Zero();
-        if (light >= 0 && light < count()) visit(entries_[std::size_t(light)], [&](const auto& l) { v = l.emitted(w, lambda); });
+        if (light >= 0 && light < count())
+            visit(entries_[std::size_t(light)], [&](const auto& l) {
+                if constexpr (DirectionEmitter<std::decay_t<decltype(l)>, S>) v = l.emitted(w, lambda);
+            });
+        return v;
+    }
+    /// What a ray travelling along w receives where it reaches light `light` at the hit sp
+    /// (SurfaceHit::shading()): a SurfaceEmitter sees sp, any other light only w.
+    typename S::Spectrum emitted(int light, const ShadingPoint& sp, const Vec3& w,
+                                 const typename S::Wavelengths& lambda = {}) const noexcept {
+        typename S::Spectrum v = S::Spectrum::Zero();
+        if (light >= 0 && light < count())
+            visit(entries_[std::size_t(light)], [&](const auto& l) {
+                if constexpr (SurfaceEmitter<std::decay_t<decltype(l)>, S>) v = l.emitted(sp, w, lambda);
+                else v = l.emitted(w, lambda);
+            });
         return v;
     }
 

@@ -7,10 +7,12 @@
 #include <utility>
 
 #include <glm/geometric.hpp>
+#include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
 namespace nsp {
 
+using Vec2 = glm::vec2;
 using Vec3 = glm::vec3;
 
 inline constexpr float kPi = 3.14159265358979323846f;

@@ -193,7 +193,7 @@ struct BdptEstimator<Mis, H, A, MaxDepth, Ch>::BdptSample {
 
     /// The BSDF or phase function at vertex v.
     auto eval_at(const V& v, const Vec3& wo, const Vec3& wi) const {
-        return eval_vertex(sc, SceneVertex{v.material, v.medium, v.ns}, wo, wi, lambda);
+        return eval_vertex(sc, v.scene_vertex(), wo, wi, lambda);
     }
 
     /// Fills pdfs with the path of k + 1 vertices made of light[0..s-1] (x_0..x_{s-1}) and

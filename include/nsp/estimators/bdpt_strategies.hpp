@@ -20,8 +20,8 @@ void BdptEstimator<Mis, H, A, MaxDepth, Ch>::BdptSample<Sc, Cam, R, C, Splat, Ob
         for (const int i : sc.lights.infinite())
             hit_one_emitter(t, z, hit, ray, nulls, beta, gamma, i, sc.lights.emitted(i, ray.d, lambda), kInf);
     } else {
-        hit_one_emitter(t, z, hit, ray, nulls, beta, gamma, hit.light, sc.lights.emitted(hit.light, ray.d, lambda),
-                        hit.t);
+        hit_one_emitter(t, z, hit, ray, nulls, beta, gamma, hit.light,
+                        sc.lights.emitted(hit.light, hit.shading(), ray.d, lambda), hit.t);
     }
 }
 
@@ -236,7 +236,7 @@ void BdptEstimator<Mis, H, A, MaxDepth, Ch>::BdptSample<Sc, Cam, R, C, Splat, Ob
     const V& z = camera[t - 1];
     const float count = from_eq ? 1.f : nee_count;
     const auto d = draw_light_nee<P>(
-        sc, SceneVertex{z.material, z.medium, z.ns}, z.p, z.wo, [&](const Vec3& wi) { return z.medium_toward(wi); },
+        sc, z.scene_vertex(), z.p, z.wo, [&](const Vec3& wi) { return z.medium_toward(wi); },
         [&](int m, const Ray& r, float t_max, const Spectrum& f, bool) { return shadow_piece(m, r, t_max, f); },
         !from_eq, lambda, rng, counter);
     if (!d) return;
@@ -296,7 +296,7 @@ void BdptEstimator<Mis, H, A, MaxDepth, Ch>::BdptSample<Sc, Cam, R, C, Splat, Ob
         const V& z = camera[t - 1];
         if (!has_volume) return;
         const auto d = draw_volume_nee<P>(
-            sc, SceneVertex{z.material, z.medium, z.ns}, z.p, z.wo, [&](const Vec3& wi) { return z.medium_toward(wi); },
+            sc, z.scene_vertex(), z.p, z.wo, [&](const Vec3& wi) { return z.medium_toward(wi); },
             seg_on, pieces(), lambda, rng, counter);
         if (d.status != Status::Ok) status = d.status;
         const Shadow sh = as_shadow(d.walk);

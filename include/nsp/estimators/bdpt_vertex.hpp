@@ -22,6 +22,9 @@ template <SpectralMode S, class P = float>
 struct Vertex {
     Vec3 p{0.f};
     Vec3 ng{0.f, 0.f, 1.f}, ns{0.f, 0.f, 1.f};  ///< normals (surfaces; a light vertex: its emitting normal)
+    Vec3 dpdu{0.f};                              ///< a surface's shading tangent (SurfaceHit::dpdu)
+    Vec2 uv{0.f};                                ///< a surface's parameters (SurfaceHit::uv)
+    int user = -1;                               ///< the host's datum at a surface (SurfaceHit::user)
     Vec3 wo{0.f, 0.f, 1.f};                      ///< the subpath's direction of travel arriving at p
     typename S::Spectrum beta = S::Spectrum::Zero();  ///< the subpath's throughput up to p
     P pdf_fwd = broadcast<P>(0.f);   ///< density of p drawn by its own subpath (area / volume measure, with N and E)
@@ -41,6 +44,8 @@ struct Vertex {
     bool delta_position = false;  ///< a point light or a directional light's direction: no path hits it
     bool at_infinity = false;     ///< a light at infinity: x_0 is a direction (solid angle), p its ray's origin
 
+    /// The vertex as the BSDF or phase function there sees it.
+    SceneVertex scene_vertex() const noexcept { return {material, medium, {p, ng, ns, dpdu, uv, user}}; }
     /// The medium a ray leaving p along w travels in.
     int medium_toward(const Vec3& w) const noexcept {
         if (kind != VertexKind::Surface) return medium;

@@ -208,6 +208,9 @@ struct BdptEstimator<Mis, H, A, MaxDepth, Ch>::SubpathWalk {
         v.p = hit.p;
         v.ng = hit.ng;
         v.ns = hit.ns;
+        v.dpdu = hit.dpdu;
+        v.uv = hit.uv;
+        v.user = hit.user;
         v.material = hit.material;
         v.medium_front = hit.medium_front;
         v.medium_back = hit.medium_back;
@@ -256,9 +259,8 @@ struct BdptEstimator<Mis, H, A, MaxDepth, Ch>::SubpathWalk {
             if (!(rng.uniform() < q)) return false;
             beta /= q;
         }
-        const SceneVertex sv{cur.material, cur.medium, cur.ns};
-        const float u1 = rng.uniform(), u2 = rng.uniform();
-        const auto next = sample_vertex(sc, sv, ray.d, u1, u2, lambda);
+        const SceneVertex sv = cur.scene_vertex();
+        const auto next = sample_vertex(sc, sv, ray.d, rng, lambda);
         if (!(next.pdf > 0.f)) return false;
         cur.delta = next.delta;
         // The density with which the other side, arriving along -next.wi, draws prev from cur.

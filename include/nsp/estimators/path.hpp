@@ -148,16 +148,16 @@ RadianceSample<typename Sc::Spectral> trace_path(const K& k, const Sc& sc, const
         } else {
             if (surface_later) hit = sc.geometry.intersect(ray, kInf);
             // An emitter reached: weighed against NEE from the last real vertex where it exists.
-            auto add_emitter = [&](int light) {
-                const Spectrum le = sc.lights.emitted(light, ray.d, lambda);
+            auto add_emitter = [&](int light, const Spectrum& le) {
                 L += st.light_hit(le, st.nee_alternative() ? sc.lights.pdf(light, st.prev, ray.d) : 0.f, counter);
             };
             if (!hit.found()) {  // the ray leaves the scene: the lights at infinity
                 if (st.counts_hits())
-                    for (const int i : sc.lights.infinite()) add_emitter(i);
+                    for (const int i : sc.lights.infinite()) add_emitter(i, sc.lights.emitted(i, ray.d, lambda));
                 break;
             }
-            if (hit.light >= 0 && st.counts_hits()) add_emitter(hit.light);
+            if (hit.light >= 0 && st.counts_hits())
+                add_emitter(hit.light, sc.lights.emitted(hit.light, hit.shading(), ray.d, lambda));
             if (crosses(sc, hit)) {  // a null interface: no vertex, the segment goes on in the next medium
                 if (++crossings > kMaxInterfaceCrossings) {
                     status = Status::InvalidInput;
@@ -177,7 +177,7 @@ RadianceSample<typename Sc::Spectral> trace_path(const K& k, const Sc& sc, const
         if (++depth > opts.max_depth) break;
         // Roulette survival is fixed before NEE: the continuing unidirectional path carries it.
         const float q = st.survival(depth);
-        const SceneVertex v{material, medium, hit.ns};
+        const SceneVertex v{material, medium, hit.shading()};
         if constexpr (St::samples_lights) {
             auto side = [&](const Vec3& wi) { return v.on_surface() ? hit.medium_entered(wi) : medium; };
             // Equiangular + NEE alone leaves the lights of a vertex its own vertices cover to them.
@@ -196,8 +196,7 @@ RadianceSample<typename Sc::Spectral> trace_path(const K& k, const Sc& sc, const
             }
         }
         if (!st.roulette(q, rng)) break;
-        const float v1 = rng.uniform(), v2 = rng.uniform();
-        const auto next = sample_vertex(sc, v, ray.d, v1, v2, lambda);
+        const auto next = sample_vertex(sc, v, ray.d, rng, lambda);
         if (!(next.pdf > 0.f)) break;
         if (v.on_surface()) medium = hit.medium_entered(next.wi);
         if (const StateScale r = st.scatter(next, q, eq_x, x); r != StateScale::Ok) {

@@ -27,13 +27,15 @@ namespace nsp::detail {
 inline constexpr int kMaxInterfaceCrossings = 256;
 
 /// Whether a hit from the host's geometry is one the estimator can use: a distance that is not
-/// NaN or negative, and where something was found a finite point, unit normals and handles
-/// inside the scene's tables (a medium, -1 or kSameMedium on each side).
+/// NaN or negative, and where something was found a finite point, unit normals, a finite tangent
+/// and uv (what a BSDF reads) and handles inside the scene's tables (a medium, -1 or kSameMedium
+/// on each side).
 template <class Sc>
 bool usable_hit(const Sc& sc, const SurfaceHit& h) noexcept {
     if (std::isnan(h.t) || h.t < 0.f) return false;
     if (!h.found()) return true;
     if (!finite(h.p) || !unit_length(h.ng) || !unit_length(h.ns)) return false;
+    if (!finite(h.dpdu) || !std::isfinite(h.uv.x) || !std::isfinite(h.uv.y)) return false;
     if (h.material != -1 && !sc.materials.contains(h.material)) return false;
     if (h.light != -1 && !(h.light >= 0 && h.light < sc.lights.count())) return false;
     auto medium_ok = [&](int m) { return m == -1 || m == kSameMedium || sc.has_medium(m); };
@@ -51,13 +53,14 @@ bool crosses(const Sc& sc, const SurfaceHit& h) noexcept {
 
 namespace nsp {
 
-/// A real vertex of a path through a SurfaceScene: on a surface (material >= 0, the hit's shading
-/// normal ns) or in medium `medium` (material -1). What the estimators ask of it: the value and
-/// pdf of a direction (NEE), and a sampled direction (the path's continuation).
+/// A real vertex of a path through a SurfaceScene: on a surface (material >= 0, what its BSDF sees
+/// of the hit in `shading`, SurfaceHit::shading()) or in medium `medium` (material -1; `shading`
+/// unread). What the estimators ask of it: the value and pdf of a direction (NEE), and a sampled
+/// direction (the path's continuation).
 struct SceneVertex {
     int material = -1;
     int medium = -1;
-    Vec3 ns{0.f, 0.f, 1.f};
+    ShadingPoint shading{};
     bool on_surface() const noexcept { return material >= 0; }
 };
 
@@ -79,8 +82,9 @@ template <class Sc>
     out.wi = wi;
     if (v.on_surface()) {
         sc.materials.visit(v.material, [&](const auto& b) {
-            out.value = b.eval(wo, wi, v.ns, lambda);
-            out.pdf = b.pdf(wo, wi, v.ns);
+            using S = typename Sc::Spectral;
+            out.value = detail::eval_bsdf<S>(b, v.shading, wo, wi, lambda);
+            out.pdf = detail::bsdf_pdf<S>(b, v.shading, wo, wi);
         });
     } else {
         const auto& phase = sc.media[std::size_t(v.medium)].phase;
@@ -90,16 +94,18 @@ template <class Sc>
     return out;
 }
 
-/// The next direction at vertex v from (u1, u2): the BSDF's or the phase function's sample; pdf
-/// 0 when there is none.
-template <class Sc>
+/// The next direction at vertex v: the BSDF's or the phase function's sample from two uniforms
+/// drawn from rng, and a third for a shading BSDF (ShadingBsdf); pdf 0 when there is none.
+template <class Sc, UniformRng R>
 [[gnu::always_inline]] inline VertexDirection<typename Sc::Spectral> sample_vertex(
-    const Sc& sc, const SceneVertex& v, const Vec3& wo, float u1, float u2,
+    const Sc& sc, const SceneVertex& v, const Vec3& wo, R& rng,
     const typename Sc::Spectral::Wavelengths& lambda) noexcept {
     VertexDirection<typename Sc::Spectral> out;
+    const float u1 = rng.uniform(), u2 = rng.uniform();
     if (v.on_surface()) {
         sc.materials.visit(v.material, [&](const auto& b) {
-            const BsdfSample<typename Sc::Spectral> bs = b.sample(wo, v.ns, u1, u2, lambda);
+            const BsdfSample<typename Sc::Spectral> bs =
+                detail::sample_bsdf<typename Sc::Spectral>(b, v.shading, wo, u1, u2, rng, lambda);
             out = {bs.wi, bs.value, bs.pdf, bs.delta};
         });
     } else {

@@ -1,0 +1,201 @@
+// tests/support/shading_scenes.hpp: two shading BSDFs (nsp::ShadingBsdf: they see the hit and
+// take a 3D sample) and the closed boxes of emitting walls in which their radiance has a closed
+// form, for the path tracer's and BDPT's tests. A textured floor: a Lambertian checkerboard read
+// from the hit's uv, black unless the hit's point, tangent and host datum reach it too. A diffuse
+// sheet: Lambertian reflection r on the side the path arrives from and Lambertian transmission t
+// through it, the lobe picked by the sample's third uniform. And a textured quad light
+// (nsp::SurfaceEmitter: it sees where a ray reaches it) on the walls of a box over a floor.
+#pragma once
+
+#include <cmath>
+#include <vector>
+
+#include <nsp/nsp.hpp>
+
+#include "grey_surface_scenes.hpp"
+#include "host/shapes.hpp"
+#include "surfaces.hpp"
+
+namespace nsp_test::shading_scenes {
+
+using namespace nsp;
+using S = Mono;
+using Spectrum = S::Spectrum;
+using nsp_host::Shapes;
+
+/// The floor's checkerboard, 4 x 4 squares over uv in [0, 1]^2: 0.8 and 0.2.
+inline float checker_albedo(Vec2 uv) { return (int(4.f * uv.x) + int(4.f * uv.y)) % 2 == 0 ? 0.8f : 0.2f; }
+
+/// Lambertian reflection with the checkerboard's albedo at sp.uv; 0 unless sp.p lies on the plane
+/// y = plane_y, sp.dpdu is `tangent` and sp.user is `user` (so a hit that lost them renders black).
+struct CheckerBsdf {
+    static constexpr bool passes_through = false;
+    float plane_y = -1.f;
+    Vec3 tangent{0.f, 0.f, 1.f};
+    int user = -1;
+
+    float albedo(const ShadingPoint& sp) const {
+        const bool seen = std::abs(sp.p.y - plane_y) < 1e-4f && glm::length(sp.dpdu - tangent) < 1e-5f && sp.user == user;
+        return seen ? checker_albedo(sp.uv) : 0.f;
+    }
+    BsdfSample<S> sample(const ShadingPoint& sp, const Vec3& wo, const Vec3& u, const S::Wavelengths& = {}) const {
+        const float cos_theta = std::sqrt(1.f - u.x);
+        BsdfSample<S> s;
+        s.wi = direction_around(detail::facing(wo, sp.ns), cos_theta, 2.f * kPi * u.y);
+        s.pdf = cos_theta / kPi;
+        s.value = Spectrum::Constant(albedo(sp) * cos_theta / kPi);
+        return s;
+    }
+    Spectrum eval(const ShadingPoint& sp, const Vec3& wo, const Vec3& wi, const S::Wavelengths& = {}) const {
+        const float c = glm::dot(wi, detail::facing(wo, sp.ns));
+        return Spectrum::Constant(c > 0.f ? albedo(sp) * c / kPi : 0.f);
+    }
+    float pdf(const ShadingPoint& sp, const Vec3& wo, const Vec3& wi) const {
+        const float c = glm::dot(wi, detail::facing(wo, sp.ns));
+        return c > 0.f ? c / kPi : 0.f;
+    }
+};
+
+/// Lambertian reflection r back to the side the path arrives from and Lambertian transmission t
+/// to the other, the lobe picked by u.z with probability r / (r + t) and t / (r + t).
+struct DiffuseSheetBsdf {
+    static constexpr bool passes_through = false;
+    float r = 0.3f, t = 0.5f;
+
+    BsdfSample<S> sample(const ShadingPoint& sp, const Vec3& wo, const Vec3& u, const S::Wavelengths& = {}) const {
+        const float p_reflect = r / (r + t);
+        const bool reflect = u.z < p_reflect;
+        const Vec3 n = reflect ? detail::facing(wo, sp.ns) : -detail::facing(wo, sp.ns);
+        const float cos_theta = std::sqrt(1.f - u.x);
+        BsdfSample<S> s;
+        s.wi = direction_around(n, cos_theta, 2.f * kPi * u.y);
+        s.pdf = (reflect ? p_reflect : 1.f - p_reflect) * cos_theta / kPi;
+        s.value = Spectrum::Constant((reflect ? r : t) * cos_theta / kPi);
+        return s;
+    }
+    Spectrum eval(const ShadingPoint& sp, const Vec3& wo, const Vec3& wi, const S::Wavelengths& = {}) const {
+        const float c = glm::dot(wi, detail::facing(wo, sp.ns));
+        return Spectrum::Constant((c > 0.f ? r : t) * std::abs(c) / kPi);
+    }
+    float pdf(const ShadingPoint& sp, const Vec3& wo, const Vec3& wi) const {
+        const float c = glm::dot(wi, detail::facing(wo, sp.ns));
+        return (c > 0.f ? r : t) / (r + t) * std::abs(c) / kPi;
+    }
+};
+
+static_assert(ShadingBsdf<CheckerBsdf, S> && ShadingBsdf<DiffuseSheetBsdf, S> && !SimpleBsdf<CheckerBsdf, S> &&
+              ShadingBsdf<OneSided<S, DiffuseSheetBsdf>, S>);
+
+/// The walls' 2 x 2 checkerboard over uv in [0, 1]^2: 0.8 and 0.2.
+inline float quadrant_albedo(Vec2 uv) { return (int(2.f * uv.x) + int(2.f * uv.y)) % 2 == 0 ? 0.8f : 0.2f; }
+
+/// A QuadLight whose radiance is scaled by quadrant_albedo at the point it is reached or
+/// sampled, uv its parameters along edge_u and edge_v (as Shapes reports a quad's hits): a textured
+/// emitter (nsp::SurfaceEmitter). Sampled as the quad, uniformly by area.
+struct TexturedQuadLight {
+    static constexpr bool is_delta = false;
+    QuadLight<S> quad;
+
+    Vec2 uv_at(const Vec3& y) const {
+        const Vec3 d = y - quad.corner;
+        return {glm::dot(d, quad.edge_u) / glm::dot(quad.edge_u, quad.edge_u),
+                glm::dot(d, quad.edge_v) / glm::dot(quad.edge_v, quad.edge_v)};
+    }
+    LightSample<S> sample(const Vec3& x, float u1, float u2, const S::Wavelengths& l = {}, float selection = 1.f) const {
+        LightSample<S> s = quad.sample(x, u1, u2, l, selection);
+        s.radiance *= quadrant_albedo(Vec2(u1, u2));
+        return s;
+    }
+    float pdf(const Vec3& x, const Vec3& w, float selection = 1.f) const { return quad.pdf(x, w, selection); }
+    Spectrum emitted(const ShadingPoint& sp, const Vec3& w, const S::Wavelengths& l = {}) const {
+        return quad.emitted(w, l) * quadrant_albedo(sp.uv);
+    }
+    float power(float r = 1.f) const { return quad.power(r); }
+    LightEmission<S> sample_emission(float u1, float u2, float u3, float u4, const S::Wavelengths& l = {}) const {
+        LightEmission<S> e = quad.sample_emission(u1, u2, u3, u4, l);
+        e.radiance *= quadrant_albedo(uv_at(e.p));
+        return e;
+    }
+    EmissionDensity emission_pdf(const Vec3& p, const Vec3& w) const { return quad.emission_pdf(p, w); }
+};
+
+static_assert(Light<TexturedQuadLight, S> && SurfaceEmitter<TexturedQuadLight, S> &&
+              !DirectionEmitter<TexturedQuadLight, S> && EmittingLight<TexturedQuadLight, S>);
+
+using Mats = Materials<S, CheckerBsdf, DiffuseSheetBsdf, LambertianBsdf<S>>;
+using Ls = grey_scenes::Ls;
+using M = grey_scenes::M;
+using Sc = SurfaceScene<Shapes, M, GlobalMajorant<M>, HenyeyGreensteinPhase, Mats, Ls>;
+
+/// The cube [-1, 1]^3 in vacuum: its floor (y = -1, quad 2, material 0) the checkerboard, the other five walls
+/// quad lights emitting 1 inward. A point on the floor sees only emitting walls: L = its albedo.
+inline Sc checker_box() {
+    Shapes shapes;
+    std::vector<QuadLight<S>> lights;
+    int face = 0;
+    for (const CubeFace& f : inward_cube_faces()) {
+        if (face++ == 2) {  // -y: u along z, v along x
+            shapes.quads.push_back({f.corner, f.u, f.v, {0, -1, -1, -1}});
+            continue;
+        }
+        shapes.quads.push_back({f.corner, f.u, f.v, {-1, int(lights.size()), -1, -1}});
+        lights.push_back({f.corner, f.u, f.v, Spectrum::Constant(1.f)});
+    }
+    const CheckerBsdf checker{-1.f, Vec3(0.f, 0.f, 1.f), 2};
+    return Sc(shapes, {}, Mats({checker}, {}, {LambertianBsdf<S>(Spectrum::Constant(0.f))}),
+              Ls(LightSelection::Uniform, 3.f, std::move(lights), {}), -1);
+}
+
+/// The cube [-1, 1]^3 in vacuum cut at y = 0 by a diffuse sheet (r, t): the walls of the upper
+/// half emit 1 inward, those of the lower half are black (material 1). From above the sheet
+/// (material 0) is L = r, from below L = t.
+inline Sc sheet_box(float r, float t) {
+    Shapes shapes;
+    std::vector<QuadLight<S>> lights;
+    const Spectrum one = Spectrum::Constant(1.f);
+    auto wall = [&](Vec3 corner, Vec3 eu, Vec3 ev, bool upper) {  // normal cross(eu, ev) inward
+        if (upper) {
+            shapes.quads.push_back({corner, eu, ev, {-1, int(lights.size()), -1, -1}});
+            lights.push_back({corner, eu, ev, one});
+        } else {
+            shapes.quads.push_back({corner, eu, ev, {1, -1, -1, -1}});
+        }
+    };
+    for (const bool upper : {true, false}) {
+        const float y0 = upper ? 0.f : -1.f;
+        wall(Vec3(-1.f, y0, -1.f), Vec3(0.f, 1.f, 0.f), Vec3(0.f, 0.f, 2.f), upper);  // x = -1, normal +x
+        wall(Vec3(1.f, y0, -1.f), Vec3(0.f, 0.f, 2.f), Vec3(0.f, 1.f, 0.f), upper);   // x = +1, normal -x
+        wall(Vec3(-1.f, y0, -1.f), Vec3(2.f, 0.f, 0.f), Vec3(0.f, 1.f, 0.f), upper);  // z = -1, normal +z
+        wall(Vec3(-1.f, y0, 1.f), Vec3(0.f, 1.f, 0.f), Vec3(2.f, 0.f, 0.f), upper);   // z = +1, normal -z
+    }
+    wall(Vec3(-1.f, 1.f, -1.f), Vec3(2.f, 0.f, 0.f), Vec3(0.f, 0.f, 2.f), true);    // top, normal -y
+    wall(Vec3(-1.f, -1.f, -1.f), Vec3(0.f, 0.f, 2.f), Vec3(2.f, 0.f, 0.f), false);  // bottom, normal +y
+    shapes.quads.push_back({Vec3(-1.f, 0.f, -1.f), Vec3(0.f, 0.f, 2.f), Vec3(2.f, 0.f, 0.f), {0, -1, -1, -1}});
+    return Sc(shapes, {}, Mats({}, {DiffuseSheetBsdf{r, t}}, {LambertianBsdf<S>(Spectrum::Constant(0.f))}),
+              Ls(LightSelection::Uniform, 3.f, std::move(lights), {}), -1);
+}
+
+using TexturedLs = LightSampler<S, TexturedQuadLight>;
+using TexturedSc = SurfaceScene<Shapes, M, GlobalMajorant<M>, HenyeyGreensteinPhase, Mats, TexturedLs>;
+
+/// The cube [-1, 1]^3 in vacuum: its floor (y = -1) Lambertian of albedo 0.5 (material 0), the
+/// other five walls textured quad lights emitting quadrant_albedo(uv) inward. From the floor's
+/// centre each wall's quadrants of 0.8 and 0.2 weigh alike in pairs (the mirror symmetries through
+/// it), as if every wall emitted 0.5: L = 0.5 x 0.5 there.
+inline TexturedSc textured_box() {
+    Shapes shapes;
+    std::vector<TexturedQuadLight> lights;
+    int face = 0;
+    for (const CubeFace& f : inward_cube_faces()) {
+        if (face++ == 2) {
+            shapes.quads.push_back({f.corner, f.u, f.v, {0, -1, -1, -1}});
+            continue;
+        }
+        shapes.quads.push_back({f.corner, f.u, f.v, {-1, int(lights.size()), -1, -1}});
+        lights.push_back({QuadLight<S>{f.corner, f.u, f.v, Spectrum::Constant(1.f)}});
+    }
+    return TexturedSc(shapes, {}, Mats({}, {}, {LambertianBsdf<S>(Spectrum::Constant(0.5f))}),
+                      TexturedLs(LightSelection::Uniform, 3.f, std::move(lights)), -1);
+}
+
+}  // namespace nsp_test::shading_scenes
