@@ -141,53 +141,11 @@ TEST_CASE("surface estimators: a surface that keeps the medium (kSameMedium), a 
 }
 
 TEST_CASE("surface estimators: a BSDF that sees the hit (a uv checkerboard), one that takes a 3D sample (a diffuse sheet)") {
-    // The floor of a box of emitting walls sees only them: L = its albedo at the hit's uv, 0.8 and
-    // 0.2 on neighbouring squares (0 if the hit's point, tangent or datum did not reach the BSDF).
-    // A sheet across a box whose upper walls emit 1 and lower walls are black: L = r from above,
-    // t from below; a third uniform that did not pick the lobe would weigh r and t wrongly.
-    using shading_scenes::checker_albedo;
-    const shading_scenes::Sc checker = shading_scenes::checker_box(), sheet = shading_scenes::sheet_box(0.3f, 0.5f);
-    auto toward = [](Vec3 o, Vec3 target) { return [=](Pcg32&) { return Ray{o, glm::normalize(target - o)}; }; };
-    for_each_strategy([&](const auto& est, const char* name) {
-        CAPTURE(std::string(name));
-        for (const float x : {-0.1f, 0.1f}) {  // u along z, v along x: squares (1, 1) and (1, 2)
-            const double expected = checker_albedo(Vec2(0.45f, 0.5f * (x + 1.f)));
-            const Stat s = estimate(est, checker, 4000, 41, toward(Vec3(0.f, 0.5f, 0.f), Vec3(x, -1.f, -0.1f)));
-            CAPTURE(expected);
-            CAPTURE(s.mean);
-            CHECK(std::abs(s.mean - expected) <= kSigmas * s.se() + 1e-6);
-        }
-        for (const float side : {1.f, -1.f}) {
-            const double expected = side > 0.f ? 0.3 : 0.5;
-            const Stat s = estimate(est, sheet, 4000, 43, toward(Vec3(0.1f, 0.6f * side, 0.2f), Vec3(0.f)));
-            CAPTURE(expected);
-            CAPTURE(s.mean);
-            CHECK(std::abs(s.mean - expected) <= kSigmas * s.se() + 1e-6);
-        }
-    });
+    shading_scenes::check_shading_bsdfs([](auto check) { for_each_strategy(check); }, 4000, kSigmas);
 }
 
 TEST_CASE("surface estimators: a light that sees its hit (textured quad lights around a Lambertian floor)") {
-    // Five walls emit a 2 x 2 checkerboard of 0.8 and 0.2 read from the hit's (or sample's) uv:
-    // from the floor's centre every wall is as bright as a uniform 0.5, so L = 0.5 x 0.5 there
-    // (0.4 if the hits' uv did not reach the light: its first quadrant everywhere); seen
-    // directly, a wall is its square's value.
-    using shading_scenes::quadrant_albedo;
-    const shading_scenes::TexturedSc sc = shading_scenes::textured_box();
-    auto toward = [](Vec3 o, Vec3 target) { return [=](Pcg32&) { return Ray{o, glm::normalize(target - o)}; }; };
-    for_each_strategy([&](const auto& est, const char* name) {
-        CAPTURE(std::string(name));
-        const Stat floor = estimate(est, sc, 4000, 47, toward(Vec3(0.3f, 0.2f, 0.1f), Vec3(0.f, -1.f, 0.f)));
-        CAPTURE(floor.mean);
-        CHECK(std::abs(floor.mean - 0.25) <= kSigmas * floor.se() + 1e-6);
-        // The wall x = -1: u along y, v along z.
-        for (const Vec3 target : {Vec3(-1.f, 0.5f, -0.5f), Vec3(-1.f, 0.5f, 0.5f)}) {
-            const double expected = quadrant_albedo(Vec2(0.5f * (target.y + 1.f), 0.5f * (target.z + 1.f)));
-            const Stat wall = estimate(est, sc, 100, 49, toward(Vec3(0.f), target));
-            CAPTURE(expected);
-            CHECK(std::abs(wall.mean - expected) <= 1e-6);
-        }
-    });
+    shading_scenes::check_textured_lights([](auto check) { for_each_strategy(check); }, 4000, kSigmas);
 }
 
 TEST_CASE("surface estimators: a mirror behind an absorbing slab reflects the light behind the camera") {

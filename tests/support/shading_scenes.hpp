@@ -8,6 +8,7 @@
 #pragma once
 
 #include <cmath>
+#include <string>
 #include <vector>
 
 #include <nsp/nsp.hpp>
@@ -196,6 +197,62 @@ inline TexturedSc textured_box() {
     }
     return TexturedSc(shapes, {}, Mats({}, {}, {LambertianBsdf<S>(Spectrum::Constant(0.5f))}),
                       TexturedLs(LightSelection::Uniform, 3.f, std::move(lights)), -1);
+}
+
+/// The camera ray from o toward `target`, for estimate().
+inline auto toward(Vec3 o, Vec3 target) {
+    return [=](Pcg32&) { return Ray{o, glm::normalize(target - o)}; };
+}
+
+/// Runs the closed forms of the shading BSDFs for every estimator `for_each` hands its check (as
+/// the tests' for_each_strategy and for_each_bdpt do), n samples a case, within k standard
+/// errors. The floor of a box of emitting walls sees only them: L = its albedo at the hit's uv,
+/// 0.8 and 0.2 on neighbouring squares (0 if the hit's point, tangent or datum did not reach the
+/// BSDF). A sheet across a box whose upper walls emit 1 and lower walls are black: L = r = 0.3
+/// from above, t = 0.5 from below; a third uniform that did not pick the lobe would weigh r and t
+/// wrongly.
+template <class ForEach>
+void check_shading_bsdfs(ForEach for_each, int n, double k) {
+    const Sc checker = checker_box(), sheet = sheet_box(0.3f, 0.5f);
+    for_each([&](const auto& est, const char* name) {
+        CAPTURE(std::string(name));
+        for (const float x : {-0.1f, 0.1f}) {  // u along z, v along x: squares (1, 1) and (1, 2)
+            const double expected = checker_albedo(Vec2(0.45f, 0.5f * (x + 1.f)));
+            const Stat s = grey_scenes::estimate(est, checker, n, 41, toward(Vec3(0.f, 0.5f, 0.f), Vec3(x, -1.f, -0.1f)));
+            CAPTURE(expected);
+            CAPTURE(s.mean);
+            CHECK(std::abs(s.mean - expected) <= k * s.se() + 1e-6);
+        }
+        for (const float side : {1.f, -1.f}) {
+            const double expected = side > 0.f ? 0.3 : 0.5;
+            const Stat s = grey_scenes::estimate(est, sheet, n, 43, toward(Vec3(0.1f, 0.6f * side, 0.2f), Vec3(0.f)));
+            CAPTURE(expected);
+            CAPTURE(s.mean);
+            CHECK(std::abs(s.mean - expected) <= k * s.se() + 1e-6);
+        }
+    });
+}
+
+/// Runs the closed forms of the textured quad lights as check_shading_bsdfs does. Five walls
+/// emit a 2 x 2 checkerboard of 0.8 and 0.2 read from the hit's (or sample's) uv: from the
+/// floor's centre every wall is as bright as a uniform 0.5, so L = 0.5 x 0.5 there (0.4 if the
+/// hits' uv did not reach the light: its first quadrant everywhere); seen directly, a wall is its
+/// square's value, exactly.
+template <class ForEach>
+void check_textured_lights(ForEach for_each, int n, double k) {
+    const TexturedSc sc = textured_box();
+    for_each([&](const auto& est, const char* name) {
+        CAPTURE(std::string(name));
+        const Stat floor = grey_scenes::estimate(est, sc, n, 47, toward(Vec3(0.3f, 0.2f, 0.1f), Vec3(0.f, -1.f, 0.f)));
+        CAPTURE(floor.mean);
+        CHECK(std::abs(floor.mean - 0.25) <= k * floor.se() + 1e-6);
+        for (const Vec3 target : {Vec3(-1.f, 0.5f, -0.5f), Vec3(-1.f, 0.5f, 0.5f)}) {  // x = -1: u along y, v along z
+            const double expected = quadrant_albedo(Vec2(0.5f * (target.y + 1.f), 0.5f * (target.z + 1.f)));
+            const Stat wall = grey_scenes::estimate(est, sc, 100, 49, toward(Vec3(0.f), target));
+            CAPTURE(expected);
+            CHECK(std::abs(wall.mean - expected) <= 1e-6);
+        }
+    });
 }
 
 }  // namespace nsp_test::shading_scenes
