@@ -291,13 +291,22 @@ struct FixedHit {
 
 TEST_CASE("surface estimators: bad host input gives Status::InvalidInput and 0, never a NaN") {
     using Bad = SurfaceScene<FixedHit, M, GlobalMajorant<M>, HenyeyGreensteinPhase, Mats, Ls>;
+    // Material 0 a shading BSDF: a scene that reads the hits' uv and tangent.
+    using ShadingMats = shading_scenes::Mats;
+    using BadShading = SurfaceScene<FixedHit, M, GlobalMajorant<M>, HenyeyGreensteinPhase, ShadingMats, Ls>;
     const Ls sky(LightSelection::Uniform, 1.f, {}, {EnvironmentLight<S>{Spectrum::Constant(1.f)}});
-    auto run = [&](const SurfaceHit& h) {
-        const Bad sc(FixedHit{h}, {medium(Box{Vec3(-1.f), Vec3(1.f)}, 0.2f, 0.5f)}, materials(), sky, 0);
+    auto render = [&](const auto& sc) {
         Pcg32 rng(1, 1);
         LookupCount counter;
         return PathEstimator<strategy::NullScatteringMis, mis::Balance>{}.radiance(
             sc, Ray{Vec3(0.f), Vec3(0.f, 0.f, 1.f)}, {}, rng, counter);
+    };
+    auto run = [&](const SurfaceHit& h) {
+        return render(Bad(FixedHit{h}, {medium(Box{Vec3(-1.f), Vec3(1.f)}, 0.2f, 0.5f)}, materials(), sky, 0));
+    };
+    auto run_shading = [&](const SurfaceHit& h) {
+        const ShadingMats mats({shading_scenes::CheckerBsdf{0.f, Vec3(0.f), -1}}, {}, {});
+        return render(BadShading(FixedHit{h}, {medium(Box{Vec3(-1.f), Vec3(1.f)}, 0.2f, 0.5f)}, mats, sky, 0));
     };
     SurfaceHit good;
     good.t = 0.5f;
@@ -321,12 +330,6 @@ TEST_CASE("surface estimators: bad host input gives Status::InvalidInput and 0, 
     h.p = Vec3(kInf, 0.f, 0.f);
     bad.push_back({"infinite point", h});
     h = good;
-    h.uv = Vec2(std::numeric_limits<float>::quiet_NaN(), 0.f);
-    bad.push_back({"NaN uv", h});
-    h = good;
-    h.dpdu = Vec3(0.f, kInf, 0.f);
-    bad.push_back({"infinite tangent", h});
-    h = good;
     h.material = 7;
     bad.push_back({"material outside the table", h});
     h = good;
@@ -345,6 +348,21 @@ TEST_CASE("surface estimators: bad host input gives Status::InvalidInput and 0, 
     const auto r = run(good);
     CHECK(r.status == Status::Ok);
     CHECK(std::isfinite(r.value[0]));
+    // Where a shading BSDF reads them, a NaN uv or an infinite tangent is refused too; where no
+    // BSDF or light reads them, they are not looked at.
+    h = good;
+    h.uv = Vec2(std::numeric_limits<float>::quiet_NaN(), 0.f);
+    SurfaceHit t = good;
+    t.dpdu = Vec3(0.f, kInf, 0.f);
+    for (const SurfaceHit& unread : {h, t}) {
+        const auto s = run_shading(unread);
+        CHECK(s.status == Status::InvalidInput);
+        CHECK(s.value[0] == 0.f);
+        CHECK(run(unread).status == Status::Ok);
+    }
+    const auto shaded = run_shading(good);
+    CHECK(shaded.status == Status::Ok);
+    CHECK(std::isfinite(shaded.value[0]));
 }
 
 TEST_CASE("surface estimators: an empty light list renders black; a bad camera medium is rejected") {

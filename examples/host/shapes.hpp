@@ -1,7 +1,7 @@
 // examples/host/shapes.hpp: a host's own geometry for the example host renderer: spheres,
 // axis-aligned boxes, parallelograms (quads) and a triangle list, each with the handles
 // nsp::SurfaceHit carries (material, light, the media inside and outside), searched one by one
-// (a real renderer would put a BVH here). Models nsp::Geometry. A quad's hits also carry its
+// (a real renderer would put a BVH here). Models nsp::Geometry. A quad's hits can also carry its
 // parameters as uv, its first edge as the shading tangent and its index as the host's datum.
 #pragma once
 
@@ -47,6 +47,10 @@ public:
     std::vector<Box> boxes;
     std::vector<Quad> quads;
     std::vector<Triangle> triangles;
+    /// Whether a quad's hits carry its parameters (a, b) as uv, edge_u as the tangent and the
+    /// quad's index as the host's datum (what a textured BSDF or light reads); off, no work is
+    /// spent on them.
+    bool report_uv = false;
 
     nsp::SurfaceHit intersect(const nsp::Ray& r, float t_max) const noexcept {
         nsp::SurfaceHit best;
@@ -66,19 +70,17 @@ public:
             for (const float t : sphere_roots(r, s)) keep(t, r.at(t) - s.center, s.h);
         for (const Box& b : boxes)
             for (const float t : box_roots(r, b)) keep(t, box_normal(r.at(t), b), b.h);
-        int quad = -1;  // the nearest quad so far
+        int quad = -1;  // the nearest quad so far, where uv is reported
         for (std::size_t i = 0; i < quads.size(); ++i) {
             const float t = best.t;
             keep(quad_root(r, quads[i]), glm::cross(quads[i].edge_u, quads[i].edge_v), quads[i].h);
-            if (best.t < t) quad = int(i);
+            if (report_uv && best.t < t) quad = int(i);
         }
         const float after_quads = best.t;
         for (const Triangle& tr : triangles) keep(triangle_root(r, tr), glm::cross(tr.b - tr.a, tr.c - tr.a), tr.h);
         if (!any) return {};
         best.p = r.at(best.t);
         if (quad >= 0 && best.t == after_quads) {  // a quad, no triangle nearer
-            // A quad's hit carries its parameters (a, b) as uv, edge_u as the tangent and the
-            // quad's index as the host's datum: what a textured BSDF reads.
             const Quad& q = quads[std::size_t(quad)];
             const nsp::Vec3 d = best.p - q.corner;
             best.uv = {glm::dot(d, q.edge_u) / glm::dot(q.edge_u, q.edge_u), glm::dot(d, q.edge_v) / glm::dot(q.edge_v, q.edge_v)};

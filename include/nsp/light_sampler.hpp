@@ -60,6 +60,9 @@ template <SpectralMode S, class... Ls>
     requires(Light<Ls, S> && ...)
 class LightSampler {
 public:
+    /// Whether a light here sees where a ray reaches it (SurfaceEmitter).
+    static constexpr bool sees_hits = (SurfaceEmitter<Ls, S> || ...);
+
     /// Throws InvalidArgument on a light with a non-finite position, a radius or area that is not
     /// finite and > 0, a bad radiance, or (Power) when no light has positive power. No lights is
     /// allowed: sample() then returns pdf 0.

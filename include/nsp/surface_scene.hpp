@@ -43,6 +43,8 @@ template <SpectralMode S, class... Bs>
 class Materials {
 public:
     using Spectral = S;
+    /// Whether a BSDF here sees the hit (ShadingBsdf): only then are a hit's uv and tangent read.
+    static constexpr bool sees_hits = (ShadingBsdf<Bs, S> || ...);
 
     explicit Materials(std::vector<Bs>... bsdfs) : bsdfs_(std::move(bsdfs)...) {
         [&]<std::size_t... K>(std::index_sequence<K...>) {

@@ -132,6 +132,7 @@ using Sc = SurfaceScene<Shapes, M, GlobalMajorant<M>, HenyeyGreensteinPhase, Mat
 /// quad lights emitting 1 inward. A point on the floor sees only emitting walls: L = its albedo.
 inline Sc checker_box() {
     Shapes shapes;
+    shapes.report_uv = true;
     std::vector<QuadLight<S>> lights;
     int face = 0;
     for (const CubeFace& f : inward_cube_faces()) {
@@ -152,6 +153,7 @@ inline Sc checker_box() {
 /// (material 0) is L = r, from below L = t.
 inline Sc sheet_box(float r, float t) {
     Shapes shapes;
+    shapes.report_uv = true;
     std::vector<QuadLight<S>> lights;
     const Spectrum one = Spectrum::Constant(1.f);
     auto wall = [&](Vec3 corner, Vec3 eu, Vec3 ev, bool upper) {  // normal cross(eu, ev) inward
@@ -185,6 +187,7 @@ using TexturedSc = SurfaceScene<Shapes, M, GlobalMajorant<M>, HenyeyGreensteinPh
 /// it), as if every wall emitted 0.5: L = 0.5 x 0.5 there.
 inline TexturedSc textured_box() {
     Shapes shapes;
+    shapes.report_uv = true;
     std::vector<TexturedQuadLight> lights;
     int face = 0;
     for (const CubeFace& f : inward_cube_faces()) {

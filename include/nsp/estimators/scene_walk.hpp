@@ -27,15 +27,16 @@ namespace nsp::detail {
 inline constexpr int kMaxInterfaceCrossings = 256;
 
 /// Whether a hit from the host's geometry is one the estimator can use: a distance that is not
-/// NaN or negative, and where something was found a finite point, unit normals, a finite tangent
-/// and uv (what a BSDF reads) and handles inside the scene's tables (a medium, -1 or kSameMedium
-/// on each side).
+/// NaN or negative, and where something was found a finite point, unit normals, handles inside
+/// the scene's tables (a medium, -1 or kSameMedium on each side) and, where a BSDF or light of
+/// the scene reads them (sees_hits), a finite tangent and uv.
 template <class Sc>
 bool usable_hit(const Sc& sc, const SurfaceHit& h) noexcept {
     if (std::isnan(h.t) || h.t < 0.f) return false;
     if (!h.found()) return true;
     if (!finite(h.p) || !unit_length(h.ng) || !unit_length(h.ns)) return false;
-    if (!finite(h.dpdu) || !std::isfinite(h.uv.x) || !std::isfinite(h.uv.y)) return false;
+    if constexpr (std::remove_cvref_t<decltype(sc.materials)>::sees_hits || std::remove_cvref_t<decltype(sc.lights)>::sees_hits)
+        if (!finite(h.dpdu) || !std::isfinite(h.uv.x) || !std::isfinite(h.uv.y)) return false;
     if (h.material != -1 && !sc.materials.contains(h.material)) return false;
     if (h.light != -1 && !(h.light >= 0 && h.light < sc.lights.count())) return false;
     auto medium_ok = [&](int m) { return m == -1 || m == kSameMedium || sc.has_medium(m); };
