@@ -104,6 +104,8 @@ struct SceneMedium {
 template <Geometry G, Medium M, MajorantPolicy<M> Maj, PhaseFunction P, class Mats, class Ls>
 struct SurfaceScene {
     static constexpr bool is_surface_scene = true;  ///< what the estimators render (nsp::Scene is one too)
+    /// Whether a BSDF or light here reads a hit's uv and tangent (ShadingBsdf, SurfaceEmitter).
+    static constexpr bool sees_hits = Mats::sees_hits || Ls::sees_hits;
     using GeometryType = G;
     using MediumType = M;
     using MajorantType = Maj;

@@ -35,7 +35,7 @@ bool usable_hit(const Sc& sc, const SurfaceHit& h) noexcept {
     if (std::isnan(h.t) || h.t < 0.f) return false;
     if (!h.found()) return true;
     if (!finite(h.p) || !unit_length(h.ng) || !unit_length(h.ns)) return false;
-    if constexpr (std::remove_cvref_t<decltype(sc.materials)>::sees_hits || std::remove_cvref_t<decltype(sc.lights)>::sees_hits)
+    if constexpr (Sc::sees_hits)
         if (!finite(h.dpdu) || !std::isfinite(h.uv.x) || !std::isfinite(h.uv.y)) return false;
     if (h.material != -1 && !sc.materials.contains(h.material)) return false;
     if (h.light != -1 && !(h.light >= 0 && h.light < sc.lights.count())) return false;
