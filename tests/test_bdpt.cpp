@@ -18,6 +18,7 @@
 
 #include "common.hpp"
 #include "grey_surface_scenes.hpp"
+#include "null_lobe_scenes.hpp"
 #include "shading_scenes.hpp"
 
 namespace {
@@ -277,6 +278,16 @@ TEST_CASE("bdpt: a BSDF that sees the hit (a uv checkerboard), one that takes a 
     // The path tracer's closed forms (shading_scenes.hpp), every strategy's connections
     // evaluating the BSDFs at the stored vertices' hits.
     shading_scenes::check_shading_bsdfs([](auto check) { for_each_bdpt(check); }, 2000, kSigmas);
+}
+
+TEST_CASE("bdpt: partly null BSDFs (thin dielectric, filter, alpha mask, a glass furnace)") {
+    // The path tracer's closed forms (null_lobe_scenes.hpp): subpaths from both sides cross the
+    // null lobes, connections cross them with their weights.
+    null_lobe_scenes::check_null_lobes([](auto check) { for_each_bdpt(check); }, 2000, 6000, kSigmas);
+}
+
+TEST_CASE("bdpt: a null lobe that breaks its rules gives Status::InvalidInput, never a NaN") {
+    null_lobe_scenes::check_bad_null_lobes([](auto check) { for_each_bdpt(check); });
 }
 
 TEST_CASE("bdpt: a light that sees its hit (textured quad lights around a Lambertian floor)") {

@@ -20,6 +20,7 @@
 
 #include "common.hpp"
 #include "host/shapes.hpp"
+#include "null_lobe_scenes.hpp"
 #include "spectral.hpp"
 #include "surfaces.hpp"
 
@@ -125,6 +126,28 @@ void check_furnace(const Scene& sc, const typename Scene::Spectrum& expected, st
             check_channels<S>(image_average_channels(est, sc, camera, 6000, seed + 1), expected);
         },
         opts);
+}
+
+TEST_CASE("spectral bdpt: partly null BSDFs, a chromatic filter over a floor and a glass furnace") {
+    // support/null_lobe_scenes.hpp's closed forms per channel (as in test_spectral_surfaces.cpp):
+    // L_c = rho w_c F under a filter passing w = (0.9, 0.45, 0.1) with probability 0.6; L = 1 in
+    // a chromatic medium of albedo 1 inside a thin-glass cube under a white sky.
+    namespace nl = null_lobe_scenes;
+    using Scene = nl::SceneOf<M<Rgb>, ChannelMajorant<M<Rgb>>>;
+    const Rgb::Spectrum w(0.9f, 0.45f, 0.1f);
+    const Scene filter = nl::half_lit_box<Scene>(nl::kFilter, nl::kFloor, nl::materials<Rgb>(w));
+    const Vec3 o(0.1f, -0.4f, 0.2f), d = glm::normalize(Vec3(0.f, -1.f, 0.f) - o);
+    const Scene furnace = nl::glass_furnace<Scene>(chromatic<Rgb>(Box{Vec3(-1.f), Vec3(1.f)}, Rgb::Spectrum::Zero(),
+                                                                  Rgb::Spectrum(1.5f, 2.f, 2.5f), 0.5f));
+    for_each_spectral_bdpt([&](const auto& est, const char* name) {
+        CAPTURE(std::string(name));
+        check_channels<Rgb>(estimate_channels(est, filter, 3000, 63, [&](Pcg32&) { return Ray{o, d}; }),
+                            Rgb::Spectrum(w * float(nl::kFloorAlbedo * nl::floor_to_sheet())));
+        check_channels<Rgb>(estimate_channels(est, furnace, 6000, 64, [](Pcg32& rng) {
+                                return Ray{Vec3(0.2f, -0.5f, 0.1f), uniform_sphere(rng.uniform(), rng.uniform())};
+                            }),
+                            Rgb::Spectrum::Ones());
+    });
 }
 
 using Pdfs3 = bdpt::PathPdfs<16, Rgb::Spectrum>;

@@ -3,7 +3,8 @@
 // (an albedo-1 chromatic medium behind null interfaces with the camera inside, a white floor and a
 // mirror under a uniform sky: L = 1 in every channel), the furnace of six emitting walls of a
 // chromatic albedo (L_c = 1 / (1 - albedo_c)), chromatic absorbing media nested behind null
-// interfaces (exp(-tau_c) per channel, channels far apart), in Rgb and Hero<4>.
+// interfaces (exp(-tau_c) per channel, channels far apart), in Rgb and Hero<4>; partly null BSDFs
+// (a chromatic filter, a glass cube around a medium).
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -13,6 +14,7 @@
 #include <vector>
 
 #include "host/shapes.hpp"
+#include "null_lobe_scenes.hpp"
 #include "spectral.hpp"
 #include "surfaces.hpp"
 
@@ -157,6 +159,26 @@ TEST_CASE_TEMPLATE_DEFINE("spectral surfaces: six emitting walls of chromatic al
 }
 TEST_CASE_TEMPLATE_APPLY(spectral_wall_furnace, SpectralEstimatorsWith<absorption::Weight>);
 TEST_CASE_TEMPLATE_APPLY(spectral_wall_furnace, SpectralEquiangular);
+
+TEST_CASE_TEMPLATE_DEFINE("spectral surfaces: partly null BSDFs, a chromatic filter over a floor and a glass furnace (Rgb)", E,
+                          spectral_null_lobes) {
+    // support/null_lobe_scenes.hpp's closed forms per channel: the floor's centre under a filter
+    // that passes w = (0.9, 0.45, 0.1) with probability 0.6, L_c = rho w_c F; a chromatic medium of
+    // albedo 1 in a thin-glass cube over an alpha-masked white floor under a white sky, L = 1.
+    CAPTURE(spectral_estimator_name<E>());
+    namespace nl = null_lobe_scenes;
+    using Scene = nl::SceneOf<HomogeneousMedium<Rgb>, MajorantFor<typename E::Channels, HomogeneousMedium<Rgb>>>;
+    const Rgb::Spectrum w(0.9f, 0.45f, 0.1f);
+    const Scene filter = nl::half_lit_box<Scene>(nl::kFilter, nl::kFloor, nl::materials<Rgb>(w));
+    const Vec3 o(0.1f, -0.4f, 0.2f), d = glm::normalize(Vec3(0.f, -1.f, 0.f) - o);
+    check_zero_error(run(E{}, filter, 8000, 61, [&](Pcg32&) { return Ray{o, d}; },
+                         Rgb::Spectrum(w * float(nl::kFloorAlbedo * nl::floor_to_sheet()))));
+    const Scene furnace = nl::glass_furnace<Scene>(
+        medium_for<E, Rgb>(Box{Vec3(-1.f), Vec3(1.f)}, constant_coefficient<Rgb>(0.f), chroma<Rgb>(1.5f, 2.f, 2.5f)));
+    check_zero_error(run(E{}, furnace, 12000, 62, furnace_ray, Rgb::Spectrum::Ones()));
+}
+TEST_CASE_TEMPLATE_APPLY(spectral_null_lobes, SpectralEstimatorsWith<absorption::Weight>);
+TEST_CASE_TEMPLATE_APPLY(spectral_null_lobes, SpectralEquiangular);
 
 TEST_CASE_TEMPLATE_DEFINE("spectral surfaces: chromatic media nested behind null interfaces, exp(-tau_c) per channel", E,
                           spectral_nested) {

@@ -15,6 +15,7 @@
 
 #include "common.hpp"
 #include "grey_surface_scenes.hpp"
+#include "null_lobe_scenes.hpp"
 #include "shading_scenes.hpp"
 #include "spectral.hpp"
 
@@ -142,6 +143,14 @@ TEST_CASE("surface estimators: a surface that keeps the medium (kSameMedium), a 
 
 TEST_CASE("surface estimators: a BSDF that sees the hit (a uv checkerboard), one that takes a 3D sample (a diffuse sheet)") {
     shading_scenes::check_shading_bsdfs([](auto check) { for_each_strategy(check); }, 4000, kSigmas);
+}
+
+TEST_CASE("surface estimators: partly null BSDFs (thin dielectric, filter, alpha mask, a glass furnace)") {
+    null_lobe_scenes::check_null_lobes([](auto check) { for_each_strategy(check); }, 4000, 20000, kSigmas);
+}
+
+TEST_CASE("surface estimators: a null lobe that breaks its rules gives Status::InvalidInput, never a NaN") {
+    null_lobe_scenes::check_bad_null_lobes([](auto check) { for_each_strategy(check); });
 }
 
 TEST_CASE("surface estimators: a light that sees its hit (textured quad lights around a Lambertian floor)") {

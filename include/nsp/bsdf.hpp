@@ -1,7 +1,8 @@
 // nsp/bsdf.hpp: surface scattering for path vertices on a host's surfaces (THEORY 5.8): the
-// concept a host's BSDF models, and three models: Lambertian reflection, a perfect mirror (a
-// delta lobe) and a null interface (the index-matched boundary of a medium, which a path crosses
-// without a real vertex).
+// concept a host's BSDF models, and its models: Lambertian reflection, a perfect mirror (a delta
+// lobe), a null interface (the index-matched boundary of a medium, which a path crosses without a
+// real vertex), and two partly null BSDFs, whose lobe that passes straight through a path takes
+// with a probability: a thin dielectric sheet and any BSDF behind an opacity mask.
 //
 // A BSDF comes in one of two forms. A shading BSDF sees the hit (a ShadingPoint: position, uv,
 // shading frame, the host's datum) and samples from three uniforms, enough for a rough lobe
@@ -18,8 +19,10 @@
 // f_p / pdf at a medium vertex, and NEE adds value / light_pdf at either.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <concepts>
+#include <type_traits>
 
 #include "core/error.hpp"
 #include "core/math.hpp"
@@ -73,6 +76,32 @@ concept ShadingBsdf = SpectralMode<S> &&
 template <class B, class S>
 concept Bsdf = ShadingBsdf<B, S> || SimpleBsdf<B, S>;
 
+/// The lobe of a partly null BSDF that passes straight through (wi = wo): `weight`, per channel,
+/// the fraction of light that crosses unchanged, and `probability`, with which a path arriving
+/// along wo takes it.
+template <SpectralMode S>
+struct NullLobe {
+    typename S::Spectrum weight = S::Spectrum::Zero();
+    float probability = 0.f;
+};
+
+/// A partly null BSDF (a thin dielectric, an alpha-masked surface) also has a lobe that passes
+/// straight through: `null_lobe(sp, wo, lambda)` gives it, and its sample, eval and pdf describe
+/// the other lobes alone (their values unscaled: f_s of the real part). A path that reaches it
+/// takes the null lobe with `probability`: it crosses as at a null interface (no vertex, no depth,
+/// throughput x weight / probability, and probability joins the segment's null product as a null
+/// collision's P_n does; THEORY 5.8, docs/theory.md). Otherwise it makes a real vertex, its
+/// throughput divided by 1 - probability. A shadow ray crosses it with factor `weight` (and the
+/// probability in its unidirectional pdf). Requirements: probability in [0, 1], above 0 wherever
+/// weight is not 0 (a lobe never taken would be missing from the estimate), and the same from
+/// either side (for wo and -wo: BDPT's reverse densities reuse it). Kernels stop a path whose null
+/// lobe breaks the first two with Status::InvalidInput.
+template <class B, class S>
+concept PartlyNullBsdf = Bsdf<B, S> &&
+    requires(const B& b, const ShadingPoint& sp, const Vec3& w, const typename S::Wavelengths& l) {
+        { b.null_lobe(sp, w, l) } -> std::same_as<NullLobe<S>>;
+    };
+
 namespace detail {
 /// Whether BSDF model B says every lobe is a delta lobe (its optional `is_delta`).
 template <class B>
@@ -108,6 +137,19 @@ template <SpectralMode S, class B>
 
 /// The unit normal on the side of the surface the path arrived from (opposite to wo).
 inline Vec3 facing(const Vec3& wo, const Vec3& n) noexcept { return glm::dot(wo, n) > 0.f ? -n : n; }
+
+/// A perfect mirror's delta lobe at normal n with weight `value`: wo reflected about n, pdf 1 (no
+/// sample for a normal that is NaN or not of unit length).
+template <SpectralMode S>
+BsdfSample<S> mirror_sample(const Vec3& wo, const Vec3& n, const typename S::Spectrum& value) noexcept {
+    BsdfSample<S> s;
+    if (!unit_length(n)) return s;
+    s.wi = wo - 2.f * glm::dot(wo, n) * n;
+    s.pdf = 1.f;
+    s.value = value;
+    s.delta = true;
+    return s;
+}
 }  // namespace detail
 
 /// Lambertian reflection f_s = albedo / pi on the side the path arrived from, sampled by the
@@ -164,13 +206,7 @@ public:
 
     BsdfSample<S> sample(const Vec3& wo, const Vec3& n, float, float,
                          const typename S::Wavelengths& lambda = {}) const noexcept {
-        BsdfSample<S> s;
-        if (!unit_length(n)) return s;  // a NaN or non-unit normal: no sample
-        s.wi = wo - 2.f * glm::dot(wo, n) * n;
-        s.pdf = 1.f;
-        s.value = S::sample(reflectance_, lambda);
-        s.delta = true;
-        return s;
+        return detail::mirror_sample<S>(wo, n, S::sample(reflectance_, lambda));
     }
     typename S::Spectrum eval(const Vec3&, const Vec3&, const Vec3&, const typename S::Wavelengths& = {}) const noexcept {
         return S::Spectrum::Zero();
@@ -249,8 +285,99 @@ struct NullInterface {
     float pdf(const Vec3&, const Vec3&, const Vec3&) const noexcept { return 0.f; }
 };
 
+namespace detail {
+/// The reflectance of a smooth dielectric interface of relative index eta (the far side's over
+/// the near side's) at incidence cosine cos_i (unpolarised; 1 under total internal reflection).
+inline float fresnel_dielectric(float cos_i, float eta) noexcept {
+    cos_i = std::min(1.f, std::abs(cos_i));
+    const float sin2_t = (1.f - cos_i * cos_i) / (eta * eta);
+    if (!(sin2_t < 1.f)) return 1.f;
+    const float cos_t = std::sqrt(1.f - sin2_t);
+    const float rs = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
+    const float rp = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
+    return 0.5f * (rs * rs + rp * rp);
+}
+}  // namespace detail
+
+/// A thin dielectric sheet of index eta in a medium of index 1, its two faces parallel and so close
+/// that the light between them stays at the point it entered: it reflects R' = 2R / (1 + R) (R the
+/// faces' Fresnel reflectance at the incidence angle; every order of reflection between them
+/// summed) and passes the rest, T' = 1 - R', straight through. A partly null BSDF: the reflection
+/// is its one delta lobe, the passage its null lobe, taken with probability T' (so either way the
+/// throughput keeps its value).
+template <SpectralMode S>
+class ThinDielectricBsdf {
+public:
+    static constexpr bool passes_through = false;
+    static constexpr bool is_delta = true;  ///< its real lobe is a mirror's: NEE is skipped there
+
+    /// Throws InvalidArgument unless eta is finite and > 0.
+    explicit ThinDielectricBsdf(float eta) : eta_(eta) {
+        if (!(std::isfinite(eta) && eta > 0.f))
+            detail::fail("ThinDielectricBsdf eta = ", eta, " is not allowed: it must be finite and > 0");
+    }
+
+    /// The sheet's reflectance R' at incidence cosine cos_i.
+    float reflectance(float cos_i) const noexcept {
+        const float r = detail::fresnel_dielectric(cos_i, eta_);
+        return r < 1.f ? 2.f * r / (1.f + r) : 1.f;
+    }
+
+    NullLobe<S> null_lobe(const ShadingPoint& sp, const Vec3& wo, const typename S::Wavelengths& = {}) const noexcept {
+        if (!unit_length(sp.ns)) return {};
+        const float t = 1.f - reflectance(glm::dot(wo, sp.ns));
+        return {S::Spectrum::Constant(t), t};
+    }
+    BsdfSample<S> sample(const Vec3& wo, const Vec3& n, float, float,
+                         const typename S::Wavelengths& = {}) const noexcept {
+        return detail::mirror_sample<S>(wo, n, S::Spectrum::Constant(reflectance(glm::dot(wo, n))));
+    }
+    typename S::Spectrum eval(const Vec3&, const Vec3&, const Vec3&, const typename S::Wavelengths& = {}) const noexcept {
+        return S::Spectrum::Zero();
+    }
+    float pdf(const Vec3&, const Vec3&, const Vec3&) const noexcept { return 0.f; }
+
+private:
+    float eta_;
+};
+
+/// Any BSDF behind an opacity mask: where `opacity(sp)` is alpha (in [0, 1]; a texture read from
+/// sp.uv, say) the surface scatters alpha x B and lets 1 - alpha pass straight through, a partly
+/// null BSDF whose null lobe is taken with probability 1 - alpha. A shading BSDF whichever form B
+/// has (the mask sees the hit). Opacity must be the same seen from either side (it is a property
+/// of the point).
+template <SpectralMode S, class B, class Opacity>
+    requires Bsdf<B, S> && std::is_invocable_r_v<float, const Opacity&, const ShadingPoint&>
+struct AlphaMasked {
+    static constexpr bool passes_through = false;
+    static constexpr bool is_delta = detail::bsdf_delta_v<B>;
+    B bsdf;
+    Opacity opacity;
+
+    NullLobe<S> null_lobe(const ShadingPoint& sp, const Vec3&, const typename S::Wavelengths& = {}) const noexcept {
+        const float pass = 1.f - opacity(sp);
+        return {S::Spectrum::Constant(pass), pass};
+    }
+    BsdfSample<S> sample(const ShadingPoint& sp, const Vec3& wo, const Vec3& u,
+                         const typename S::Wavelengths& lambda = {}) const noexcept {
+        BsdfSample<S> s;
+        if constexpr (ShadingBsdf<B, S>) s = bsdf.sample(sp, wo, u, lambda);
+        else s = bsdf.sample(wo, sp.ns, u.x, u.y, lambda);
+        s.value *= opacity(sp);
+        return s;
+    }
+    typename S::Spectrum eval(const ShadingPoint& sp, const Vec3& wo, const Vec3& wi,
+                              const typename S::Wavelengths& lambda = {}) const noexcept {
+        return detail::eval_bsdf<S>(bsdf, sp, wo, wi, lambda) * opacity(sp);
+    }
+    float pdf(const ShadingPoint& sp, const Vec3& wo, const Vec3& wi) const noexcept {
+        return detail::bsdf_pdf<S>(bsdf, sp, wo, wi);
+    }
+};
+
 static_assert(SimpleBsdf<LambertianBsdf<Mono>, Mono> && !ShadingBsdf<LambertianBsdf<Mono>, Mono> &&
               Bsdf<LambertianBsdf<Mono>, Mono> && Bsdf<MirrorBsdf<Rgb>, Rgb> && Bsdf<NullInterface<Mono>, Mono> &&
-              Bsdf<OneSided<Rgb, LambertianBsdf<Rgb>>, Rgb> && Bsdf<OneSided<Mono, MirrorBsdf<Mono>>, Mono>);
+              Bsdf<OneSided<Rgb, LambertianBsdf<Rgb>>, Rgb> && Bsdf<OneSided<Mono, MirrorBsdf<Mono>>, Mono> &&
+              PartlyNullBsdf<ThinDielectricBsdf<Rgb>, Rgb> && !PartlyNullBsdf<LambertianBsdf<Mono>, Mono>);
 
 }  // namespace nsp

@@ -156,6 +156,19 @@ public:
         return draw_technique(opts_.nee_count, rng);
     }
 
+    /// A partly null BSDF's choice (see the grey state's): the null lobe multiplies f by its
+    /// weight and every channel's tracking pdf by its probability (NEE's alternative crosses it
+    /// with probability 1: its pdf stays); a real vertex multiplies the tracking pdfs by 1 - P.
+    StateScale choose_lobe(bool pass, const NullLobe<S>& lobe) noexcept {
+        if (pass) {
+            st_.f *= lobe.weight;
+            st_.uni *= lobe.probability;
+        } else {
+            st_.uni *= 1.f - lobe.probability;
+        }
+        return st_.template renormalize<CP>(c_);
+    }
+
     // -- Contributions of the techniques ------------------------------------------------------
 
     /// NEE's contribution from vertex x: tracking + NEE (its count), tracking + hit, and

@@ -166,6 +166,21 @@ public:
         return k_.draw_nee(rng);
     }
 
+    /// A partly null BSDF's choice at a surface (`lobe.probability` > 0): its null lobe (`pass`:
+    /// beta x weight / P, and P joins the segment's null product as a null collision's P_n) or a
+    /// real vertex (beta / (1 - P); a factor the vertex's techniques share). Dead where nothing
+    /// is left to carry, Overflowed where beta left float's range.
+    StateScale choose_lobe(bool pass, const NullLobe<S>& lobe) noexcept {
+        if (pass) {
+            beta_ *= lobe.weight / lobe.probability;
+            nulls_ *= lobe.probability;
+        } else {
+            beta_ /= 1.f - lobe.probability;
+        }
+        if (!beta_.allFinite()) return StateScale::Overflowed;
+        return (beta_ != 0.f).any() ? StateScale::Ok : StateScale::Dead;
+    }
+
     // -- Contributions of the techniques ------------------------------------------------------
 
     /// NEE's contribution from vertex `x` with light sample and walk `s` (reached, not blocked):

@@ -45,6 +45,9 @@ public:
     using Spectral = S;
     /// Whether a BSDF here sees the hit (ShadingBsdf): only then are a hit's uv and tangent read.
     static constexpr bool sees_hits = (ShadingBsdf<Bs, S> || ...);
+    /// Whether a BSDF here has a null lobe (PartlyNullBsdf): only then does a hit draw between it
+    /// and a real vertex.
+    static constexpr bool has_null_lobes = (PartlyNullBsdf<Bs, S> || ...);
 
     explicit Materials(std::vector<Bs>... bsdfs) : bsdfs_(std::move(bsdfs)...) {
         [&]<std::size_t... K>(std::index_sequence<K...>) {
@@ -73,6 +76,20 @@ public:
         bool p = false;
         visit(material, [&](const auto& b) { p = std::decay_t<decltype(b)>::passes_through; });
         return p;
+    }
+    /// The material's null lobe for a path arriving along wo (PartlyNullBsdf; none, probability 0,
+    /// for the others).
+    NullLobe<S> null_lobe(int material, const ShadingPoint& sp, const Vec3& wo,
+                          const typename S::Wavelengths& lambda) const noexcept {
+        NullLobe<S> out;
+        if constexpr (has_null_lobes) {
+            visit(material, [&](const auto& b) {
+                if constexpr (PartlyNullBsdf<std::decay_t<decltype(b)>, S>) out = b.null_lobe(sp, wo, lambda);
+            });
+        } else {
+            (void)material, (void)sp, (void)wo, (void)lambda;
+        }
+        return out;
     }
     /// Whether every lobe of the material is a delta lobe (light sampling cannot reach its paths).
     bool is_delta(int material) const noexcept {

@@ -245,7 +245,7 @@ struct BdptEstimator<Mis, H, A, MaxDepth, Ch>::BdptSample {
     /// The shadow walk along r up to `distance` from medium `start`. `end_medium`, if given,
     /// receives the medium the ray ends in.
     Shadow shadow(const Ray& r, float distance, int start, int* end_medium = nullptr) {
-        const auto sh = walk_shadow<P>(sc, r, start, WalkEnd{distance}, pieces());
+        const auto sh = walk_shadow<P>(sc, r, start, WalkEnd{distance}, lambda, pieces());
         if (end_medium && sh.status == Status::Ok && sh.reached) *end_medium = sh.end_medium;
         return as_shadow(sh);
     }

@@ -194,7 +194,7 @@ struct BdptEstimator<Mis, H, A, MaxDepth, Ch>::SubpathWalk {
             return Step::End;
         }
         if (hit.light >= 0) on_hit(path, count, hit, ray, nulls, beta, gamma_here());
-        if (detail::crosses(sc, hit)) {
+        auto cross = [&] {
             if (++crossings > detail::kMaxInterfaceCrossings) {
                 status = Status::InvalidInput;
                 return Step::End;
@@ -202,8 +202,36 @@ struct BdptEstimator<Mis, H, A, MaxDepth, Ch>::SubpathWalk {
             medium = hit.medium_entered(ray.d);
             ray.o = hit.p;
             return Step::Passed;
-        }
+        };
+        if (detail::crosses(sc, hit)) return cross();
         if (hit.material < 0 || sc.materials.passes_through(hit.material)) return Step::End;  // an emitter alone
+        if constexpr (detail::has_null_lobes_v<Sc>) {
+            // A partly null BSDF: its null lobe with probability P (weight / P, and P a null
+            // factor of the segment from either side: the lobe's P is the same both ways), else a
+            // real vertex whose event factor is 1 - P (from either side; it cancels in every
+            // weight, and keeps the densities true).
+            const NullLobe<S> lobe = detail::null_lobe_at(sc, hit, ray.d, lambda);
+            if (!detail::usable_null_lobe(lobe)) {
+                status = Status::InvalidInput;
+                return Step::End;
+            }
+            if (lobe.probability > 0.f) {
+                if (rng.uniform() < lobe.probability) {
+                    beta *= lobe.weight / lobe.probability;
+                    if constexpr (kPerChannel) {
+                        st.f *= lobe.weight;
+                        st.uni *= lobe.probability;
+                    }
+                    if constexpr (Mis::null_pdfs) {
+                        nulls *= lobe.probability;
+                        if (first && count == 1) first->later_nulls *= lobe.probability;
+                    }
+                    return cross();
+                }
+                beta /= 1.f - lobe.probability;
+                if constexpr (Mis::null_pdfs) v.event = bdpt::broadcast<P>(1.f - lobe.probability);
+            }
+        }
         v.kind = bdpt::VertexKind::Surface;
         v.p = hit.p;
         v.ng = hit.ng;

@@ -189,7 +189,7 @@ auto draw_volume_nee(const Sc& sc, const SceneVertex& v, const Vec3& x, const Ve
     d.vertex = eval_vertex(sc, v, wo, point->wi, lambda);
     if (!(d.vertex.value != 0.f).any()) return d;
     d.walk = walk_shadow<P>(sc, Ray{x, point->wi}, start_medium(point->wi),
-                            WalkEnd{point->dist, point->index, false, with_along}, piece);
+                            WalkEnd{point->dist, point->index, false, with_along}, lambda, piece);
     d.status = d.walk.status;
     if (d.status != Status::Ok || !d.walk.reached || !(d.walk.f != 0.f).any()) return d;
     detail::look_up_emission_point(d, m, d.walk.last, d.walk.t_last, lambda, counter);

@@ -47,7 +47,7 @@ template <class P, class Sc, class StartMedium, class Piece, UniformRng R, Looku
     const bool toward_delta = d.light.sample.delta;
     const double before = detail::recorder_work(counter);
     d.walk = walk_shadow<P>(sc, Ray{x, d.vertex.wi}, start_medium(d.vertex.wi),
-                            WalkEnd{d.light.sample.distance, -2, true, false, d.light.light},
+                            WalkEnd{d.light.sample.distance, -2, true, false, d.light.light}, lambda,
                             [&](int m, const Ray& r, float t_max, const Spectrum& f) {
                                 return piece(m, r, t_max, f, toward_delta);
                             });

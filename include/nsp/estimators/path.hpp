@@ -158,19 +158,42 @@ RadianceSample<typename Sc::Spectral> trace_path(const K& k, const Sc& sc, const
             }
             if (hit.light >= 0 && st.counts_hits())
                 add_emitter(hit.light, sc.lights.emitted(hit.light, hit.shading(), ray.d, lambda));
-            if (crosses(sc, hit)) {  // a null interface: no vertex, the segment goes on in the next medium
-                if (++crossings > kMaxInterfaceCrossings) {
-                    status = Status::InvalidInput;
-                    break;
-                }
+            // A null interface, or a null lobe taken: no vertex, the segment goes on in the next medium.
+            auto cross = [&] {
+                if (++crossings > kMaxInterfaceCrossings) return false;
                 medium = hit.medium_entered(ray.d);
                 ray.o = hit.p;
                 st.walked += hit.t;
                 from_medium_vertex = false;
-                continue;
+                return true;
+            };
+            if (crosses(sc, hit)) {
+                if (cross()) continue;
+                status = Status::InvalidInput;
+                break;
             }
             if (hit.material < 0 || sc.materials.passes_through(hit.material))
                 break;  // an emitter without a BSDF: what reaches it ends there
+            if constexpr (has_null_lobes_v<Sc>) {
+                // A partly null BSDF: its null lobe with its probability, else a real vertex.
+                const NullLobe<S> lobe = null_lobe_at(sc, hit, ray.d, lambda);
+                if (!usable_null_lobe(lobe)) {
+                    status = Status::InvalidInput;
+                    break;
+                }
+                if (lobe.probability > 0.f) {
+                    const bool pass = rng.uniform() < lobe.probability;
+                    if (const StateScale r = st.choose_lobe(pass, lobe); r != StateScale::Ok) {
+                        if (r == StateScale::Overflowed) status = Status::NonFinite;
+                        break;
+                    }
+                    if (pass) {
+                        if (cross()) continue;
+                        status = Status::InvalidInput;
+                        break;
+                    }
+                }
+            }
             material = hit.material;
             x = hit.p;
         }

@@ -50,6 +50,27 @@ bool crosses(const Sc& sc, const SurfaceHit& h) noexcept {
     return h.light < 0 && (h.material < 0 || sc.materials.passes_through(h.material));
 }
 
+/// Whether SurfaceScene Sc has a partly null BSDF (only then does a hit draw its null lobe).
+template <class Sc>
+inline constexpr bool has_null_lobes_v = std::remove_cvref_t<decltype(std::declval<const Sc&>().materials)>::has_null_lobes;
+
+/// The null lobe a path arriving along wo meets at h (probability 0: none, or no BSDF there).
+template <class Sc>
+NullLobe<typename Sc::Spectral> null_lobe_at(const Sc& sc, const SurfaceHit& h, const Vec3& wo,
+                                             const typename Sc::Spectral::Wavelengths& lambda) noexcept {
+    if (h.material < 0) return {};
+    return sc.materials.null_lobe(h.material, h.shading(), wo, lambda);
+}
+
+/// Whether a null lobe keeps PartlyNullBsdf's rules: a probability in [0, 1], finite weights >= 0,
+/// and none where the probability is 0.
+template <class S>
+bool usable_null_lobe(const NullLobe<S>& l) noexcept {
+    if (!(l.probability >= 0.f && l.probability <= 1.f)) return false;
+    if (!l.weight.allFinite() || (l.weight < 0.f).any()) return false;
+    return l.probability > 0.f || (l.weight == 0.f).all();
+}
+
 }  // namespace nsp::detail
 
 namespace nsp {
@@ -189,8 +210,9 @@ namespace nsp {
 /// (`end.target`) the end lies in another medium; a failed flight's status, or InvalidInput for a
 /// hit the estimators cannot use.
 template <class P, class Sc, class Piece>
-[[gnu::always_inline]] inline ShadowWalk<P, typename Sc::Spectral> walk_shadow(const Sc& sc, Ray r, int medium,
-                                                                                const WalkEnd& end, Piece&& piece) {
+[[gnu::always_inline]] inline ShadowWalk<P, typename Sc::Spectral> walk_shadow(
+    const Sc& sc, Ray r, int medium, const WalkEnd& end, const typename Sc::Spectral::Wavelengths& lambda,
+    Piece&& piece) {
     using S = typename Sc::Spectral;
     using Spec = typename S::Spectrum;
     ShadowWalk<P, S> out;
@@ -258,6 +280,7 @@ template <class P, class Sc, class Piece>
         if (end.with_along || !sc.geometry.ends_on(end.light))
             t = sc.geometry.distance(r, end.with_along ? kInf : distance - margin);
         if (t < distance - margin) return fail(Status::Ok);
+        (void)lambda;
         if (!take_piece(r, distance, true)) return out;
         return reached(r, t);
     } else {
@@ -266,10 +289,23 @@ template <class P, class Sc, class Piece>
             if (!detail::usable_hit(sc, h)) return fail(Status::InvalidInput);
             h.keep_media(medium);
             const bool last = !h.found() || h.t >= distance - margin;
-            // A surface that is not a null interface before the end blocks the ray: nothing to track.
-            if (!last && !detail::crosses(sc, h)) return fail(Status::Ok);
+            // A surface before the end blocks the ray unless it is a null interface or has a null
+            // lobe, which passes its weight (in the unidirectional pdf: its probability).
+            NullLobe<S> lobe;
+            if constexpr (detail::has_null_lobes_v<Sc>) {
+                if (!last && !detail::crosses(sc, h)) {
+                    lobe = detail::null_lobe_at(sc, h, r.d, lambda);
+                    if (!detail::usable_null_lobe(lobe)) return fail(Status::InvalidInput);
+                }
+            }
+            if (!last && !detail::crosses(sc, h) && !(lobe.probability > 0.f)) return fail(Status::Ok);
             if (!take_piece(r, last ? distance : h.t, last)) return out;
             if (last) return reached(r, h.t);
+            if (lobe.probability > 0.f) {
+                f *= lobe.weight;
+                uni *= lobe.probability;
+                if (!(f != 0.f).any()) return fail(Status::Ok);
+            }
             medium = h.medium_entered(r.d);
             r.o = h.p;
             distance -= h.t;
