@@ -11,14 +11,16 @@
 // against BdptEstimator's directional and null-scattering MIS and BDPT with its expected counts
 // learned (_learned: nsp::NeeCountLearner over the image), then the chromatic lantern (the
 // chromatic cloud in it; Rgb) with the spectral path tracers against BDPT with one pdf
-// (directional and null-scattering MIS) and with every channel's pdfs. The grey room's and the
+// (directional and null-scattering MIS) and with every channel's pdfs, then the glass (the
+// cloud in a thin glass cube on a checkered floor, a lamp in the smoke, a sky image; Mono, half
+// the size and spp) with every grey path tracer and BDPT. The grey room's and the
 // plume's tables end with uni + NEE MIS at counts learned per 16x16 tile. On request (--tables
 // cloud) the main job's cloud in empty space, set-ups A and B, as a SurfaceScene (its sphere
 // light a shape the geometry reports), path tracers against BDPT; (--tables sky) the grey room's
 // BDPT with and without light subpaths from the sky; (--tables empty) nsp_render's other scenes.
 //
 //   nsp_room [--res N] [--spp N] [--threads N] [--out DIR] [--no-png] [--picture-res N]
-//            [--tables grey,rgb,plume,lantern,lantern-rgb,cloud,sky,empty] [--setups ...] [--seed N]
+//            [--tables grey,rgb,plume,lantern,lantern-rgb,glass,cloud,sky,empty] [--setups ...] [--seed N]
 //
 // The files, one concern each: room_cli (the flags), room_plan (which tables run, in order) and
 // room_tables_*.cpp (each table's scene, rows and summary lines; the render loops are
@@ -26,8 +28,8 @@
 // tables and sheets); this file runs the plan, with a progress line per render on stderr.
 //
 // Writes DIR/room_sheet.png, DIR/room_rgb_sheet.png, DIR/room_plume_sheet.png,
-// DIR/lantern_sheet.png and DIR/lantern_rgb_sheet.png (each table's rows at one exposure; with
-// --tables sky, cloud or empty also DIR/room_sky_sheet.png, DIR/cloud_bdpt_sheet.png,
+// DIR/lantern_sheet.png, DIR/lantern_rgb_sheet.png and DIR/glass_sheet.png (each table's rows
+// at one exposure; with --tables sky, cloud or empty also DIR/room_sky_sheet.png, DIR/cloud_bdpt_sheet.png,
 // DIR/empty_bdpt_sheet.png) and DIR/room.png (the grey room, uni-nee-mis balance, 128 spp,
 // --picture-res pixels square) unless --no-png; DIR is created, and checked to be writable,
 // before the first render.

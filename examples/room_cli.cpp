@@ -26,10 +26,10 @@ RoomOptions parse_room_flags(int argc, char** argv) {
     app.add_option("--seed", o.seed, "added to every row's seed (independent runs), 0 to 10^12")
         ->check(integer_in(0, 1'000'000'000'000));
     app.add_option("--tables", o.tables,
-                   "which tables to render (default: grey,rgb,plume,lantern,lantern-rgb; cloud: the main job's cloud, set-ups A "
+                   "which tables to render (default: grey,rgb,plume,lantern,lantern-rgb,glass; cloud: the main job's cloud, set-ups A "
                    "and B, with BDPT; sky: the grey room's BDPT with and without light subpaths from the sky; empty: "
                    "nsp_render's other scenes, SA, F1-F3, C1, C2, P1, with BDPT)")
-        ->check(CLI::IsMember({"grey", "rgb", "plume", "lantern", "lantern-rgb", "cloud", "sky", "empty"}))
+        ->check(CLI::IsMember({"grey", "rgb", "plume", "lantern", "lantern-rgb", "glass", "cloud", "sky", "empty"}))
         ->delimiter(',');
     app.add_option("--setups", o.setups, "with --tables empty: which of nsp_render's set-ups to render (default: all)")
         ->check(CLI::IsMember({"SA", "F1", "F2", "F3", "C1", "C2", "P1"}))

@@ -15,7 +15,7 @@ struct RoomOptions {
     std::string out = "out";
     bool no_png = false;
     std::uint64_t seed = 0;  ///< --seed: added (x 1000) to every row's seed
-    std::vector<std::string> tables{"grey", "rgb", "plume", "lantern", "lantern-rgb"};
+    std::vector<std::string> tables{"grey", "rgb", "plume", "lantern", "lantern-rgb", "glass"};
     std::vector<std::string> setups{"SA", "F1", "F2", "F3", "C1", "C2", "P1"};  ///< with --tables empty
 
     bool wants(const std::string& table) const { return std::find(tables.begin(), tables.end(), table) != tables.end(); }

@@ -15,6 +15,7 @@ std::vector<RoomTable> room_tables(const RoomOptions& o) {
     add("plume", plume_table);
     add("lantern", lantern_table);
     add("lantern-rgb", lantern_rgb_table);
+    add("glass", glass_table);
     add("sky", sky_table);
     add("cloud", cloud_tables);
     add("empty", empty_tables);

@@ -41,11 +41,12 @@ RoomTable rgb_table(const RoomOptions& o);
 RoomTable lantern_rgb_table(const RoomOptions& o);
 RoomTable plume_table(const RoomOptions& o);
 RoomTable lantern_table(const RoomOptions& o);
+RoomTable glass_table(const RoomOptions& o);
 std::vector<RoomTable> cloud_tables(const RoomOptions& o);
 std::vector<RoomTable> empty_tables(const RoomOptions& o);
 
 /// The tables --tables asks for, in the order they run: grey, rgb, plume, lantern, lantern-rgb,
-/// sky, cloud, empty.
+/// glass, sky, cloud, empty.
 std::vector<RoomTable> room_tables(const RoomOptions& o);
 
 /// DIR/room.png's render: the grey room with uni + NEE MIS (balance), --picture-res pixels square,

@@ -1,9 +1,12 @@
 // examples/room_scene.hpp: the surface-and-smoke scene of the main job (nsp_room): the default
 // cloud (default_scene.hpp), grey or chromatic, resting over a diffuse floor in an open room (a
 // floor, a back wall and a left wall), lit by a small rectangular light above and to the right of
-// it and a dim sky, as an nsp::SurfaceScene over the example shapes (host/shapes.hpp).
+// it and a dim sky, as an nsp::SurfaceScene over the example shapes (host/shapes.hpp); the
+// lantern (a lamp in a box above the cloud); and the glass (the cloud in a thin glass cube on a
+// checkered floor, a lamp in the smoke, under a sky image).
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <utility>
 #include <vector>
@@ -105,6 +108,103 @@ RoomScene<M, Maj> make_lantern_scene(M medium, Maj majorant) {
                                                nsp::LambertianBsdf<S>(nsp::constant_coefficient<S>(0.5f)),
                                                nsp::LambertianBsdf<S>(nsp::constant_coefficient<S>(0.2f))}),
                              RoomLights<S>(nsp::LightSelection::Power, 4.f, {lamp}, {}), -1);
+}
+
+// ---------------------------------------------------------------------------------------------
+// The glass: the cloud inside a thin glass cube on a checkered floor, a lamp inside the smoke,
+// under an environment map. What a host brings: a BSDF that reads the hit's uv, a partly null
+// BSDF around a medium, an emitter inside a medium and an image light.
+
+/// The glass scene's floor: Lambertian with a checkerboard albedo, 0.75 and 0.25 on 8 x 8 squares
+/// over the quad's uv; a host's textured BSDF (nsp::ShadingBsdf).
+template <nsp::SpectralMode S>
+struct CheckerFloorBsdf {
+    static constexpr bool passes_through = false;
+
+    static float albedo(const nsp::ShadingPoint& sp) {
+        return (int(8.f * sp.uv.x) + int(8.f * sp.uv.y)) % 2 == 0 ? 0.75f : 0.25f;
+    }
+    nsp::BsdfSample<S> sample(const nsp::ShadingPoint& sp, const nsp::Vec3& wo, const nsp::Vec3& u,
+                              const typename S::Wavelengths& = {}) const noexcept {
+        const float cos_theta = std::sqrt(std::max(0.f, 1.f - u.x));
+        nsp::BsdfSample<S> s;
+        if (!(cos_theta > 0.f)) return s;
+        s.wi = nsp::direction_around(nsp::detail::facing(wo, sp.ns), cos_theta, 2.f * nsp::kPi * u.y);
+        s.pdf = cos_theta / nsp::kPi;
+        s.value = S::Spectrum::Constant(albedo(sp) * cos_theta / nsp::kPi);
+        return s;
+    }
+    typename S::Spectrum eval(const nsp::ShadingPoint& sp, const nsp::Vec3& wo, const nsp::Vec3& wi,
+                              const typename S::Wavelengths& = {}) const noexcept {
+        const float c = glm::dot(wi, nsp::detail::facing(wo, sp.ns));
+        return S::Spectrum::Constant(c > 0.f ? albedo(sp) * c / nsp::kPi : 0.f);
+    }
+    float pdf(const nsp::ShadingPoint& sp, const nsp::Vec3& wo, const nsp::Vec3& wi) const noexcept {
+        const float c = glm::dot(wi, nsp::detail::facing(wo, sp.ns));
+        return c > 0.f ? c / nsp::kPi : 0.f;
+    }
+};
+
+template <nsp::SpectralMode S>
+using GlassMaterials = nsp::Materials<S, CheckerFloorBsdf<S>, nsp::ThinDielectricBsdf<S>, nsp::LambertianBsdf<S>>;
+template <nsp::SpectralMode S>
+using GlassLights = nsp::LightSampler<S, nsp::QuadLight<S>, nsp::ImageEnvironmentLight<S>>;
+template <nsp::Medium M = nsp::DenseGridMedium<nsp::Mono>, class Maj = nsp::GlobalMajorant<M>>
+using GlassScene = nsp::SurfaceScene<nsp_host::Shapes, M, Maj, nsp::HenyeyGreensteinPhase,
+                                     GlassMaterials<typename M::Spectral>, GlassLights<typename M::Spectral>>;
+
+/// The glass scene's sky, 64 x 32 in latitude-longitude: a gradient from a pale horizon (0.35) to
+/// a blue zenith and a sun 6 degrees across, 30 degrees up toward -x, +z (radiance 400), dark below
+/// the horizon (0.05).
+inline std::vector<float> glass_sky_image(int w = 64, int h = 32) {
+    std::vector<float> rgb(std::size_t(w) * std::size_t(h) * 3);
+    const nsp::Vec3 sun = glm::normalize(nsp::Vec3(-0.6f, std::tan(30.f * nsp::kPi / 180.f), 0.8f));
+    for (int y = 0; y < h; ++y) {
+        for (int x = 0; x < w; ++x) {
+            const float theta = nsp::kPi * (float(y) + 0.5f) / float(h), phi = 2.f * nsp::kPi * (float(x) + 0.5f) / float(w);
+            const nsp::Vec3 d(std::sin(theta) * std::sin(phi), std::cos(theta), -std::sin(theta) * std::cos(phi));
+            float r = 0.05f, g = 0.05f, b = 0.05f;
+            if (d.y > 0.f) {
+                r = 0.35f - 0.25f * d.y;
+                g = 0.35f - 0.15f * d.y;
+                b = 0.35f + 0.1f * d.y;
+            }
+            if (glm::dot(d, sun) > std::cos(3.f * nsp::kPi / 180.f)) r = g = b = 400.f;
+            float* px = &rgb[(std::size_t(y) * std::size_t(w) + std::size_t(x)) * 3];
+            px[0] = r, px[1] = g, px[2] = b;
+        }
+    }
+    return rgb;
+}
+
+/// The glass: `medium` (in [-1, 1]^3) inside a thin glass cube of index 1.5 (material 1, medium 0
+/// inside), standing on the room's floor as a checkerboard (material 0, uv over its 6 x 6) before
+/// the back and left walls (material 2, albedo 0.5); a lamp 0.3 x 0.3 inside the smoke at height
+/// 0.6, facing down, radiance 25 (light 0, medium 0 on both sides); the sky image (light 1).
+template <nsp::Medium M, class Maj>
+GlassScene<M, Maj> make_glass_scene(M medium, Maj majorant) {
+    using S = typename M::Spectral;
+    nsp_host::Shapes shapes;
+    shapes.report_uv = true;
+    add_room_shell(shapes);
+    shapes.boxes[0].h.material = 1;
+    shapes.quads[1].h.material = shapes.quads[2].h.material = 2;
+    const nsp::QuadLight<S> lamp{nsp::Vec3(-0.15f, 0.6f, -0.15f), nsp::Vec3(0.f, 0.f, 0.3f), nsp::Vec3(0.3f, 0.f, 0.f),
+                                 nsp::constant_coefficient<S>(25.f)};
+    shapes.quads.push_back({lamp.corner, lamp.edge_u, lamp.edge_v, {-1, 0, 0, 0}});
+    return GlassScene<M, Maj>(
+        std::move(shapes), {{std::move(medium), std::move(majorant), nsp::HenyeyGreensteinPhase(kPhaseG)}},
+        GlassMaterials<S>({CheckerFloorBsdf<S>{}}, {nsp::ThinDielectricBsdf<S>(1.5f)},
+                          {nsp::LambertianBsdf<S>(nsp::constant_coefficient<S>(0.5f))}),
+        GlassLights<S>(nsp::LightSelection::Power, 4.f, {lamp}, {nsp::ImageEnvironmentLight<S>(64, 32, glass_sky_image())}),
+        -1);
+}
+
+/// The glass of the main job's table: the default cloud, Mono, one global majorant.
+inline GlassScene<> make_glass_scene() {
+    auto cloud = make_default_medium<nsp::Mono>();
+    nsp::GlobalMajorant<nsp::DenseGridMedium<nsp::Mono>> majorant(cloud);
+    return make_glass_scene(std::move(cloud), majorant);
 }
 
 /// The room's camera: from (0, 0.6, -5.6) toward (0, -0.15, 0), 42 degrees vertical field of
