@@ -407,6 +407,64 @@ TEST_CASE_TEMPLATE("transmittance is unbiased with grid majorants and with major
                         "global-signed-0.5", exact);
 }
 
+static_assert(ExtinctionBoundedMedium<TwoGridMedium<Rgb>> && CellBoundedMedium<TwoGridMedium<Mono>> &&
+              !RegionBoundedMedium<TwoGridMedium<Rgb>>);
+
+TEST_CASE_TEMPLATE("a medium made of several grids takes grid and tree majorants that bound every channel", S, Mono, Rgb) {
+    using M = TwoGridMedium<S>;
+    const M medium{spec<S>(3.f, 0.5f, 0.1f), spec<S>(0.2f, 1.f, 4.f)};
+    const GridMajorant<M> grid(medium, 8);
+    const ChannelGridMajorant<M> channel_grid(medium, 8);
+    const auto tree = TreeKind::make(medium);
+    const auto channel_tree = ChannelTreeKind::make(medium);
+    // Every majorant bounds every channel's extinction at random points.
+    Pcg32 rng(3, 3);
+    for (int i = 0; i < 20000; ++i) {
+        const Vec3 p(2.f * rng.uniform() - 1.f, 2.f * rng.uniform() - 1.f, 2.f * rng.uniform() - 1.f);
+        const auto mu = medium.coefficients(p).sigma_t();
+        CAPTURE(p.x);
+        CAPTURE(p.y);
+        CHECK(grid.value_at(p, {}) >= mu.maxCoeff());
+        CHECK(tree.value_at(p, {}) >= mu.maxCoeff());
+        CHECK((channel_grid.value_at(p, {}) >= mu).all());
+        CHECK((channel_tree.value_at(p, {}) >= mu).all());
+    }
+    // The grid follows the medium: the cell at the low corner (r < 1/8 in x and y) is bounded by
+    // (a + b) / 8 per channel, far below the global bound a + b (padding aside).
+    const auto low = channel_grid.value_at(Vec3(-0.99f, -0.99f, 0.f), {});
+    CHECK((low <= 1.001f * (medium.a + medium.b) / 8.f).all());
+    CHECK(grid.value_at(Vec3(-0.99f, -0.99f, 0.f), {}) <= 1.001f * (medium.a + medium.b).maxCoeff() / 8.f);
+    // Ratio and delta tracking under the grey ones are unbiased: exp(-tau_c), tau linear along
+    // each ray (the per-channel ones drive channel tracking: test_spectral_majorants.cpp).
+    auto exact = [&](const Ray& r, float tmax) { return typename S::Spectrum((-medium.optical_depth(r, tmax)).exp()); };
+    check_transmittance(medium, grid, "grid over two grids", exact);
+    check_transmittance(medium, tree, "tree over two grids", exact);
+}
+
+TEST_CASE("a medium made of several grids: bad region bounds are refused with the value and the channel") {
+    struct Bad : TwoGridMedium<Rgb> {
+        float nan_at = 0.f;
+        Rgb::Spectrum extinction_bound_over(const Box& r) const {
+            Rgb::Spectrum v = TwoGridMedium<Rgb>::extinction_bound_over(r);
+            if (r.hi.x < 1.f) v[1] = nan_at;  // every cell but the last column (and not the whole box)
+            return v;
+        }
+    };
+    static_assert(ExtinctionBoundedMedium<Bad>);
+    Bad nan;
+    nan.a = Rgb::Spectrum(1.f, 1.f, 1.f);
+    nan.b = Rgb::Spectrum(1.f, 1.f, 1.f);
+    nan.nan_at = std::numeric_limits<float>::quiet_NaN();
+    CHECK_THROWS_WITH_AS(GridMajorant<Bad>(nan, 4), Contains("in channel 1 is not allowed"), InvalidArgument);
+    // A channel with no extinction over the whole box but some in a cell: the bounds contradict.
+    Bad zero;
+    zero.a = Rgb::Spectrum(1.f, 0.f, 1.f);
+    zero.b = Rgb::Spectrum(1.f, 0.f, 1.f);
+    zero.nan_at = 0.5f;
+    CHECK_THROWS_WITH_AS(ChannelGridMajorant<Bad>(zero, 4), Contains("exceeds its bound over its whole box"),
+                         InvalidArgument);
+}
+
 TEST_CASE("bound::Clamp gives the clamped medium's transmittance: its bias is what the clamp predicts") {
     // Homogeneous mu_t = 2 under a global majorant of 1: the clamped medium has mu_t = 1.
     using H = HomogeneousMedium<Mono>;

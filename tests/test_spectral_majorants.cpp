@@ -2,7 +2,8 @@
 // (per channel for the policies with their own pdfs, grey for spectral tracking) and with grid
 // majorants at half the bound under bound::Signed: directly transmitted light against the
 // closed-form exp(-tau_c) of an exponential medium (channels 1e4 apart, one empty), and the
-// furnace on a grid medium. Fixed seeds, k = 5 standard errors estimated from the samples.
+// furnace on a grid medium; and transmitted light through a medium made of two grids (bounded per
+// channel). Fixed seeds, k = 5 standard errors estimated from the samples.
 #include <string>
 #include <type_traits>
 
@@ -76,6 +77,25 @@ TEST_CASE_TEMPLATE_DEFINE("spectral estimators with grid majorants: transmitted 
 }
 
 TEST_CASE_TEMPLATE_APPLY(grid_transmitted, AllSpectralEstimators);
+
+TEST_CASE_TEMPLATE_DEFINE("spectral estimators with grid majorants over a medium of two grids: exp(-tau_c)", E,
+                          two_grid_transmitted) {
+    // support/majorants.hpp's TwoGridMedium (an ExtinctionBoundedMedium: no single density), its
+    // channels' extinctions far apart in x and y; tau linear along the ray.
+    CAPTURE(spectral_estimator_name<E>());
+    EstimatorOptions opts;
+    opts.max_depth = 0;
+    const TwoGridMedium<Rgb> medium{Rgb::Spectrum(3.f, 0.5f, 0.f), Rgb::Spectrum(0.2f, 1.f, 4.f)};
+    const Ray ray{Vec3(-3.f, 0.1f, 0.2f), glm::normalize(Vec3(1.f, 0.3f, -0.1f))};
+    with_grid_scenes<E>(medium, unit_environment<Rgb>(), [&](const auto& scene, const char* kind) {
+        CAPTURE(kind);
+        check_unbiased(estimate_error(E(opts), scene, ray, 20000, 43, [&](const Rgb::Wavelengths&) {
+            return Rgb::Spectrum((-medium.optical_depth(ray, kInf)).exp());
+        }));
+    });
+}
+
+TEST_CASE_TEMPLATE_APPLY(two_grid_transmitted, AllSpectralEstimators);
 
 TEST_CASE_TEMPLATE_DEFINE("spectral estimators with grid majorants: the furnace gives 1 in every channel", E,
                           grid_spectral_furnace) {

@@ -4,6 +4,7 @@
 // (unbiased) and bound::Clamp (exact for the clamped medium).
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <string>
 #include <tuple>
@@ -75,6 +76,35 @@ struct ClampGridKind {
     template <class M> static type<M> make(const M& m) { return type<M>(m, kTestGridRes, 0.5f); }
 };
 
+/// A medium made of two grids, as a host's may be: mu_t,c(p) = a_c r(x) + b_c r(y) with the
+/// ramps r(s) = (s + 1) / 2 over [-1, 1]^3 (scattering half of it); no single density, so it
+/// bounds its extinction per channel over a region (ExtinctionBoundedMedium): a_c r(hi.x) +
+/// b_c r(hi.y), both ramps rising, hi clamped to the box.
+template <SpectralMode S>
+struct TwoGridMedium {
+    using Spectral = S;
+    using Spectrum = typename S::Spectrum;
+    Spectrum a, b;
+
+    static float ramp(float s) { return 0.5f * (std::clamp(s, -1.f, 1.f) + 1.f); }
+    Box bounds() const { return Box{Vec3(-1.f), Vec3(1.f)}; }
+    Coefficients<S> coefficients(const Vec3& p, const typename S::Wavelengths& = {}) const {
+        if (!bounds().contains(p)) return {Spectrum::Zero(), Spectrum::Zero()};
+        const Spectrum t = a * ramp(p.x) + b * ramp(p.y);
+        return {Spectrum(0.5f * t), Spectrum(0.5f * t)};
+    }
+    Spectrum extinction_bound_over(const Box& r) const { return a * ramp(r.hi.x) + b * ramp(r.hi.y); }
+    Spectrum extinction_bound_coefficient() const { return a + b; }
+    Spectrum extinction_bound(const typename S::Wavelengths& = {}) const { return a + b; }
+    float max_extinction() const { return (a + b).maxCoeff(); }
+    /// Every channel's optical depth along r over [0, tmax]: the ramps are linear along the ray.
+    Spectrum optical_depth(const Ray& r, float tmax) const {
+        const Interval in = bounds().clip(r, 0.f, tmax);
+        if (!(in.t1 > in.t0)) return Spectrum::Zero();
+        const Vec3 m = r.at(0.5f * (in.t0 + in.t1));
+        return Spectrum((a * ramp(m.x) + b * ramp(m.y)) * (in.t1 - in.t0));
+    }
+};
 /// True when majorant kind K can be built for medium M (grid kinds need a RegionBoundedMedium).
 template <class K, class M>
 inline constexpr bool kind_applies_v = requires(const M& m) { K::make(m); };

@@ -52,7 +52,7 @@ inline void require_step_cost(float step_cost) {
 }  // namespace detail
 
 /// The cost model's steps and lookups per random line for the GlobalMajorant of `medium`.
-template <RegionBoundedMedium M>
+template <CellBoundedMedium M>
 MajorantCost global_majorant_cost(const M& medium) {
     const Box b = medium.bounds();
     const double s = detail::box_surface(b);
@@ -68,7 +68,7 @@ MajorantCost global_majorant_cost(const M& medium) {
 /// The cost model's steps and lookups per random line for a GridMajorant of `res` cells over
 /// `medium`'s bounds (its cells as GridMajorant builds them, padding included). Throws as
 /// GridMajorant does, and on a step_cost that is negative or not finite.
-template <RegionBoundedMedium M>
+template <CellBoundedMedium M>
 MajorantCost grid_majorant_cost(const M& medium, std::array<int, 3> res, float step_cost = kDefaultStepCost) {
     detail::require_step_cost(step_cost);
     const GridMajorant<M> grid(medium, res);
@@ -93,7 +93,7 @@ MajorantCost grid_majorant_cost(const M& medium, std::array<int, 3> res, float s
 /// 2, 4, 8, ... up to max_res cells per axis (as GridMajorant(medium, R) builds it), whichever
 /// costs least per random line (ties to the coarser). Builds each candidate grid once (at 64,
 /// 262144 density bounds). Throws on max_res outside [1, 4096] or a bad step_cost.
-template <RegionBoundedMedium M>
+template <CellBoundedMedium M>
 MajorantCost choose_grid_resolution(const M& medium, int max_res = 64, float step_cost = kDefaultStepCost) {
     if (max_res < 1 || max_res > 4096)
         detail::fail("choose_grid_resolution: max_res = ", max_res, " is not allowed: it must lie in [1, 4096]");

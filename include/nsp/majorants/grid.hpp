@@ -4,8 +4,10 @@
 // along a ray the DDA visits the cells the ray crosses in order and yields one majorant segment
 // per cell, so the free-flight loop (tracking.hpp) samples with a majorant that follows the
 // medium. Cells whose bound is 0 are skipped: no collision is drawn there, so no lookup is paid.
-// Only media that can bound their density over a region (RegionBoundedMedium) take a grid
-// majorant: a homogeneous medium keeps its single segment and compiles no DDA code.
+// Only media that can bound their extinction over a region take a grid majorant (CellBoundedMedium:
+// a density bound times a per-channel coefficient, RegionBoundedMedium, or a bound per channel,
+// ExtinctionBoundedMedium, for media made of several grids): a homogeneous medium keeps its single
+// segment and compiles no DDA code.
 #pragma once
 
 #include <algorithm>
@@ -34,7 +36,74 @@ concept RegionBoundedMedium = ChannelBoundedMedium<M> && requires(const M& m, co
     { m.extinction_per_density() } -> std::same_as<typename M::Spectral::Coefficient>;
 };
 
+/// A medium whose extinction is not one density times a coefficient (several grids, a grid per
+/// channel, an albedo grid beside a density) and that can bound its extinction per channel over
+/// any axis-aligned region: `extinction_bound_over(region)` (rounding included). Only for spectral
+/// modes whose coefficients are the channels themselves (Mono, Rgb).
+template <class M>
+concept ExtinctionBoundedMedium =
+    ChannelBoundedMedium<M> && std::same_as<typename M::Spectral::Coefficient, typename M::Spectral::Spectrum> &&
+    requires(const M& m, const Box& b) {
+        { m.extinction_bound_over(b) } -> std::same_as<typename M::Spectral::Coefficient>;
+    };
+
+/// What grid and tree majorants need: a medium that bounds its extinction over any region, as a
+/// density times a per-channel coefficient (RegionBoundedMedium) or per channel
+/// (ExtinctionBoundedMedium).
+template <class M>
+concept CellBoundedMedium = RegionBoundedMedium<M> || ExtinctionBoundedMedium<M>;
+
 namespace detail {
+
+/// A CellBoundedMedium's bounds in the form the majorants store, a density per region times a
+/// per-channel unit: a RegionBoundedMedium's own, or for an ExtinctionBoundedMedium the unit
+/// u = its bound over its whole box and the density max_c bound_c(region) / u_c, so that density
+/// x u_c >= bound_c in every channel (equal in the channel that sets it; where the channels do
+/// not vary together the others get a looser bound).
+template <CellBoundedMedium M>
+class CellBounds {
+public:
+    using Coefficient = typename M::Spectral::Coefficient;
+
+    CellBounds(const M& medium, const char* what) : medium_(medium), what_(what) {
+        if constexpr (RegionBoundedMedium<M>) {
+            unit_ = medium.extinction_per_density();
+            require_coefficient(unit_, (std::string(what) + ": the medium's extinction per unit density").c_str());
+        } else {
+            unit_ = medium.extinction_bound_over(medium.bounds());
+            require_coefficient(unit_, (std::string(what) + ": the medium's extinction bound over its bounds").c_str());
+        }
+    }
+
+    const Coefficient& unit() const noexcept { return unit_; }
+
+    /// The density bound over `region`; throws on a bound that is not finite and >= 0, or (per
+    /// channel) one above 0 in a channel whose bound over the whole box is 0.
+    float density(const Box& region) const {
+        if constexpr (RegionBoundedMedium<M>) {
+            return medium_.density_bound(region);
+        } else {
+            const Coefficient b = medium_.extinction_bound_over(region);
+            float d = 0.f;
+            for (int c = 0; c < int(b.size()); ++c) {
+                if (!std::isfinite(b[c]) || b[c] < 0.f)
+                    fail(what_, ": the medium's extinction bound over a cell = ", b[c], " in channel ", c,
+                         " is not allowed: it must be finite and >= 0");
+                if (!(b[c] > 0.f)) continue;
+                if (!(unit_[c] > 0.f))
+                    fail(what_, ": the medium's extinction bound over a cell = ", b[c], " in channel ", c,
+                         " exceeds its bound over its whole box, ", unit_[c], ": a region's bound must not");
+                d = std::max(d, b[c] / unit_[c]);
+            }
+            return d;
+        }
+    }
+
+private:
+    const M& medium_;
+    const char* what_;
+    Coefficient unit_{};
+};
 
 /// Relative padding of every grid-majorant cell over the density bound the medium states: it
 /// covers the rounding of the product density * coefficient and of the channel sums (a few ulps;
@@ -192,11 +261,12 @@ private:
 
 /// The storage shared by the grey and per-channel grid majorants: per cell, a bound of the
 /// density over the cell times kGridMajorantPad times the caller's scale.
-template <RegionBoundedMedium M>
+template <CellBoundedMedium M>
 class MajorantGrid {
 public:
     MajorantGrid(const M& medium, std::array<int, 3> res, float scale, const char* what)
         : box_(medium.bounds()), res_(res) {
+        const CellBounds<M> bounds(medium, what);
         std::size_t n = 1;
         for (int a = 0; a < 3; ++a) {
             if (res[a] < 1 || res[a] > 4096)
@@ -216,9 +286,7 @@ public:
                 fail(what, " cell size on axis ", a, " = ", cell_[a], " (bounds [", box_.lo[a], ", ", box_.hi[a],
                      "] over resolution[", a, "] = ", res[a], ") is not allowed: it must be finite and > 0");
         }
-        require_coefficient(medium.extinction_per_density(),
-                            (std::string(what) + ": the medium's extinction per unit density").c_str());
-        const float unit = max_value(medium.extinction_per_density());
+        const float unit = max_value(bounds.unit());
         values_.resize(n);
         const float pad = kGridMajorantPad * scale;
         std::size_t i = 0;
@@ -231,7 +299,7 @@ public:
                         region.lo[a] = box_.lo[a] + float(c[a]) * cell_[a];
                         region.hi[a] = c[a] + 1 == res[a] ? box_.hi[a] : box_.lo[a] + float(c[a] + 1) * cell_[a];
                     }
-                    const float d = medium.density_bound(region);
+                    const float d = bounds.density(region);
                     if (!std::isfinite(d) || d < 0.f)
                         fail(what, " cell (", x, ", ", y, ", ", z, "): the medium's density bound = ", d,
                              " is not allowed: it must be finite and >= 0");
@@ -312,7 +380,7 @@ private:
 /// the largest extinction per unit density over every channel (and wavelength), walked by a DDA.
 /// `scale` multiplies every cell: >= 1 under bound::Guaranteed; any value > 0 under bound::Signed,
 /// Clamp or Reject (e.g. 0.5 to go faster with a majorant that does not bound the density).
-template <RegionBoundedMedium M, BoundPolicy B = bound::Guaranteed>
+template <CellBoundedMedium M, BoundPolicy B = bound::Guaranteed>
 class GridMajorant {
 public:
     using Bound = B;
@@ -322,7 +390,7 @@ public:
     /// that overflows, or rounds to 0 where the density is not 0.
     GridMajorant(const M& medium, std::array<int, 3> resolution, float scale = 1.f)
         : grid_(medium, resolution, detail::require_majorant_scale<B>(scale, "GridMajorant scale"), "GridMajorant"),
-          unit_(max_value(medium.extinction_per_density())) {}
+          unit_(max_value(detail::CellBounds<M>(medium, "GridMajorant").unit())) {}
     GridMajorant(const M& medium, int resolution, float scale = 1.f)
         : GridMajorant(medium, {resolution, resolution, resolution}, scale) {}
 
@@ -351,7 +419,7 @@ private:
 /// the density over the cell, times each channel's extinction per unit density at the path's
 /// wavelengths; every channel's majorant follows the medium and its own coefficient. `scale` as
 /// for GridMajorant.
-template <RegionBoundedMedium M, BoundPolicy B = bound::Guaranteed>
+template <CellBoundedMedium M, BoundPolicy B = bound::Guaranteed>
 class ChannelGridMajorant {
 public:
     using Bound = B;
@@ -361,7 +429,7 @@ public:
     /// Throws as GridMajorant does.
     ChannelGridMajorant(const M& medium, std::array<int, 3> resolution, float scale = 1.f)
         : grid_(medium, resolution, detail::require_majorant_scale<B>(scale, "ChannelGridMajorant scale"), "ChannelGridMajorant"),
-          unit_(medium.extinction_per_density()) {}
+          unit_(detail::CellBounds<M>(medium, "ChannelGridMajorant").unit()) {}
     ChannelGridMajorant(const M& medium, int resolution, float scale = 1.f)
         : ChannelGridMajorant(medium, {resolution, resolution, resolution}, scale) {}
 

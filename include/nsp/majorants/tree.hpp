@@ -73,7 +73,7 @@ struct TreeLayout {
 /// A medium that states the layout of its own sparse tree (coarse cells on its internal nodes,
 /// the finest cells on its leaves).
 template <class M>
-concept TreeLayoutMedium = RegionBoundedMedium<M> && requires(const M& m) {
+concept TreeLayoutMedium = CellBoundedMedium<M> && requires(const M& m) {
     { m.tree_layout() } -> std::same_as<TreeLayout>;
 };
 
@@ -82,7 +82,7 @@ namespace detail {
 /// The storage shared by the grey and per-channel tree majorants: the coarse grid's cells, then
 /// per level the nodes (split cells), each n^3 cells of that level's split n; every cell holds its
 /// padded bound and the node it splits into (-1 for none: empty or uniform).
-template <RegionBoundedMedium M>
+template <CellBoundedMedium M>
 class MajorantTree {
 public:
     MajorantTree(const M& medium, const TreeLayout& layout, float scale, const char* what)
@@ -125,9 +125,8 @@ public:
         if (!std::isfinite(layout.descent_cost) || layout.descent_cost < 0.f)
             fail(what, " descent_cost = ", layout.descent_cost,
                  " is not allowed: it must be finite and >= 0 (lookups per descent into a split cell)");
-        require_coefficient(medium.extinction_per_density(),
-                            (std::string(what) + ": the medium's extinction per unit density").c_str());
-        unit_ = max_value(medium.extinction_per_density());
+        const CellBounds<M> bounds(medium, what);
+        unit_ = max_value(bounds.unit());
         pad_ = kGridMajorantPad * scale;
         scale_ = scale;
         cells_[0].assign(n, 0u);
@@ -136,7 +135,7 @@ public:
             for (int y = 0; y < layout.coarse[1]; ++y)
                 for (int x = 0; x < layout.coarse[0]; ++x, ++i) {
                     const int c[3] = {x, y, z};
-                    cells_[0][i] = build(medium, 0, cell_box(box, 0, c, layout.coarse), c, what).packed();
+                    cells_[0][i] = build(bounds, 0, cell_box(box, 0, c, layout.coarse), c, what).packed();
                 }
         for (auto& v : cells_) v.shrink_to_fit();
         for (int l = 0; l < levels_; ++l) {
@@ -226,8 +225,8 @@ private:
     };
 
     /// Builds cell `region` of level l: its bound and, where that pays, its split (children first).
-    Built build(const M& medium, int l, const Box& region, const int* c, const char* what) {
-        const float d = medium.density_bound(region);
+    Built build(const CellBounds<M>& bounds, int l, const Box& region, const int* c, const char* what) {
+        const float d = bounds.density(region);
         if (!std::isfinite(d) || d < 0.f)
             fail(what, " level-", l, " cell (", c[0], ", ", c[1], ", ", c[2], "): the medium's density bound = ", d,
                  " is not allowed: it must be finite and >= 0");
@@ -261,7 +260,7 @@ private:
                 for (int x = 0; x < r[0]; ++x, ++j) {
                     const int g[3] = {x, y, z};
                     const Box part = cell_box(region, l + 1, g, r);
-                    const Built b = build(medium, l + 1, part, g, what);
+                    const Built b = build(bounds, l + 1, part, g, what);
                     parts[j] = b.packed();
                     if (j == 0) first = b.value;
                     as_split += box_surface(part) / area * b.cost;
@@ -296,7 +295,7 @@ private:
 /// and the walk's t is shared: a level holds only its node's origin, cells and next crossings, so
 /// entering a node costs a few multiplications per axis (the walk held a full GridWalk per level
 /// before, and cost twice a grid's walk per step).
-template <RegionBoundedMedium M, class V>
+template <CellBoundedMedium M, class V>
 class TreeSegmentIterator {
 public:
     TreeSegmentIterator() = default;
@@ -414,7 +413,7 @@ private:
 };
 
 /// A layout over a medium's own bounds: `coarse` cells, each split once into brick^3.
-template <RegionBoundedMedium M>
+template <CellBoundedMedium M>
 TreeLayout layout_over_bounds(const M& medium, std::array<int, 3> coarse, int brick) {
     if (brick < 1 || brick > 64)
         fail("TreeMajorant brick = ", brick, " cells per coarse cell and axis is not allowed: it must lie in [1, 64]");
@@ -427,7 +426,7 @@ TreeLayout layout_over_bounds(const M& medium, std::array<int, 3> coarse, int br
 /// it pays (finest cells 1/256 of the longest extent). Measured on the sparse plume and the dense
 /// cloud (docs/volumes.md), this adapts better than cells on a VDB tree's nodes, which ignore
 /// where in a node the density lies, and than 8 coarse cells, which descend too often.
-template <RegionBoundedMedium M>
+template <CellBoundedMedium M>
 TreeLayout adaptive_layout(const M& medium) {
     const Box b = medium.bounds();
     const Vec3 e = b.hi - b.lo;
@@ -443,7 +442,7 @@ TreeLayout adaptive_layout(const M& medium) {
 /// A grey tree majorant: per cell the bound of the density times the largest extinction per
 /// unit density over every channel (and wavelength). `scale` multiplies every cell: >= 1 under
 /// bound::Guaranteed; any value > 0 under bound::Signed, Clamp or Reject.
-template <RegionBoundedMedium M, BoundPolicy B = bound::Guaranteed>
+template <CellBoundedMedium M, BoundPolicy B = bound::Guaranteed>
 class TreeMajorant {
 public:
     using Bound = B;
@@ -461,7 +460,7 @@ public:
     /// 0 where the density is not 0.
     TreeMajorant(const M& medium, const TreeLayout& layout, float scale = 1.f)
         : tree_(medium, layout, detail::require_majorant_scale<B>(scale, "TreeMajorant scale"), "TreeMajorant"),
-          unit_(max_value(medium.extinction_per_density())) {}
+          unit_(max_value(detail::CellBounds<M>(medium, "TreeMajorant").unit())) {}
 
     detail::TreeSegmentIterator<M, float> iterate(const Ray& r, float tmin, float tmax,
                                                   const typename M::Spectral::Wavelengths&) const noexcept {
@@ -486,7 +485,7 @@ private:
 
 /// A per-channel tree majorant: the tree's density bounds times each channel's extinction
 /// per unit density at the path's wavelengths (THEORY 5.3). `scale` as for TreeMajorant.
-template <RegionBoundedMedium M, BoundPolicy B = bound::Guaranteed>
+template <CellBoundedMedium M, BoundPolicy B = bound::Guaranteed>
 class ChannelTreeMajorant {
 public:
     using Bound = B;
@@ -502,7 +501,7 @@ public:
     ChannelTreeMajorant(const M& medium, const TreeLayout& layout, float scale = 1.f)
         : tree_(medium, layout, detail::require_majorant_scale<B>(scale, "ChannelTreeMajorant scale"),
                 "ChannelTreeMajorant"),
-          unit_(medium.extinction_per_density()) {}
+          unit_(detail::CellBounds<M>(medium, "ChannelTreeMajorant").unit()) {}
 
     detail::TreeSegmentIterator<M, Spectrum> iterate(const Ray& r, float tmin, float tmax,
                                                      const typename Spectral::Wavelengths& l) const noexcept {

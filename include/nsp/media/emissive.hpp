@@ -242,7 +242,8 @@ public:
     Spectrum extinction_bound(const Wavelengths& l) const noexcept { return medium_.extinction_bound(l); }
     float max_extinction() const noexcept { return medium_.max_extinction(); }
 
-    // The optional majorant support of M (ChannelBoundedMedium, RegionBoundedMedium), forwarded.
+    // The optional majorant support of M (ChannelBoundedMedium, RegionBoundedMedium,
+    // ExtinctionBoundedMedium), forwarded.
     Coefficient extinction_bound_coefficient() const
         requires ChannelBoundedMedium<M>
     {
@@ -257,6 +258,11 @@ public:
         requires RegionBoundedMedium<M>
     {
         return medium_.extinction_per_density();
+    }
+    Coefficient extinction_bound_over(const Box& region) const
+        requires ExtinctionBoundedMedium<M>
+    {
+        return medium_.extinction_bound_over(region);
     }
     /// The layout of M's own tree (TreeLayoutMedium), with whatever arguments M takes.
     template <class... A>
@@ -405,6 +411,8 @@ private:
     bool medium_may_absorb(const Box& cell) const {
         if constexpr (RegionBoundedMedium<M>)
             return medium_.density_bound(cell) > 0.f && max_value(medium_.extinction_per_density()) > 0.f;
+        else if constexpr (ExtinctionBoundedMedium<M>)
+            return max_value(medium_.extinction_bound_over(cell)) > 0.f;
         else
             return medium_.max_extinction() > 0.f;
     }
