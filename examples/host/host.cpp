@@ -123,10 +123,15 @@ Spectrum radiance(const Kernels& k, const Scene& sc, nsp::Ray ray, nsp::Pcg32& r
         if (end == nsp::SegmentEnd::Passed) {  // a surface, or the sky: a light there, weighed against NEE
             const int light = hit.found() ? hit.light : 2;
             if (light >= 0) {
-                if (st.counts_hits())
-                    L += st.light_hit(hit.found() ? sc.lights.emitted(light, hit.shading(), ray.d, lambda)
-                                              : sc.lights.emitted(light, ray.d, lambda),
+                // On a surface the light sees the hit, in its radiance and its density.
+                if (st.counts_hits() && hit.found()) {
+                    const nsp::ShadingPoint at = hit.shading();
+                    L += st.light_hit(sc.lights.emitted(light, at, ray.d, lambda),
+                                      st.nee_alternative() ? sc.lights.pdf(light, st.prev, ray.d, at) : 0.f, counter);
+                } else if (st.counts_hits()) {
+                    L += st.light_hit(sc.lights.emitted(light, ray.d, lambda),
                                       st.nee_alternative() ? sc.lights.pdf(light, st.prev, ray.d) : 0.f, counter);
+                }
                 break;
             }
             material = hit.material;

@@ -33,6 +33,8 @@ struct LightSample {
     float pdf = 0.f;                  ///< solid-angle pdf including light selection (delta: selection only); 0: no sample
     bool delta = false;               ///< a point light: no other strategy can sample it
     bool occludable_by_sphere = false;///< Lights<S>: the sphere light may block this sample
+    Vec2 uv{0.f};                     ///< where on the light it lies: the light's own surface parameters
+    int user = -1;                    ///< and its own datum there (a primitive index; -1: none)
 };
 
 /// A point and direction of emission drawn from a light, for light subpaths (THEORY 5.5): the
@@ -50,7 +52,19 @@ struct LightEmission {
     float pdf_pos = 0.f, pdf_dir = 0.f, cos = 0.f;
     bool delta_position = false;  ///< a point light, or a DirectionalLight's one direction: no path can hit it
     bool at_infinity = false;     ///< a light at infinity (see above)
+    Vec2 uv{0.f};                 ///< where on the light p lies (as LightSample::uv)
+    int user = -1;                ///< the light's datum there (as LightSample::user)
 };
+
+/// The point `at` a light's densities get for one of its own samples (SurfacePdfLight): p, and
+/// the uv and datum the sample reported; its normals and tangent unset.
+inline ShadingPoint light_point(const Vec3& p, Vec2 uv, int user) noexcept {
+    ShadingPoint at;
+    at.p = p;
+    at.uv = uv;
+    at.user = user;
+    return at;
+}
 
 /// The densities with which a light's `sample_emission` produces point p (on the light) and a
 /// direction w leaving it, and |n . w| there (see LightEmission).
@@ -64,10 +78,15 @@ struct EmissionDensity {
 /// subpaths when it has a BoundingSphere (else bidirectional estimators reach them by hitting and
 /// NEE alone, a DirectionalLight by NEE alone).
 template <class L, class S>
-concept EmittingLight = SpectralMode<S> && requires(const L& l, const Vec3& v, float u, const typename S::Wavelengths& lambda) {
-    { l.sample_emission(u, u, u, u, lambda) } -> std::same_as<LightEmission<S>>;
-    { l.emission_pdf(v, v) } -> std::same_as<EmissionDensity>;
-};
+concept EmittingLight = SpectralMode<S> &&
+    requires(const L& l, const Vec3& v, float u, const typename S::Wavelengths& lambda) {
+        { l.sample_emission(u, u, u, u, lambda) } -> std::same_as<LightEmission<S>>;
+    } &&
+    (requires(const L& l, const Vec3& v) {
+        { l.emission_pdf(v, v) } -> std::same_as<EmissionDensity>;
+    } || requires(const L& l, const ShadingPoint& at, const Vec3& v) {
+        { l.emission_pdf(at, v) } -> std::same_as<EmissionDensity>;
+    });
 
 /// A light whose emitted radiance depends only on the direction of the ray that reaches it:
 /// `emitted(w, lambda)`.
@@ -85,10 +104,23 @@ concept SurfaceEmitter = requires(const L& l, const ShadingPoint& sp, const Vec3
     { l.emitted(sp, w, lambda) } -> std::same_as<typename S::Spectrum>;
 };
 
+/// A surface light whose densities depend on where a direction or a ray lands on it (a textured
+/// emitter sampled by its texture's brightness, a mesh light by its triangles):
+/// `pdf(x, w, at, selection)` and, if it starts light subpaths, `emission_pdf(at, w)`. `at` is
+/// the point on the light: at a hit SurfaceHit::shading(), for the light's own samples
+/// light_point(p, uv, user) with the uv and datum its LightSample or LightEmission reported. nsp
+/// passes `at` wherever it asks a surface light for a density, so such a light need not give the
+/// position-only forms (where they are missing, LightSampler's position-only queries give 0).
+template <class L, class S>
+concept SurfacePdfLight = SurfaceEmitter<L, S> && requires(const L& l, const ShadingPoint& at, const Vec3& v, float u) {
+    { l.pdf(v, v, at, u) } -> std::same_as<float>;
+};
+
 /// A light a host's loop samples for NEE and may hit (THEORY 5.8). `sample(x, u1, u2, lambda,
 /// selection)` draws a direction from x toward it with its solid-angle pdf times `selection` (the
 /// probability with which the caller picked this light); `pdf(x, w, selection)` is that density
-/// for direction w (0 for a delta light, or where w misses it); `emitted(w, lambda)` or
+/// for direction w (0 for a delta light, or where w misses it; a SurfacePdfLight may give
+/// `pdf(x, w, at, selection)` instead); `emitted(w, lambda)` or
 /// `emitted(sp, w, lambda)` (DirectionEmitter, SurfaceEmitter) what a ray travelling along w
 /// receives when it reaches the light; `power(scene_radius)` a grey measure of its emitted power
 /// for light selection by power. Models: PointLight, SphereLight, QuadLight, EnvironmentLight,
@@ -99,10 +131,12 @@ template <class L, class S>
 concept Light = SpectralMode<S> && (DirectionEmitter<L, S> || SurfaceEmitter<L, S>) &&
     requires(const L& l, const Vec3& v, float u, const typename S::Wavelengths& lambda) {
         { l.sample(v, u, u, lambda, u) } -> std::same_as<LightSample<S>>;
-        { l.pdf(v, v, u) } -> std::same_as<float>;
         { l.power(u) } -> std::same_as<float>;
         { L::is_delta } -> std::convertible_to<bool>;
-    };
+    } &&
+    (SurfacePdfLight<L, S> || requires(const L& l, const Vec3& v, float u) {
+        { l.pdf(v, v, u) } -> std::same_as<float>;
+    });
 
 /// An isotropic point light with radiant intensity `intensity` (W/sr). Reachable by NEE only.
 template <SpectralMode S>

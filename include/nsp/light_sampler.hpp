@@ -208,9 +208,22 @@ public:
         if (!(emission_selection_pdf(light) > 0.f)) return d;
         visit(entries_[std::size_t(light)], [&](const auto& l) {
             using L = std::decay_t<decltype(l)>;
-            if constexpr (EmittingLight<L, S>) d = l.emission_pdf(p, w);
+            if constexpr (requires { l.emission_pdf(p, w); }) d = l.emission_pdf(p, w);
             else if constexpr (from_infinity<L>()) d = emission_pdf_from_infinity(l, p, w);
         });
+        d.pdf_pos *= emit_pmf_[std::size_t(light)];
+        return d;
+    }
+    /// The same at the point `at` on a surface light (a hit's SurfaceHit::shading(), or
+    /// light_point() of the light's own sample): a SurfacePdfLight reads it, any other light at.p.
+    EmissionDensity emission_pdf(int light, const ShadingPoint& at, const Vec3& w) const noexcept {
+        EmissionDensity d;
+        if (!(emission_selection_pdf(light) > 0.f)) return d;
+        bool read = false;
+        visit(entries_[std::size_t(light)], [&](const auto& l) {
+            if constexpr (requires { l.emission_pdf(at, w); }) d = l.emission_pdf(at, w), read = true;
+        });
+        if (!read) return emission_pdf(light, at.p, w);
         d.pdf_pos *= emit_pmf_[std::size_t(light)];
         return d;
     }
@@ -269,7 +282,21 @@ public:
         if (light < 0 || light >= count()) return 0.f;
         const Entry& e = entries_[std::size_t(light)];
         float p = 0.f;
-        visit(e, [&](const auto& l) { p = l.pdf(x, w, e.pmf); });
+        visit(e, [&](const auto& l) {
+            if constexpr (requires { l.pdf(x, w, e.pmf); }) p = l.pdf(x, w, e.pmf);
+        });
+        return p;
+    }
+    /// The same for a direction that reaches the light at `at` (a hit's SurfaceHit::shading(), or
+    /// light_point() of the light's own sample): a SurfacePdfLight reads it, any other light not.
+    float pdf(int light, const Vec3& x, const Vec3& w, const ShadingPoint& at) const noexcept {
+        if (light < 0 || light >= count()) return 0.f;
+        const Entry& e = entries_[std::size_t(light)];
+        float p = 0.f;
+        visit(e, [&](const auto& l) {
+            if constexpr (SurfacePdfLight<std::decay_t<decltype(l)>, S>) p = l.pdf(x, w, at, e.pmf);
+            else p = l.pdf(x, w, e.pmf);
+        });
         return p;
     }
 

@@ -4,9 +4,11 @@
 // from the hit's uv, black unless the hit's point, tangent and host datum reach it too. A diffuse
 // sheet: Lambertian reflection r on the side the path arrives from and Lambertian transmission t
 // through it, the lobe picked by the sample's third uniform. And a textured quad light
-// (nsp::SurfaceEmitter: it sees where a ray reaches it) on the walls of a box over a floor.
+// (nsp::SurfaceEmitter: it sees where a ray reaches it; nsp::SurfacePdfLight: sampled by its
+// texture) on the walls of a box over a floor.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -92,35 +94,62 @@ inline float quadrant_albedo(Vec2 uv) { return (int(2.f * uv.x) + int(2.f * uv.y
 
 /// A QuadLight whose radiance is scaled by quadrant_albedo at the point it is reached or
 /// sampled, uv its parameters along edge_u and edge_v (as Shapes reports a quad's hits): a textured
-/// emitter (nsp::SurfaceEmitter). Sampled as the quad, uniformly by area.
+/// emitter (nsp::SurfaceEmitter). Sampled by its texture: a quadrant in proportion to its albedo
+/// (0.8 : 0.2), uniformly inside it, so the density by area is 2 quadrant_albedo(uv) / area.
+/// Its densities read uv from the point they get (nsp::SurfacePdfLight) and it has no
+/// position-only ones: a density asked without the point, or with a point that lost its uv, would
+/// weigh its MIS wrongly.
 struct TexturedQuadLight {
     static constexpr bool is_delta = false;
     QuadLight<S> quad;
 
-    Vec2 uv_at(const Vec3& y) const {
-        const Vec3 d = y - quad.corner;
-        return {glm::dot(d, quad.edge_u) / glm::dot(quad.edge_u, quad.edge_u),
-                glm::dot(d, quad.edge_v) / glm::dot(quad.edge_v, quad.edge_v)};
+    /// (u1, u2) in [0, 1)^2 to uv: quadrants (0, 0), (1, 0), (0, 1), (1, 1) with probabilities
+    /// 0.4, 0.1, 0.1, 0.4 (albedo / 2), uniformly inside.
+    static Vec2 warp(float u1, float u2) {
+        const float cdf[4] = {0.4f, 0.5f, 0.6f, 1.f};
+        int k = 0;
+        while (k < 3 && !(u1 < cdf[k])) ++k;
+        const float lo = k == 0 ? 0.f : cdf[k - 1];
+        const float r = std::min((u1 - lo) / (cdf[k] - lo), 0.99999994f);
+        return {(float(k % 2) + r) * 0.5f, (float(k / 2) + u2) * 0.5f};
     }
+    /// The uv density of warp() at uv, relative to uniform: 2 quadrant_albedo(uv).
+    static float texture_density(Vec2 uv) { return 2.f * quadrant_albedo(uv); }
+
     LightSample<S> sample(const Vec3& x, float u1, float u2, const S::Wavelengths& l = {}, float selection = 1.f) const {
-        LightSample<S> s = quad.sample(x, u1, u2, l, selection);
-        s.radiance *= quadrant_albedo(Vec2(u1, u2));
+        const Vec2 uv = warp(u1, u2);
+        LightSample<S> s = quad.sample(x, uv.x, uv.y, l, selection);
+        s.pdf *= texture_density(uv);
+        s.radiance *= quadrant_albedo(uv);
+        s.uv = uv;
         return s;
     }
-    float pdf(const Vec3& x, const Vec3& w, float selection = 1.f) const { return quad.pdf(x, w, selection); }
+    float pdf(const Vec3& x, const Vec3& w, const ShadingPoint& at, float selection = 1.f) const {
+        const Vec3 d = at.p - x;
+        const float cos_y = -glm::dot(quad.normal(), w);
+        if (!(cos_y > 0.f)) return 0.f;
+        return selection * glm::dot(d, d) / (cos_y * quad.area()) * texture_density(at.uv);
+    }
     Spectrum emitted(const ShadingPoint& sp, const Vec3& w, const S::Wavelengths& l = {}) const {
         return quad.emitted(w, l) * quadrant_albedo(sp.uv);
     }
     float power(float r = 1.f) const { return quad.power(r); }
     LightEmission<S> sample_emission(float u1, float u2, float u3, float u4, const S::Wavelengths& l = {}) const {
-        LightEmission<S> e = quad.sample_emission(u1, u2, u3, u4, l);
-        e.radiance *= quadrant_albedo(uv_at(e.p));
+        const Vec2 uv = warp(u1, u2);
+        LightEmission<S> e = quad.sample_emission(uv.x, uv.y, u3, u4, l);
+        e.pdf_pos *= texture_density(uv);
+        e.radiance *= quadrant_albedo(uv);
+        e.uv = uv;
         return e;
     }
-    EmissionDensity emission_pdf(const Vec3& p, const Vec3& w) const { return quad.emission_pdf(p, w); }
+    EmissionDensity emission_pdf(const ShadingPoint& at, const Vec3& w) const {
+        EmissionDensity d = quad.emission_pdf(at.p, w);
+        d.pdf_pos *= texture_density(at.uv);
+        return d;
+    }
 };
 
-static_assert(Light<TexturedQuadLight, S> && SurfaceEmitter<TexturedQuadLight, S> &&
+static_assert(Light<TexturedQuadLight, S> && SurfaceEmitter<TexturedQuadLight, S> && SurfacePdfLight<TexturedQuadLight, S> &&
               !DirectionEmitter<TexturedQuadLight, S> && EmittingLight<TexturedQuadLight, S>);
 
 using Mats = Materials<S, CheckerBsdf, DiffuseSheetBsdf, LambertianBsdf<S>>;
@@ -237,10 +266,10 @@ void check_shading_bsdfs(ForEach for_each, int n, double k) {
 }
 
 /// Runs the closed forms of the textured quad lights as check_shading_bsdfs does. Five walls
-/// emit a 2 x 2 checkerboard of 0.8 and 0.2 read from the hit's (or sample's) uv: from the
-/// floor's centre every wall is as bright as a uniform 0.5, so L = 0.5 x 0.5 there (0.4 if the
-/// hits' uv did not reach the light: its first quadrant everywhere); seen directly, a wall is its
-/// square's value, exactly.
+/// emit a 2 x 2 checkerboard of 0.8 and 0.2 read from the hit's (or sample's) uv and are sampled
+/// by it: from the floor's centre every wall is as bright as a uniform 0.5, so L = 0.5 x 0.5 there
+/// (0.4 if the hits' uv did not reach the light: its first quadrant everywhere; other values if a
+/// density missed where it lands); seen directly, a wall is its square's value, exactly.
 template <class ForEach>
 void check_textured_lights(ForEach for_each, int n, double k) {
     const TexturedSc sc = textured_box();

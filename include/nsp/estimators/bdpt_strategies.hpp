@@ -52,11 +52,12 @@ void BdptEstimator<Mis, H, A, MaxDepth, Ch>::BdptSample<Sc, Cam, R, C, Splat, Ob
     if (std::isfinite(dist)) {
         const Vec3 d = hit.p - z.p;
         const float d2 = glm::dot(d, d);
-        const EmissionDensity e = sc.lights.emission_pdf(light_index, hit.p, -w);
+        const ShadingPoint at = hit.shading();  // what a light's densities may read of the hit
+        const EmissionDensity e = sc.lights.emission_pdf(light_index, at, -w);
         const float cos0 = std::abs(glm::dot(hit.ng, w));
         pdfs.from_camera[0] = (z.delta ? 1.f : pdf_dir_z) * cos0 / d2 * nulls;
         pdfs.emit = q_lights * e.pdf_pos;
-        pdfs.eq_nee = sc.lights.pdf(light_index, z.p, w) * cos0 / d2;
+        pdfs.eq_nee = sc.lights.pdf(light_index, z.p, w, at) * cos0 / d2;
         pdfs.nee = nee_count * pdfs.eq_nee;
         pdfs.from_light[1] = to_vertex_measure(e.pdf_dir, hit.p, z) * nulls * z.event;
     } else {  // x_0 is the direction w; light subpaths (if any) reach z along -w
@@ -273,7 +274,8 @@ void BdptEstimator<Mis, H, A, MaxDepth, Ch>::BdptSample<Sc, Cam, R, C, Splat, Ob
         pdfs.emit = q_lights * e.pdf_pos;
         pdfs.from_light[1] = from_infinity_measure(e.pdf_dir, -w, z) * nulls * z.event;
     } else {
-        const EmissionDensity e = sc.lights.emission_pdf(ls.light, y0.p, -w);
+        const EmissionDensity e =
+            sc.lights.emission_pdf(ls.light, light_point(y0.p, ls.sample.uv, ls.sample.user), -w);
         pdfs.from_camera[0] = fz.pdf * e.cos / d2 * nulls;
         pdfs.eq_nee = ls.sample.pdf * e.cos / d2;
         pdfs.emit = q_lights * e.pdf_pos;
@@ -438,7 +440,8 @@ void BdptEstimator<Mis, H, A, MaxDepth, Ch>::BdptSample<Sc, Cam, R, C, Splat, Ob
         const float d2 = glm::dot(d, d);
         eq_nee_y0 = y0.delta_position ? sc.lights.selection_pdf(y0.light)  // a point or a direction
                     : y0.at_infinity  ? sc.lights.pdf(y0.light, light[1].p, -e.emission.w)  // solid angle
-                                        : sc.lights.pdf(y0.light, light[1].p, d / std::sqrt(d2)) *
+                                        : sc.lights.pdf(y0.light, light[1].p, d / std::sqrt(d2),
+                                                        light_point(y0.p, e.emission.uv, e.emission.user)) *
                                               std::abs(glm::dot(y0.ng, d)) / (d2 * std::sqrt(d2));
         nee_y0 = nee_count * eq_nee_y0;
     }

@@ -148,16 +148,18 @@ RadianceSample<typename Sc::Spectral> trace_path(const K& k, const Sc& sc, const
         } else {
             if (surface_later) hit = sc.geometry.intersect(ray, kInf);
             // An emitter reached: weighed against NEE from the last real vertex where it exists.
-            auto add_emitter = [&](int light, const Spectrum& le) {
-                L += st.light_hit(le, st.nee_alternative() ? sc.lights.pdf(light, st.prev, ray.d) : 0.f, counter);
-            };
             if (!hit.found()) {  // the ray leaves the scene: the lights at infinity
                 if (st.counts_hits())
-                    for (const int i : sc.lights.infinite()) add_emitter(i, sc.lights.emitted(i, ray.d, lambda));
+                    for (const int i : sc.lights.infinite())
+                        L += st.light_hit(sc.lights.emitted(i, ray.d, lambda),
+                                          st.nee_alternative() ? sc.lights.pdf(i, st.prev, ray.d) : 0.f, counter);
                 break;
             }
-            if (hit.light >= 0 && st.counts_hits())
-                add_emitter(hit.light, sc.lights.emitted(hit.light, hit.shading(), ray.d, lambda));
+            if (hit.light >= 0 && st.counts_hits()) {  // on a surface: its densities may read where
+                const ShadingPoint at = hit.shading();
+                L += st.light_hit(sc.lights.emitted(hit.light, at, ray.d, lambda),
+                                  st.nee_alternative() ? sc.lights.pdf(hit.light, st.prev, ray.d, at) : 0.f, counter);
+            }
             // A null interface, or a null lobe taken: no vertex, the segment goes on in the next medium.
             auto cross = [&] {
                 if (++crossings > kMaxInterfaceCrossings) return false;
