@@ -147,18 +147,22 @@ RadianceSample<typename Sc::Spectral> trace_path(const K& k, const Sc& sc, const
             x = ray.at(t_medium);
         } else {
             if (surface_later) hit = sc.geometry.intersect(ray, kInf);
-            // An emitter reached: weighed against NEE from the last real vertex where it exists.
+            // An emitter reached: weighed against NEE from the last real vertex where it exists,
+            // whose density on a surface light may read where (`at`: the hit; none at infinity).
+            auto add_emitter = [&](int light, const Spectrum& le, const ShadingPoint* at) {
+                float light_pdf = 0.f;
+                if (st.nee_alternative())
+                    light_pdf = at ? sc.lights.pdf(light, st.prev, ray.d, *at) : sc.lights.pdf(light, st.prev, ray.d);
+                L += st.light_hit(le, light_pdf, counter);
+            };
             if (!hit.found()) {  // the ray leaves the scene: the lights at infinity
                 if (st.counts_hits())
-                    for (const int i : sc.lights.infinite())
-                        L += st.light_hit(sc.lights.emitted(i, ray.d, lambda),
-                                          st.nee_alternative() ? sc.lights.pdf(i, st.prev, ray.d) : 0.f, counter);
+                    for (const int i : sc.lights.infinite()) add_emitter(i, sc.lights.emitted(i, ray.d, lambda), nullptr);
                 break;
             }
-            if (hit.light >= 0 && st.counts_hits()) {  // on a surface: its densities may read where
+            if (hit.light >= 0 && st.counts_hits()) {
                 const ShadingPoint at = hit.shading();
-                L += st.light_hit(sc.lights.emitted(hit.light, at, ray.d, lambda),
-                                  st.nee_alternative() ? sc.lights.pdf(hit.light, st.prev, ray.d, at) : 0.f, counter);
+                add_emitter(hit.light, sc.lights.emitted(hit.light, at, ray.d, lambda), &at);
             }
             // A null interface, or a null lobe taken: no vertex, the segment goes on in the next medium.
             auto cross = [&] {
