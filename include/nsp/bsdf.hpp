@@ -93,8 +93,9 @@ struct NullLobe {
 /// collision's P_n does; THEORY 5.8, docs/theory.md). Otherwise it makes a real vertex, its
 /// throughput divided by 1 - probability. A shadow ray crosses it with factor `weight` (and the
 /// probability in its unidirectional pdf). Requirements: probability in [0, 1], above 0 wherever
-/// weight is not 0 (a lobe never taken would be missing from the estimate), and the same from
-/// either side (for wo and -wo: BDPT's reverse densities reuse it). Kernels stop a path whose null
+/// weight is not 0 and below 1 wherever the other lobes are not black (a lobe never taken would
+/// be missing from the estimate), and the same from either side (for wo and -wo: BDPT's reverse
+/// densities reuse it). Kernels stop a path whose null
 /// lobe breaks the first two with Status::InvalidInput.
 template <class B, class S>
 concept PartlyNullBsdf = Bsdf<B, S> &&
