@@ -2,8 +2,10 @@
 // cube on a checkered floor, a lamp inside the smoke, under a sky image; Mono, one global
 // majorant): every grey strategy of nsp::PathEstimator and BDPT through a partly null BSDF (the
 // glass: reflected or passed straight through), a textured floor and an image light.
+#include <algorithm>
 #include <cstdio>
 
+#include "agreement.hpp"
 #include "room_rows.hpp"
 
 namespace nsp_examples {

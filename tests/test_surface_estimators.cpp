@@ -347,9 +347,10 @@ TEST_CASE("surface estimators: bad host input gives Status::InvalidInput and 0, 
     h = good;
     h.medium_front = 4;
     bad.push_back({"medium outside the table", h});
-    for (const auto& [what, hit] : bad) {
+    for (const auto& entry : bad) {
+        const std::string& what = entry.first;  // not a structured binding: CAPTURE's lambda takes it
         CAPTURE(what);
-        const auto r = run(hit);
+        const auto r = run(entry.second);
         CHECK(r.status == Status::InvalidInput);
         CHECK(r.value[0] == 0.f);
     }

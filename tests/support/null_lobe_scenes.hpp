@@ -188,7 +188,8 @@ void check_bad_null_lobes(ForEach for_each) {
                                                    {-0.2f, 0.6f}, {0.45f, 0.f}};
     for_each([&](const auto& est, const char* name) {
         CAPTURE(std::string(name));
-        for (const auto& [w, p] : bad) {
+        for (const std::pair<float, float>& lobe : bad) {
+            const float w = lobe.first, p = lobe.second;  // not a structured binding: CAPTURE's lambda takes them
             CAPTURE(w);
             CAPTURE(p);
             const Sc sc = half_lit_box(kFilter, kFloor, materials<Mono>(constant_coefficient<Mono>(w), p));
