@@ -95,8 +95,8 @@ struct NullLobe {
 /// probability in its unidirectional pdf). Requirements: probability in [0, 1], above 0 wherever
 /// weight is not 0 and below 1 wherever the other lobes are not black (a lobe never taken would
 /// be missing from the estimate), and the same from either side (for wo and -wo: BDPT's reverse
-/// densities reuse it). Kernels stop a path whose null
-/// lobe breaks the first two with Status::InvalidInput.
+/// densities reuse it). Kernels stop a path whose null lobe is outside [0, 1], has a weight that
+/// is not finite and >= 0, or a weight with probability 0, with Status::InvalidInput.
 template <class B, class S>
 concept PartlyNullBsdf = Bsdf<B, S> &&
     requires(const B& b, const ShadingPoint& sp, const Vec3& w, const typename S::Wavelengths& l) {
