@@ -2,7 +2,8 @@
 // concept a host's BSDF models, and its models: Lambertian reflection, a perfect mirror (a delta
 // lobe), a null interface (the index-matched boundary of a medium, which a path crosses without a
 // real vertex), and two partly null BSDFs, whose lobe that passes straight through a path takes
-// with a probability: a thin dielectric sheet and any BSDF behind an opacity mask.
+// with a probability: a thin dielectric sheet and any BSDF behind an opacity mask; and a rough
+// dielectric interface (GGX microfacets).
 //
 // A BSDF comes in one of two forms. A shading BSDF sees the hit (a ShadingPoint: position, uv,
 // shading frame, the host's datum) and samples from three uniforms, enough for a rough lobe
@@ -342,6 +343,169 @@ private:
     float eta_;
 };
 
+/// A rough dielectric interface (Walter et al. 2007): GGX microfacets of roughness alpha (isotropic;
+/// Smith's separable shadowing G = G1(wo) G1(wi), as in Mitsuba 3), each a smooth interface that
+/// reflects the Fresnel fraction F and refracts the rest. `eta` is the index on the side opposite
+/// the geometric normal sp.ng over the index on the side ng points to (glass in air, ng outward:
+/// 1.5); the medium a refracted path enters is the hit's, as for any surface. Sampled from the
+/// visible normals (Heitz 2018): two uniforms draw the microfacet, the third picks reflection with
+/// probability F, so reflection's weight is G1(wi) and refraction's G1(wi) / eta_rel.
+///
+/// nsp's estimators use one BSDF for paths from the camera and from lights (BDPT), so its
+/// refraction lobe is the symmetric f_t n_i / n_o = f_t / eta_rel (f_t Walter's radiance form):
+/// along a path the factors n_i / n_o telescope, and every estimate is the radiance exactly when
+/// the camera and the lights lie in media of one index (all in air, say). A light inside glass of
+/// index n seen from a camera in air must report its radiance times 1 / n; docs/surfaces.md.
+template <SpectralMode S>
+class RoughDielectricBsdf {
+public:
+    static constexpr bool passes_through = false;
+
+    /// Throws InvalidArgument unless eta is finite, > 0 and not 1 (an index-matched boundary is a
+    /// NullInterface), and alpha is finite and in [1e-3, 2].
+    RoughDielectricBsdf(float eta, float alpha) : eta_(eta), alpha_(alpha) {
+        if (!(std::isfinite(eta) && eta > 0.f) || eta == 1.f)
+            detail::fail("RoughDielectricBsdf eta = ", eta,
+                         " is not allowed: it must be finite, > 0 and not 1 (an index-matched boundary is a NullInterface)");
+        if (!(alpha >= 1e-3f && alpha <= 2.f))
+            detail::fail("RoughDielectricBsdf alpha = ", alpha, " is not allowed: it must lie in [0.001, 2]");
+    }
+
+    BsdfSample<S> sample(const ShadingPoint& sp, const Vec3& wo, const Vec3& u,
+                         const typename S::Wavelengths& = {}) const noexcept {
+        Frame f;
+        if (!frame(sp, wo, f)) return {};
+        const Vec3 o = -wo;
+        const float cos_o = glm::dot(o, f.n);
+        // The visible normal in the local frame (z = f.n), then in the world.
+        const Vec3 ol(glm::dot(o, f.s), glm::dot(o, f.t), cos_o);
+        const Vec3 hl = sample_visible_normal(ol, u.x, u.y);
+        const Vec3 h = hl.x * f.s + hl.y * f.t + hl.z * f.n;
+        const float cos_oh = glm::dot(o, h);
+        if (!(cos_oh > 0.f)) return {};
+        const float fr = detail::fresnel_dielectric(cos_oh, f.eta);
+        BsdfSample<S> s;
+        const bool reflect = u.z < fr;
+        if (reflect) {
+            s.wi = 2.f * cos_oh * h - o;
+        } else {
+            const float sin2_t = (1.f - cos_oh * cos_oh) / (f.eta * f.eta);
+            const float cos_t = std::sqrt(std::max(0.f, 1.f - sin2_t));
+            s.wi = (cos_oh / f.eta - cos_t) * h - o / f.eta;
+        }
+        // A microfacet can send the path to the wrong side of the macro surface: no sample (the
+        // pdf of the other lobe there is not this draw's).
+        if ((glm::dot(s.wi, f.n) > 0.f) != reflect) return {};
+        const Lobe l = lobe(f, o, s.wi);
+        if (!(l.pdf > 0.f) || !std::isfinite(l.value)) return {};
+        s.pdf = l.pdf;
+        s.value = S::Spectrum::Constant(l.value);
+        return s;
+    }
+    typename S::Spectrum eval(const ShadingPoint& sp, const Vec3& wo, const Vec3& wi,
+                              const typename S::Wavelengths& = {}) const noexcept {
+        Frame f;
+        if (!frame(sp, wo, f)) return S::Spectrum::Zero();
+        const float v = lobe(f, -wo, wi).value;
+        return S::Spectrum::Constant(std::isfinite(v) ? v : 0.f);
+    }
+    float pdf(const ShadingPoint& sp, const Vec3& wo, const Vec3& wi) const noexcept {
+        Frame f;
+        if (!frame(sp, wo, f)) return 0.f;
+        const float p = lobe(f, -wo, wi).pdf;
+        return std::isfinite(p) ? p : 0.f;
+    }
+
+    float eta() const noexcept { return eta_; }
+    float alpha() const noexcept { return alpha_; }
+
+private:
+    /// The shading normal on the side the path arrived from, a tangent frame around it, and the
+    /// relative index of the far side over the near side.
+    struct Frame {
+        Vec3 n, s, t;
+        float eta;
+    };
+    struct Lobe {
+        float value = 0.f;  ///< f |n . wi|
+        float pdf = 0.f;
+    };
+
+    bool frame(const ShadingPoint& sp, const Vec3& wo, Frame& f) const noexcept {
+        if (!unit_length(sp.ns) || !unit_length(sp.ng) || !unit_length(wo)) return false;
+        const Vec3 ns = glm::dot(sp.ns, sp.ng) < 0.f ? -sp.ns : sp.ns;  // on ng's side
+        const bool front = glm::dot(wo, sp.ng) < 0.f;                   // arrived on ng's side
+        f.n = front ? ns : -ns;
+        f.eta = front ? eta_ : 1.f / eta_;
+        if (!(glm::dot(wo, f.n) < 0.f)) return false;  // grazing, or behind the shading normal
+        orthonormal_basis(f.n, f.s, f.t);
+        return true;
+    }
+
+    /// GGX's density of microfacet normals with cosine c to the macro normal.
+    float ggx(float c) const noexcept {
+        if (!(c > 0.f)) return 0.f;
+        const float a2 = alpha_ * alpha_;
+        const float d = c * c * (a2 - 1.f) + 1.f;
+        return a2 / (kPi * d * d);
+    }
+    /// Smith's G1 for direction v (pointing away from the surface) and microfacet h about n.
+    float smith_g1(const Vec3& v, const Vec3& h, const Vec3& n) const noexcept {
+        const float cv = glm::dot(v, n);
+        if (!(glm::dot(v, h) * cv > 0.f)) return 0.f;
+        const float c2 = cv * cv;
+        const float tan2 = std::max(0.f, 1.f - c2) / c2;
+        return 2.f / (1.f + std::sqrt(1.f + alpha_ * alpha_ * tan2));
+    }
+    /// A microfacet normal drawn with density G1(o) max(0, o . h) D(h) / (o . n) (local frame,
+    /// o.z > 0): Heitz's sampling of the visible normals of the stretched hemisphere.
+    Vec3 sample_visible_normal(const Vec3& o, float u1, float u2) const noexcept {
+        const Vec3 v = glm::normalize(Vec3(alpha_ * o.x, alpha_ * o.y, o.z));
+        const float len2 = v.x * v.x + v.y * v.y;
+        const Vec3 t1 = len2 > 0.f ? Vec3(-v.y, v.x, 0.f) / std::sqrt(len2) : Vec3(1.f, 0.f, 0.f);
+        const Vec3 t2 = glm::cross(v, t1);
+        const float r = std::sqrt(u1), phi = 2.f * kPi * u2;
+        const float p1 = r * std::cos(phi);
+        const float s = 0.5f * (1.f + v.z);
+        const float p2 = (1.f - s) * std::sqrt(std::max(0.f, 1.f - p1 * p1)) + s * r * std::sin(phi);
+        const Vec3 nh = p1 * t1 + p2 * t2 + std::sqrt(std::max(0.f, 1.f - p1 * p1 - p2 * p2)) * v;
+        return glm::normalize(Vec3(alpha_ * nh.x, alpha_ * nh.y, std::max(1e-6f, nh.z)));
+    }
+
+    /// The value f |n . wi| and the sampling pdf of wi for a path leaving along o (= -wo).
+    Lobe lobe(const Frame& f, const Vec3& o, const Vec3& wi) const noexcept {
+        const float cos_o = glm::dot(o, f.n), cos_i = glm::dot(wi, f.n);
+        Lobe l;
+        if (!(cos_o > 0.f) || cos_i == 0.f || !unit_length(wi)) return l;
+        const bool reflect = cos_i > 0.f;
+        // The (generalised) half vector, on the near side.
+        Vec3 h = reflect ? o + wi : o + f.eta * wi;
+        const float len = glm::length(h);
+        if (!(len > 1e-6f)) return l;
+        h /= len;
+        if (glm::dot(h, f.n) < 0.f) h = -h;
+        const float cos_oh = glm::dot(o, h), cos_ih = glm::dot(wi, h);
+        if (!(cos_oh > 0.f) || (reflect ? !(cos_ih > 0.f) : !(cos_ih < 0.f))) return l;
+        const float d = ggx(glm::dot(h, f.n));
+        const float g1o = smith_g1(o, h, f.n);
+        const float g = g1o * smith_g1(wi, h, f.n);
+        const float fr = detail::fresnel_dielectric(cos_oh, f.eta);
+        const float visible = g1o * cos_oh * d / cos_o;  // density of h among the visible normals
+        if (reflect) {
+            l.value = fr * d * g / (4.f * cos_o);
+            l.pdf = fr * visible / (4.f * cos_oh);
+        } else {
+            const float denom = cos_oh + f.eta * cos_ih;
+            const float jac = std::abs(cos_ih) / (denom * denom);  // dh / dwi over eta^2
+            l.value = (1.f - fr) * d * g * cos_oh * f.eta * jac / cos_o;
+            l.pdf = (1.f - fr) * visible * f.eta * f.eta * jac;
+        }
+        return l;
+    }
+
+    float eta_, alpha_;
+};
+
 /// Any BSDF behind an opacity mask: where `opacity(sp)` is alpha (in [0, 1]; a texture read from
 /// sp.uv, say) the surface scatters alpha x B and lets 1 - alpha pass straight through, a partly
 /// null BSDF whose null lobe is taken with probability 1 - alpha. A shading BSDF whichever form B
@@ -379,6 +543,7 @@ struct AlphaMasked {
 static_assert(SimpleBsdf<LambertianBsdf<Mono>, Mono> && !ShadingBsdf<LambertianBsdf<Mono>, Mono> &&
               Bsdf<LambertianBsdf<Mono>, Mono> && Bsdf<MirrorBsdf<Rgb>, Rgb> && Bsdf<NullInterface<Mono>, Mono> &&
               Bsdf<OneSided<Rgb, LambertianBsdf<Rgb>>, Rgb> && Bsdf<OneSided<Mono, MirrorBsdf<Mono>>, Mono> &&
-              PartlyNullBsdf<ThinDielectricBsdf<Rgb>, Rgb> && !PartlyNullBsdf<LambertianBsdf<Mono>, Mono>);
+              PartlyNullBsdf<ThinDielectricBsdf<Rgb>, Rgb> && ShadingBsdf<RoughDielectricBsdf<Rgb>, Rgb> &&
+              !PartlyNullBsdf<LambertianBsdf<Mono>, Mono>);
 
 }  // namespace nsp
