@@ -128,10 +128,11 @@ void check_furnace(const Scene& sc, const typename Scene::Spectrum& expected, st
         opts);
 }
 
-TEST_CASE("spectral bdpt: partly null BSDFs, a chromatic filter over a floor and a glass furnace") {
+TEST_CASE("spectral bdpt: partly null BSDFs, a chromatic filter over a floor, a glass furnace, rough glass") {
     // support/null_lobe_scenes.hpp's closed forms per channel (as in test_spectral_surfaces.cpp):
     // L_c = rho w_c F under a filter passing w = (0.9, 0.45, 0.1) with probability 0.6; L = 1 in
-    // a chromatic medium of albedo 1 inside a thin-glass cube under a white sky.
+    // a chromatic medium of albedo 1 inside a thin-glass cube under a white sky; a rough
+    // dielectric sheet seen from below.
     namespace nl = null_lobe_scenes;
     using Scene = nl::SceneOf<M<Rgb>, ChannelMajorant<M<Rgb>>>;
     const Rgb::Spectrum w(0.9f, 0.45f, 0.1f);
@@ -139,6 +140,8 @@ TEST_CASE("spectral bdpt: partly null BSDFs, a chromatic filter over a floor and
     const Vec3 o(0.1f, -0.4f, 0.2f), d = glm::normalize(Vec3(0.f, -1.f, 0.f) - o);
     const Scene furnace = nl::glass_furnace<Scene>(chromatic<Rgb>(Box{Vec3(-1.f), Vec3(1.f)}, Rgb::Spectrum::Zero(),
                                                                   Rgb::Spectrum(1.5f, 2.f, 2.5f), 0.5f));
+    const Scene rough = nl::half_lit_box<Scene>(nl::kRough, nl::kBlack);  // refracting, seen from below
+    const Vec3 below(0.1f, -0.6f, 0.2f);
     for_each_spectral_bdpt([&](const auto& est, const char* name) {
         CAPTURE(std::string(name));
         check_channels<Rgb>(estimate_channels(est, filter, 3000, 63, [&](Pcg32&) { return Ray{o, d}; }),
@@ -147,6 +150,8 @@ TEST_CASE("spectral bdpt: partly null BSDFs, a chromatic filter over a floor and
                                 return Ray{Vec3(0.2f, -0.5f, 0.1f), uniform_sphere(rng.uniform(), rng.uniform())};
                             }),
                             Rgb::Spectrum::Ones());
+        check_channels<Rgb>(estimate_channels(est, rough, 3000, 65, [&](Pcg32&) { return Ray{below, glm::normalize(-below)}; }),
+                            Rgb::Spectrum::Constant(float(nl::rough_sheet_radiance(below))));
     });
 }
 

@@ -160,11 +160,12 @@ TEST_CASE_TEMPLATE_DEFINE("spectral surfaces: six emitting walls of chromatic al
 TEST_CASE_TEMPLATE_APPLY(spectral_wall_furnace, SpectralEstimatorsWith<absorption::Weight>);
 TEST_CASE_TEMPLATE_APPLY(spectral_wall_furnace, SpectralEquiangular);
 
-TEST_CASE_TEMPLATE_DEFINE("spectral surfaces: partly null BSDFs, a chromatic filter over a floor and a glass furnace (Rgb)", E,
+TEST_CASE_TEMPLATE_DEFINE("spectral surfaces: partly null BSDFs, a chromatic filter over a floor, a glass furnace, rough glass (Rgb)", E,
                           spectral_null_lobes) {
     // support/null_lobe_scenes.hpp's closed forms per channel: the floor's centre under a filter
     // that passes w = (0.9, 0.45, 0.1) with probability 0.6, L_c = rho w_c F; a chromatic medium of
-    // albedo 1 in a thin-glass cube over an alpha-masked white floor under a white sky, L = 1.
+    // albedo 1 in a thin-glass cube over an alpha-masked white floor under a white sky, L = 1;
+    // and a rough dielectric sheet, refracting.
     CAPTURE(spectral_estimator_name<E>());
     namespace nl = null_lobe_scenes;
     using Scene = nl::SceneOf<HomogeneousMedium<Rgb>, MajorantFor<typename E::Channels, HomogeneousMedium<Rgb>>>;
@@ -176,6 +177,12 @@ TEST_CASE_TEMPLATE_DEFINE("spectral surfaces: partly null BSDFs, a chromatic fil
     const Scene furnace = nl::glass_furnace<Scene>(
         medium_for<E, Rgb>(Box{Vec3(-1.f), Vec3(1.f)}, constant_coefficient<Rgb>(0.f), chroma<Rgb>(1.5f, 2.f, 2.5f)));
     check_zero_error(run(E{}, furnace, 12000, 62, furnace_ray, Rgb::Spectrum::Ones()));
+    // A rough dielectric sheet (index 1.5 below it, alpha 0.3) seen from below: the integral of
+    // its value over the upper hemisphere (the walls there emit 1), by quadrature, every channel.
+    const Scene rough = nl::half_lit_box<Scene>(nl::kRough, nl::kBlack);
+    const Vec3 below(0.1f, -0.6f, 0.2f);
+    check_zero_error(run(E{}, rough, 8000, 63, [&](Pcg32&) { return Ray{below, glm::normalize(-below)}; },
+                         Rgb::Spectrum::Constant(float(nl::rough_sheet_radiance(below)))));
 }
 TEST_CASE_TEMPLATE_APPLY(spectral_null_lobes, SpectralEstimatorsWith<absorption::Weight>);
 TEST_CASE_TEMPLATE_APPLY(spectral_null_lobes, SpectralEquiangular);

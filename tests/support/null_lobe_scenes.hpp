@@ -57,7 +57,7 @@ static_assert(PartlyNullBsdf<FilterSheet<Mono>, Mono> && PartlyNullBsdf<Masked<R
               PartlyNullBsdf<ThinDielectricBsdf<Mono>, Mono>);
 
 template <SpectralMode S>
-using Mats = Materials<S, ThinDielectricBsdf<S>, FilterSheet<S>, Masked<S>, LambertianBsdf<S>>;
+using Mats = Materials<S, ThinDielectricBsdf<S>, FilterSheet<S>, Masked<S>, LambertianBsdf<S>, RoughDielectricBsdf<S>>;
 template <SpectralMode S>
 using Ls = LightSampler<S, QuadLight<S>, EnvironmentLight<S>>;
 /// The scenes over medium M (HomogeneousMedium<S>) and majorant Maj.
@@ -66,16 +66,38 @@ using SceneOf = SurfaceScene<Shapes, M, Maj, HenyeyGreensteinPhase, Mats<typenam
 using Sc = SceneOf<grey_scenes::M>;
 
 // The materials, in the order Materials numbers them.
-inline constexpr int kThin = 0, kFilter = 1, kMasked = 2, kWhiteMasked = 3, kBlack = 4, kFloor = 5;
-inline constexpr float kEta = 1.5f, kSheetAlbedo = 0.6f, kFloorAlbedo = 0.5f;
+inline constexpr int kThin = 0, kFilter = 1, kMasked = 2, kWhiteMasked = 3, kBlack = 4, kFloor = 5, kRough = 6;
+inline constexpr float kEta = 1.5f, kSheetAlbedo = 0.6f, kFloorAlbedo = 0.5f, kRoughAlpha = 0.3f;
 
 /// The materials; the filter passes `filter` (0.45 in every channel by default) with probability
-/// `filter_p`.
+/// `filter_p`; the rough dielectric has index rough_eta and roughness rough_alpha.
 template <SpectralMode S>
-Mats<S> materials(typename S::Coefficient filter = constant_coefficient<S>(0.45f), float filter_p = 0.6f) {
+Mats<S> materials(typename S::Coefficient filter = constant_coefficient<S>(0.45f), float filter_p = 0.6f,
+                  float rough_eta = kEta, float rough_alpha = kRoughAlpha) {
     auto lambert = [](float a) { return LambertianBsdf<S>(constant_coefficient<S>(a)); };
     return Mats<S>({ThinDielectricBsdf<S>(kEta)}, {FilterSheet<S>{filter, filter_p}},
-                   {Masked<S>{lambert(kSheetAlbedo), {}}, Masked<S>{lambert(1.f), {}}}, {lambert(0.f), lambert(kFloorAlbedo)});
+                   {Masked<S>{lambert(kSheetAlbedo), {}}, Masked<S>{lambert(1.f), {}}}, {lambert(0.f), lambert(kFloorAlbedo)},
+                   {RoughDielectricBsdf<S>(rough_eta, rough_alpha)});
+}
+
+/// The integral of BSDF b's value f |n . wi| (channel 0) over the directions wi with wi . axis > 0,
+/// for a path arriving along wo at sp: the midpoint rule on 512 x 512 cells of equal solid angle in
+/// (cos theta, phi) about axis, summed in double.
+template <SpectralMode S, class B>
+double hemisphere_integral(const B& b, const ShadingPoint& sp, const Vec3& wo, const Vec3& axis) {
+    constexpr int kN = 512;
+    Vec3 s, t;
+    orthonormal_basis(axis, s, t);
+    double sum = 0.0;
+    for (int i = 0; i < kN; ++i) {
+        const double c = (i + 0.5) / kN, r = std::sqrt(1.0 - c * c);
+        for (int j = 0; j < kN; ++j) {
+            const double phi = 2.0 * kPi * (j + 0.5) / kN;
+            const Vec3 wi = float(r * std::cos(phi)) * s + float(r * std::sin(phi)) * t + float(c) * axis;
+            sum += double(detail::eval_bsdf<S>(b, sp, wo, glm::normalize(wi), {})[0]);
+        }
+    }
+    return sum * 2.0 * kPi / (double(kN) * kN);
 }
 
 /// A thin dielectric sheet's reflectance R' = 2R / (1 + R) at incidence cosine c, R the Fresnel
@@ -137,6 +159,39 @@ Scene glass_furnace(SceneMedium<typename Scene::MediumType, typename Scene::Majo
     return Scene(shapes, {std::move(medium)}, materials<S>(), sky, 0);
 }
 
+/// What the camera at `o` sees of the rough dielectric sheet across half_lit_box looking toward
+/// its centre: the integral of its value over the upper hemisphere, where the walls emit 1.
+inline double rough_sheet_radiance(const Vec3& o) {
+    ShadingPoint sp;
+    sp.ng = sp.ns = Vec3(0.f, 1.f, 0.f);
+    return hemisphere_integral<Mono>(RoughDielectricBsdf<Mono>(kEta, kRoughAlpha), sp, glm::normalize(-o), Vec3(0.f, 1.f, 0.f));
+}
+
+/// cube_over_floor's scene behind glass: its scattering cube (sigma_a 0.3, sigma_s 1.2, g 0.6)
+/// bounded by material `boundary` (kThin: a thin dielectric, whose null lobe every path through
+/// the cube's sides takes or not; kRough: a rough dielectric, which refracts into the medium, of
+/// index 1.33 and alpha 0.5, whose wider cone of escape keeps rare the paths that no strategy
+/// but one draws often) over
+/// an alpha-masked floor (albedo 0.6 behind a uv checkerboard opacity of 0.25 and 0.75, black
+/// below), under cube_over_floor's lamp, or with `lamp_inside` a smaller one inside the cube at
+/// y = 0.6 (facing down, in the medium): each BDPT strategy alone and the pdf symmetry there.
+inline Sc glass_cube_under_lamp(int boundary, bool lamp_inside = false) {
+    using S = Mono;
+    Shapes shapes;
+    shapes.report_uv = true;
+    shapes.boxes.push_back({Vec3(-1.f), Vec3(1.f), {boundary, -1, 0, -1}});
+    shapes.quads.push_back({Vec3(-3.f, -1.05f, 3.f), Vec3(6.f, 0.f, 0.f), Vec3(0.f, 0.f, -6.f), {kMasked, -1, -1, -1}});
+    const QuadLight<S> lamp = lamp_inside ? QuadLight<S>{Vec3(-0.3f, 0.6f, -0.3f), Vec3(0.6f, 0.f, 0.f), Vec3(0.f, 0.f, 0.6f),
+                                                         constant_coefficient<S>(12.f)}
+                                          : QuadLight<S>{Vec3(-0.6f, 2.6f, -0.6f), Vec3(1.2f, 0.f, 0.f), Vec3(0.f, 0.f, 1.2f),
+                                                         constant_coefficient<S>(12.f)};
+    const int around = lamp_inside ? 0 : -1;  // the lamp's media: the cube's inside it
+    shapes.quads.push_back({lamp.corner, lamp.edge_u, lamp.edge_v, {-1, 0, around, around}});
+    return Sc(shapes, {grey_scenes::medium(Box{Vec3(-1.f), Vec3(1.f)}, 0.3f, 1.2f, 0.6f)},
+              materials<S>(constant_coefficient<S>(0.45f), 0.6f, 1.33f, 0.5f),
+                 Ls<S>(LightSelection::Power, 4.f, {lamp}, {}), -1);
+}
+
 /// Runs the closed forms for every estimator `for_each` hands its check, n samples a case, within
 /// k standard errors (the furnace: n_furnace samples):
 /// - thin dielectric sheet, seen from above at incidence cosine c: R'(c); from below: T' = 1 - R'
@@ -144,11 +199,16 @@ Scene glass_furnace(SceneMedium<typename Scene::MediumType, typename Scene::Majo
 /// - the floor's centre under the filter (w = 0.45, P = 0.6): rho w F = 0.5 x 0.45 x 0.55413;
 /// - the alpha-masked sheet from above over a black lower half: L = 0.6 alpha(uv), 0.15 and 0.45
 ///   on neighbouring squares;
-/// - the glass furnace from inside its medium, in random directions: L = 1.
+/// - the glass furnace from inside its medium, in random directions: L = 1;
+/// - the rough dielectric sheet (eta 1.5 below it, alpha 0.3) seen from above and from below: the
+///   integral of its value over the upper hemisphere (the walls there emit 1, those below are
+///   black), by quadrature of eval (itself checked against its samples in test_bsdf.cpp).
 template <class ForEach>
 void check_null_lobes(ForEach for_each, int n, int n_furnace, double k) {
     const Sc thin = half_lit_box(kThin, kBlack), filter = half_lit_box(kFilter, kFloor),
-             masked = half_lit_box(kMasked, kBlack), furnace = glass_furnace();
+             masked = half_lit_box(kMasked, kBlack), furnace = glass_furnace(), rough = half_lit_box(kRough, kBlack);
+    const double rough_above = rough_sheet_radiance(Vec3(0.1f, 0.6f, 0.2f)),
+                 rough_below = rough_sheet_radiance(Vec3(0.1f, -0.6f, 0.2f));
     auto check = [&](const auto& est, const Sc& sc, double expected, int samples, std::uint64_t seed, auto make_ray) {
         const Stat s = grey_scenes::estimate(est, sc, samples, seed, make_ray);
         CAPTURE(expected);
@@ -163,6 +223,7 @@ void check_null_lobes(ForEach for_each, int n, int n_furnace, double k) {
             const Vec3 o(0.1f, 0.6f * side, 0.2f);
             const double c = 0.6 / double(glm::length(o)), r = thin_reflectance(c);
             check(est, thin, side > 0.f ? r : 1.0 - r, n, 51, toward(o, Vec3(0.f)));
+            check(est, rough, side > 0.f ? rough_above : rough_below, n, 59, toward(o, Vec3(0.f)));
         }
         check(est, filter, kFloorAlbedo * 0.45 * floor_to_sheet(), n, 53,
               toward(Vec3(0.1f, -0.4f, 0.2f), Vec3(0.f, -1.f, 0.f)));
