@@ -146,7 +146,8 @@ struct CheckerFloorBsdf {
 };
 
 template <nsp::SpectralMode S>
-using GlassMaterials = nsp::Materials<S, CheckerFloorBsdf<S>, nsp::ThinDielectricBsdf<S>, nsp::LambertianBsdf<S>>;
+using GlassMaterials =
+    nsp::Materials<S, CheckerFloorBsdf<S>, nsp::ThinDielectricBsdf<S>, nsp::LambertianBsdf<S>, nsp::RoughDielectricBsdf<S>>;
 template <nsp::SpectralMode S>
 using GlassLights = nsp::LightSampler<S, nsp::QuadLight<S>, nsp::ImageEnvironmentLight<S>>;
 template <nsp::Medium M = nsp::DenseGridMedium<nsp::Mono>, class Maj = nsp::GlobalMajorant<M>>
@@ -169,7 +170,7 @@ inline std::vector<float> glass_sky_image(int w = 64, int h = 32) {
                 g = 0.35f - 0.15f * d.y;
                 b = 0.35f + 0.1f * d.y;
             }
-            if (glm::dot(d, sun) > std::cos(3.f * nsp::kPi / 180.f)) r = g = b = 400.f;
+            if (glm::dot(d, sun) > std::cos(5.f * nsp::kPi / 180.f)) r = g = b = 144.f;
             float* px = &rgb[(std::size_t(y) * std::size_t(w) + std::size_t(x)) * 3];
             px[0] = r, px[1] = g, px[2] = b;
         }
@@ -180,7 +181,9 @@ inline std::vector<float> glass_sky_image(int w = 64, int h = 32) {
 /// The glass: `medium` (in [-1, 1]^3) inside a thin glass cube of index 1.5 (material 1, medium 0
 /// inside), standing on the room's floor as a checkerboard (material 0, uv over its 6 x 6) before
 /// the back and left walls (material 2, albedo 0.5); a lamp 0.3 x 0.3 inside the smoke at height
-/// 0.6, facing down, radiance 25 (light 0, medium 0 on both sides); the sky image (light 1).
+/// 0.6, facing down, radiance 25 (light 0, medium 0 on both sides); a ball of rough glass (index
+/// 1.5, alpha 0.2; material 3) of radius 0.45 on the floor in front of it, to the left; the sky
+/// image (light 1).
 template <nsp::Medium M, class Maj>
 GlassScene<M, Maj> make_glass_scene(M medium, Maj majorant) {
     using S = typename M::Spectral;
@@ -192,10 +195,11 @@ GlassScene<M, Maj> make_glass_scene(M medium, Maj majorant) {
     const nsp::QuadLight<S> lamp{nsp::Vec3(-0.15f, 0.6f, -0.15f), nsp::Vec3(0.f, 0.f, 0.3f), nsp::Vec3(0.3f, 0.f, 0.f),
                                  nsp::constant_coefficient<S>(25.f)};
     shapes.quads.push_back({lamp.corner, lamp.edge_u, lamp.edge_v, {-1, 0, 0, 0}});
+    shapes.spheres.push_back({nsp::Vec3(1.f, kRoomFloorY + 0.45f, -2.f), 0.45f, {3, -1, -1, -1}});
     return GlassScene<M, Maj>(
         std::move(shapes), {{std::move(medium), std::move(majorant), nsp::HenyeyGreensteinPhase(kPhaseG)}},
         GlassMaterials<S>({CheckerFloorBsdf<S>{}}, {nsp::ThinDielectricBsdf<S>(1.5f)},
-                          {nsp::LambertianBsdf<S>(nsp::constant_coefficient<S>(0.5f))}),
+                          {nsp::LambertianBsdf<S>(nsp::constant_coefficient<S>(0.5f))}, {nsp::RoughDielectricBsdf<S>(1.5f, 0.35f)}),
         GlassLights<S>(nsp::LightSelection::Power, 4.f, {lamp}, {nsp::ImageEnvironmentLight<S>(64, 32, glass_sky_image())}),
         -1);
 }

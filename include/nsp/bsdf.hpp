@@ -355,7 +355,7 @@ private:
 /// refraction lobe is the symmetric f_t n_i / n_o = f_t / eta_rel (f_t Walter's radiance form):
 /// along a path the factors n_i / n_o telescope, and every estimate is the radiance exactly when
 /// the camera and the lights lie in media of one index (all in air, say). A light inside glass of
-/// index n seen from a camera in air must report its radiance times 1 / n; docs/surfaces.md.
+/// index n seen from a camera in air must report its radiance times 1 / n (docs/integration.md).
 template <SpectralMode S>
 class RoughDielectricBsdf {
 public:
