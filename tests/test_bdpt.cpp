@@ -1030,7 +1030,7 @@ TEST_CASE("bdpt: agrees with PathEstimator on an emitting cube over a floor unde
     });
 }
 
-TEST_CASE("bdpt: light subpaths and NEE on a fraction of the samples (expected counts < 1) stay unbiased" * doctest::test_suite("converge")) {
+TEST_CASE("bdpt: light subpaths and NEE on a fraction of the samples (expected counts < 1, or 0) stay unbiased" * doctest::test_suite("converge")) {
     // THEORY 5.9: with light_subpath_probability c the connections and light tracing run on a
     // fraction c of the samples and weigh with c times their densities; with nee_count n, NEE
     // toward the lights (s = 1) runs at a camera vertex with probability n, divides by it, and
@@ -1055,14 +1055,29 @@ TEST_CASE("bdpt: light subpaths and NEE on a fraction of the samples (expected c
     const Stat b = image_average(est, sc, camera, 6000, 44);
     CAPTURE(b.mean);
     CHECK(std::abs(b.mean - 2.0) <= kSigmas * b.se());
+    // Counts 0 (THEORY 5.9: the technique is absent from the sum): no NEE toward the lights, no
+    // light subpaths, or neither (s = 0, the collision estimator's emission, NEE toward the
+    // volume and the segment technique are left; the walls can be hit): still L = 2.
+    for (const auto& [n, c] : {std::pair{0.f, 0.4f}, std::pair{0.5f, 0.f}, std::pair{0.f, 0.f}}) {
+        EstimatorOptions o = BdptEstimator<>::default_options();
+        o.nee_count = n;
+        const float light = c;  // not a structured binding: CAPTURE's lambda takes it
+        const float nee = n;
+        CAPTURE(nee);
+        CAPTURE(light);
+        const BdptEstimator<bdpt::NullScattering, mis::Balance> zero(o, {}, light);
+        const Stat z = image_average(zero, sc, camera, 6000, 45);
+        CAPTURE(z.mean);
+        CHECK(std::abs(z.mean - 2.0) <= kSigmas * z.se());
+    }
 
     EstimatorOptions opts = strategy_test_options();
     opts.nee_count = 0.5f;
     StrategyRecord rec =
         record_strategies(BdptEstimator<bdpt::NullScattering, mis::Balance>(opts, {}, 0.4f), cube_over_floor(false), 200000, 3);
     check_strategies_alone_and_symmetric(rec);
-    CHECK_THROWS_WITH_AS((BdptEstimator<>(BdptEstimator<>::default_options(), {}, 0.f)),
-                         doctest::Contains("light_subpath_probability = 0 is not allowed"), InvalidArgument);
+    CHECK_THROWS_WITH_AS((BdptEstimator<>(BdptEstimator<>::default_options(), {}, -0.1f)),
+                         doctest::Contains("light_subpath_probability = -0.1 is not allowed"), InvalidArgument);
     CHECK_THROWS_WITH_AS((BdptEstimator<>(BdptEstimator<>::default_options(), {}, 1.5f)),
                          doctest::Contains("light_subpath_probability = 1.5 is not allowed"), InvalidArgument);
 }
@@ -1094,6 +1109,18 @@ TEST_CASE("bdpt: media in empty space (NoSurfaces): light subpaths start in the 
         CHECK(std::abs(a.mean - ref.mean) <= kSigmas * std::sqrt(a.se() * a.se() + ref.se() * ref.se()));
         CHECK(std::abs(b.mean - ref.mean) <= kSigmas * std::sqrt(b.se() * b.se() + ref.se() * ref.se()));
     });
+    // The point light is a delta light: only NEE reaches it, so NEE's count 0 is refused there
+    // (Status::InvalidInput, no estimate), light subpaths or not.
+    EstimatorOptions none = BdptEstimator<>::default_options();
+    none.nee_count = 0.f;
+    for (const float c : {1.f, 0.f}) {
+        const BdptEstimator<bdpt::NullScattering, mis::Balance> est(none, {}, c);
+        Pcg32 rng(3, 3);
+        LookupCount counter;
+        const auto r = est.radiance(sc, camera.ray(0.5f, 0.5f), {}, rng, counter);
+        CHECK(r.status == Status::InvalidInput);
+        CHECK(r.value[0] == 0.f);
+    }
 }
 
 TEST_CASE("bdpt: rejects a max_depth beyond its vertex arrays") {

@@ -375,6 +375,137 @@ void check_choice(const Prediction& p) {
 
 }  // namespace
 
+TEST_CASE("NEE count 0: uni + NEE MIS is exactly tracking + hits, the furnaces give 1, delta lights are refused") {
+    // THEORY 5.9: a technique of count 0 is absent from the sum. Where every light can be hit (a
+    // sphere light and a sky), a combining strategy at NEE count 0 runs no NEE, draws no number
+    // for it and weighs every hit 1: sample for sample the unidirectional estimator's estimate on
+    // the same random stream, to float rounding (1e-5 relative), grey and per channel.
+    using M = DenseGridMedium<Mono>;
+    const Box box{Vec3(-1.f), Vec3(1.f)};
+    const M medium = make_medium<M>(box, 0.6f, grey<Mono>(0.2f), grey<Mono>(0.8f), 7);
+    Lights<Mono> lights;
+    lights.set(SphereLight<Mono>{Vec3(1.6f, 0.4f, 0.2f), 0.5f, grey<Mono>(10.f)});
+    lights.set(EnvironmentLight<Mono>{grey<Mono>(0.2f)});
+    EstimatorOptions opts;
+    opts.rr_start_depth = 1;
+    opts.rr_max_survival = 0.6f;
+    const Scene scene(medium, GlobalMajorant<M>(medium), HenyeyGreensteinPhase(0.3f), lights);
+    auto same_as_unidirectional = [&](const auto& uni, const auto& zero, const auto& sc, const char* name) {
+        CAPTURE(std::string(name));
+        Pcg32 a(9, 9), b(9, 9), dirs(2, 2);
+        LookupCount ca, cb;
+        int nonzero = 0;
+        for (int i = 0; i < 3000; ++i) {
+            const Ray ray{Vec3(-3.f, 0.2f, 0.1f), glm::normalize(Vec3(1.f, 0.3f * (dirs.uniform() - 0.5f), 0.3f * (dirs.uniform() - 0.5f)))};
+            const auto ru = uni.radiance(sc, ray, {}, a, ca);
+            const auto rz = zero.radiance(sc, ray, {}, b, cb);
+            REQUIRE(rz.status == Status::Ok);
+            CAPTURE(i);
+            for (int c = 0; c < int(ru.value.size()); ++c)
+                CHECK(double(rz.value[c]) == doctest::Approx(double(ru.value[c])).epsilon(1e-5));
+            nonzero += ru.value[0] > 0.f;
+        }
+        CHECK(nonzero > 1000);
+        CHECK(ca.count() == cb.count());  // the same lookups: no shadow walk ran
+    };
+    same_as_unidirectional(PathEstimator<strategy::Unidirectional>(opts),
+                           PathEstimator<strategy::NullScatteringMis, mis::Balance>(with_count(0.f, opts)), scene,
+                           "uni-nee-mis balance");
+    same_as_unidirectional(PathEstimator<strategy::Unidirectional>(opts),
+                           PathEstimator<strategy::NullScatteringMis, mis::Power>(with_count(0.f, opts)), scene,
+                           "uni-nee-mis power");
+    same_as_unidirectional(PathEstimator<strategy::Unidirectional>(opts),
+                           PathEstimator<strategy::DirectionalMis, mis::Balance>(with_count(0.f, opts)), scene,
+                           "directional-mis balance");
+    {
+        using R = DenseGridMedium<Rgb>;
+        const R chroma = make_medium<R>(box, 0.6f, spec<Rgb>(0.2f, 0.1f, 0.4f), spec<Rgb>(0.8f, 0.4f, 1.2f), 7);
+        Lights<Rgb> rgb_lights;
+        rgb_lights.set(SphereLight<Rgb>{Vec3(1.6f, 0.4f, 0.2f), 0.5f, grey<Rgb>(10.f)});
+        rgb_lights.set(EnvironmentLight<Rgb>{spec<Rgb>(0.2f, 0.3f, 0.1f)});
+        const Scene rgb(chroma, GlobalMajorant<R>(chroma), HenyeyGreensteinPhase(0.3f), rgb_lights);
+        same_as_unidirectional(SpectralPathEstimator<channels::SpectralMis, strategy::Unidirectional>(opts),
+                               SpectralPathEstimator<channels::SpectralMis, strategy::NullScatteringMis, mis::Balance>(
+                                   with_count(0.f, opts)),
+                               rgb, "spectral uni-nee-mis");
+    }
+
+    // The furnace (albedo 1, unit sky) gives 1 at count 0 for every combining strategy, the
+    // equiangular one included (5 SE).
+    {
+        Lights<Mono> sky;
+        sky.set(EnvironmentLight<Mono>{grey<Mono>(1.f)});
+        const M white = make_medium<M>(box, 1.f, grey<Mono>(0.f), grey<Mono>(1.f), 42);
+        const auto maj = GlobalMajorant<M>(white);
+        const Scene furnace(white, GlobalMajorant<M>(white, 2.f * maj.value()), HenyeyGreensteinPhase(0.5f), sky);
+        const Ray ray{Vec3(-3.f, 0.2f, 0.1f), glm::normalize(Vec3(1.f, -0.05f, 0.02f))};
+        int seed = 700;
+        auto check = [&](const auto& est, const char* name) {
+            CAPTURE(std::string(name));
+            const auto res = estimate_radiance(est, furnace, ray, 20000, std::uint64_t(++seed));
+            const Stat& s = res.stat.ch[0];
+            CAPTURE(s.mean);
+            CAPTURE(s.se());
+            CHECK(res.not_ok == 0);
+            CHECK(std::abs(s.mean - 1.0) <= kSigmas * s.se() + kRoundingFloor);
+        };
+        check(PathEstimator<strategy::DirectionalMis, mis::Balance>(with_count(0.f)), "directional-mis balance");
+        check(PathEstimator<strategy::NullScatteringMis, mis::Power>(with_count(0.f)), "uni-nee-mis power");
+        check(PathEstimator<strategy::EquiangularMis, mis::Balance>(with_count(0.f)), "uni-nee-eq-mis balance");
+    }
+
+    // A point light: NEE alone reaches it, so count 0 gives Status::InvalidInput and 0 (not a
+    // silently dark image), grey and per channel.
+    {
+        Lights<Mono> point;
+        point.set(PointLight<Mono>{Vec3(0.2f, 0.25f, -0.1f), grey<Mono>(2.f)});
+        point.set(EnvironmentLight<Mono>{grey<Mono>(0.2f)});
+        const Scene lamp(medium, GlobalMajorant<M>(medium), HenyeyGreensteinPhase(0.3f), point);
+        const Ray ray{Vec3(-3.f, 0.2f, 0.1f), Vec3(1.f, 0.f, 0.f)};
+        Pcg32 rng(4, 4);
+        LookupCount counter;
+        const auto a = PathEstimator<strategy::NullScatteringMis, mis::Balance>(with_count(0.f)).radiance(lamp, ray, {}, rng, counter);
+        CHECK(a.status == Status::InvalidInput);
+        CHECK(a.value[0] == 0.f);
+        const auto b = PathEstimator<strategy::EquiangularMis, mis::Balance>(with_count(0.f)).radiance(lamp, ray, {}, rng, counter);
+        CHECK(b.status == Status::InvalidInput);
+        // Count 1e-3 still reaches it.
+        const auto c = PathEstimator<strategy::NullScatteringMis, mis::Balance>(with_count(1e-3f)).radiance(lamp, ray, {}, rng, counter);
+        CHECK(c.status == Status::Ok);
+    }
+}
+
+TEST_CASE("NEE count 0: surfaces: the lit cube over a floor under a lamp and a sky agrees with count 1") {
+    // The lit cube of "NEE counts: surfaces" at count 0: every light there (a sky, a quad lamp the
+    // geometry reports) can be hit, so every combining strategy is tracking + hits; against uni +
+    // NEE MIS at count 1, 5 combined SE.
+    using namespace nsp_test::grey_scenes;
+    Shapes shapes;
+    shapes.boxes.push_back({Vec3(-1.f), Vec3(1.f), {-1, -1, 0, -1}});
+    shapes.quads.push_back({Vec3(-3.f, -1.05f, 3.f), Vec3(6.f, 0.f, 0.f), Vec3(0.f, 0.f, -6.f), {0, -1, -1, -1}});
+    const QuadLight<S> lamp{Vec3(-0.6f, 2.6f, -0.6f), Vec3(1.2f, 0.f, 0.f), Vec3(0.f, 0.f, 1.2f), Spectrum::Constant(12.f)};
+    shapes.quads.push_back({lamp.corner, lamp.edge_u, lamp.edge_v, {-1, 0, -1, -1}});
+    const Sc sc(shapes, {medium(Box{Vec3(-1.f), Vec3(1.f)}, 0.3f, 1.2f, 0.6f)}, materials(0.6f),
+                Ls(LightSelection::Power, 4.f, {lamp}, {EnvironmentLight<S>{Spectrum::Constant(0.05f)}}), -1);
+    auto camera = [](Pcg32& rng) {
+        const float u = rng.uniform(), v = rng.uniform();
+        return Ray{Vec3(0.f, 0.3f, -4.5f), glm::normalize(Vec3(0.7f * (1.f - 2.f * u), 0.7f * (1.f - 2.f * v), 1.f))};
+    };
+    const Stat ref = estimate(PathEstimator<strategy::NullScatteringMis, mis::Balance>{}, sc, 40000, 621, camera);
+    CHECK(ref.mean > 0.05);
+    int seed = 630;
+    auto check = [&](const auto& est, const char* name) {
+        CAPTURE(std::string(name));
+        const Stat s = estimate(est, sc, 40000, std::uint64_t(++seed), camera);
+        CAPTURE(s.mean);
+        CAPTURE(ref.mean);
+        CHECK(std::abs(s.mean - ref.mean) <= kSigmas * std::hypot(s.se(), ref.se()));
+    };
+    check(PathEstimator<strategy::NullScatteringMis, mis::Balance>(with_count(0.f)), "uni-nee-mis balance");
+    check(PathEstimator<strategy::DirectionalMis, mis::Balance>(with_count(0.f)), "directional-mis balance");
+    check(PathEstimator<strategy::EquiangularMis, mis::Balance>(with_count(0.f)), "uni-nee-eq-mis balance");
+}
+
 TEST_CASE("NeeCountLearner: the variance predicted from a count-1 pilot is the variance measured at each count") {
     // The prediction is exact in expectation (law of total variance over the NEE draws, THEORY
     // 5.9), covariances within a path included: checked against independent runs at every
@@ -765,8 +896,8 @@ TEST_CASE("NeeCountLearner: bookkeeping") {
     }
 }
 
-TEST_CASE("NEE counts: a count outside (0, 1] is rejected by name, by BDPT too") {
-    for (const float bad : {0.f, -0.5f, 1.5f, std::nanf("")}) {
+TEST_CASE("NEE counts: a count outside [0, 1] is rejected by name, by BDPT too; 0 where NEE is a strategy's only way") {
+    for (const float bad : {-0.5f, 1.5f, std::nanf("")}) {
         CAPTURE(bad);
         CHECK_THROWS_WITH_AS((PathEstimator<strategy::NullScatteringMis, mis::Balance>(with_count(bad))),
                              doctest::Contains("nee_count"), InvalidArgument);
@@ -774,14 +905,25 @@ TEST_CASE("NEE counts: a count outside (0, 1] is rejected by name, by BDPT too")
     CHECK_THROWS_WITH_AS((SpectralPathEstimator<channels::SpectralMis, strategy::NullScatteringMis, mis::Balance>(
                              with_count(1.5f))),
                          doctest::Contains("nee_count"), InvalidArgument);
-    CHECK_THROWS_WITH_AS((BdptEstimator<bdpt::NullScattering, mis::Balance>(with_count(0.f, BdptEstimator<>::default_options()))),
-                         doctest::Contains("nee_count"), InvalidArgument);
-    CHECK_NOTHROW((BdptEstimator<bdpt::NullScattering, mis::Balance>(with_count(0.5f, BdptEstimator<>::default_options()))));
+    CHECK_THROWS_WITH_AS((BdptEstimator<bdpt::NullScattering, mis::Balance>(with_count(-1.f, BdptEstimator<>::default_options()))),
+                         doctest::Contains("nee_count = -1 is not allowed: an expected sample count must lie in [0, 1]"),
+                         InvalidArgument);
+    CHECK_NOTHROW((BdptEstimator<bdpt::NullScattering, mis::Balance>(with_count(0.f, BdptEstimator<>::default_options()))));
     CHECK_NOTHROW((PathEstimator<strategy::NullScatteringMis, mis::Balance>(with_count(1e-3f))));
+    // Count 0 where a strategy reaches the lights by NEE alone: refused at construction.
+    CHECK_NOTHROW((PathEstimator<strategy::NullScatteringMis, mis::Balance>(with_count(0.f))));
+    CHECK_NOTHROW((PathEstimator<strategy::Unidirectional>(with_count(0.f))));
+    CHECK_THROWS_WITH_AS((PathEstimator<strategy::NextEvent>(with_count(0.f))),
+                         doctest::Contains("nee_count = 0 is not allowed with strategy ratio-nee: NEE is its only way to the lights"),
+                         InvalidArgument);
+    CHECK_THROWS_WITH_AS((PathEstimator<strategy::EquiangularNextEvent>(with_count(0.f))),
+                         doctest::Contains("nee_count = 0 is not allowed with strategy equiangular-nee"), InvalidArgument);
+    CHECK_THROWS_WITH_AS((SpectralPathEstimator<channels::SpectralMis, strategy::NextEvent>(with_count(0.f))),
+                         doctest::Contains("nee_count = 0 is not allowed with strategy ratio-nee"), InvalidArgument);
 }
 
-TEST_CASE("emission segment counts: a count outside (0, 1] is rejected by name, by every estimator") {
-    for (const float bad : {0.f, -0.5f, 1.5f, std::nanf("")}) {
+TEST_CASE("emission segment counts: a count outside [0, 1] is rejected by name, by every estimator") {
+    for (const float bad : {-0.5f, 1.5f, std::nanf("")}) {
         CAPTURE(bad);
         EstimatorOptions o;
         o.emission_segment_count = bad;
@@ -796,5 +938,7 @@ TEST_CASE("emission segment counts: a count outside (0, 1] is rejected by name, 
     }
     EstimatorOptions half = BdptEstimator<>::default_options();
     half.emission_segment_count = 0.5f;
+    CHECK_NOTHROW((BdptEstimator<bdpt::NullScattering, mis::Balance>(half)));
+    half.emission_segment_count = 0.f;  // the collision estimator reaches all emission
     CHECK_NOTHROW((BdptEstimator<bdpt::NullScattering, mis::Balance>(half)));
 }

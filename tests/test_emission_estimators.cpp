@@ -122,6 +122,13 @@ TEST_CASE_TEMPLATE_DEFINE("emissive furnace: L_e equal to the environment gives 
         few.nee_count = 0.5f;
         check_all<C>(scene, ray, few, 6000, 240, "global, segment count 0.3, NEE count 0.5",
                      [&](int c) { return double(le[c]); }, Run::kCombining);
+        // Counts 0: no segment technique and no NEE toward the sky (the collision estimator and
+        // the hits reach both): L stays L_e.
+        EstimatorOptions none;
+        none.emission_segment_count = 0.f;
+        none.nee_count = 0.f;
+        check_all<C>(scene, ray, none, 6000, 340, "global, segment count 0, NEE count 0",
+                     [&](int c) { return double(le[c]); }, Run::kCombining);
     }
     for_each_kind<std::tuple<GridKind, SignedGridKind>, Emissive<M>>(
         [&](auto kind) { run(decltype(kind)::make(medium), decltype(kind)::name); });
@@ -151,6 +158,8 @@ TEST_CASE_TEMPLATE_DEFINE("emitting absorber with analytic optical depth = quadr
         EstimatorOptions few;
         few.emission_segment_count = 0.2f;
         check_all<C>(scene, ray, few, 20000, 260, maj_name + " segment count 0.2", [&](int c) { return ref[c]; }, Run::kCombining);
+        few.emission_segment_count = 0.f;  // never: the collision estimator alone on the camera ray
+        check_all<C>(scene, ray, few, 20000, 360, maj_name + " segment count 0", [&](int c) { return ref[c]; }, Run::kCombining);
     };
     run(GlobalMajorant<Emissive<M>>(medium), "global");
     for_each_kind<std::tuple<SignedGlobalKind, GridKind, SignedGridKind>, Emissive<M>>(

@@ -136,9 +136,13 @@ TEST_CASE_TEMPLATE_DEFINE("spectral emitting absorber = quadrature per channel",
     EstimatorOptions few;
     few.emission_segment_count = 0.2f;
     const E est_few(few);
+    // And never (count 0): the collision estimator alone on the camera ray.
+    EstimatorOptions none;
+    none.emission_segment_count = 0.f;
+    const E est_none(none);
     for_each_majorant<typename E::Channels>(medium, [&](const auto& maj, const char* maj_name) {
         const auto scene = Scene(medium, maj, IsotropicPhase{}, Lights<Rgb>{});
-        for (const E* e_ : {&est, &est_off, &est_few}) {
+        for (const E* e_ : {&est, &est_off, &est_few, &est_none}) {
             if (e_ != &est && !E::Strategy::combines) continue;
             const auto res = estimate_radiance(*e_, scene, ray, 20000, std::uint64_t(++seed));
             CHECK(res.not_ok == 0);

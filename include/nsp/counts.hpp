@@ -2,10 +2,11 @@
 // them from a render's first samples.
 //
 // One mechanism serves every technique an estimator may skip: a technique with expected count
-// n in (0, 1] runs with probability n, decided before it is sampled (draw_technique); where it
+// n in [0, 1] runs with probability n, decided before it is sampled (draw_technique); where it
 // runs its estimate divides by n, and every MIS weight takes n p in place of its pdf p. That keeps
 // the estimator unbiased for any n in (0, 1] and lets a technique that does not pay for itself be
-// drawn rarely. The adaptive equiangular probability (EstimatorOptions::adaptive_equiangular),
+// drawn rarely; n = 0 removes the technique from every weight, unbiased where the others cover
+// what it samples (EstimatorOptions says where nsp allows it; the learner does not choose it). The adaptive equiangular probability (EstimatorOptions::adaptive_equiangular),
 // BDPT's light_subpath_probability, the NEE count (EstimatorOptions::nee_count) and the emission
 // segment technique's count (EstimatorOptions::emission_segment_count) are such counts.
 //

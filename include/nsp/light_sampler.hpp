@@ -101,6 +101,7 @@ private:
             validate(l);
             const double w = selection == LightSelection::Power ? double(l.power(scene_radius)) : 1.0;
             if (is_infinite<std::decay_t<decltype(l)>>()) infinite_.push_back(int(entries_.size()));
+            if (std::decay_t<decltype(l)>::is_delta) delta_ = true;
             entries_.push_back({std::uint8_t(kind), std::uint32_t(index), float(w), 0.f});
             total += w;
         });
@@ -157,6 +158,10 @@ public:
     static constexpr bool bidirectional_ready() noexcept {
         return ((EmittingLight<Ls, S> || is_infinite<Ls>() || bool(Ls::is_delta)) && ...);
     }
+
+    /// Whether any light is a delta light (a point light, a directional light): one no path can
+    /// hit, which NEE alone reaches (so NEE's count may not be 0; EstimatorOptions::nee_count).
+    bool has_delta_lights() const noexcept { return delta_; }
 
     /// Whether any light can start a light subpath (an EmittingLight with a positive probability).
     bool has_emitters() const noexcept { return !emitters_.empty(); }
@@ -430,6 +435,7 @@ private:
     std::tuple<std::vector<Ls>...> lights_;
     std::vector<Entry> entries_;
     std::vector<int> infinite_;
+    bool delta_ = false;
     struct Target {
         Vec3 point;
         float pmf, cdf;

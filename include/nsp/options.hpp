@@ -89,20 +89,26 @@ struct EstimatorOptions {
     /// a camera segment in an emitting medium, one more strategy among the (s, t) ones (THEORY 5.7
     /// in 5.5); directional MIS leaves it out.
     bool emission_along_segments = true;
-    /// The expected count of the segment technique on each segment, in (0, 1] (THEORY 5.9,
+    /// The expected count of the segment technique on each segment, in [0, 1] (THEORY 5.9,
     /// counts.hpp; with emission_along_segments on): it runs on a segment with this probability,
     /// its estimate divided by it, and every emission weight takes count x p_seg. 1: on every
     /// segment. Below 1 it saves the technique's flight and lookup where the collision estimator
     /// and NEE find the emission well; the power grid's walk along the segment stays (the other
-    /// techniques' weights need W). nsp::PathEstimator and nsp::SpectralPathEstimator, media and
+    /// techniques' weights need W). 0: it never runs and is absent from every weight (the
+    /// collision estimator reaches all emission, so nothing is lost). nsp::PathEstimator and nsp::SpectralPathEstimator, media and
     /// surfaces, and nsp::BdptEstimator (on the camera segments' pieces; NeeCountLearner does
     /// not learn it there).
     float emission_segment_count = 1.f;
-    /// The expected count of NEE toward the lights at each real vertex, in (0, 1] (THEORY 5.9,
+    /// The expected count of NEE toward the lights at each real vertex, in [0, 1] (THEORY 5.9,
     /// counts.hpp): NEE runs there with this probability, its estimate divided by it, and the MIS
     /// weights of both techniques take nee_count x the light pdf. 1: NEE at every vertex. Below 1
     /// it trades variance for the shadow rays' cost where tracking finds the light well (a large
-    /// light, an environment); NeeCountLearner chooses it per pixel tile. nsp::PathEstimator and
+    /// light, an environment); NeeCountLearner chooses it per pixel tile. 0: NEE never runs and
+    /// is absent from every weight, so a combining strategy is exactly tracking + hits; allowed
+    /// only where every light can be hit: a strategy that reaches lights by NEE alone (ratio-nee,
+    /// equiangular-nee) refuses it at construction, and a scene with a delta light (a point or
+    /// directional light) gives Status::InvalidInput and 0 (LightSampler::has_delta_lights()). A
+    /// light the host's geometry never reports as hit is the host's to leave out. nsp::PathEstimator and
     /// nsp::SpectralPathEstimator (every strategy that samples lights, NEE from equiangular
     /// vertices excepted: they exist for it); nsp::BdptEstimator (s = 1 toward the lights at each
     /// camera vertex; NEE toward an emitting volume keeps count 1).
@@ -125,18 +131,24 @@ struct RadianceSample {
     Status status = Status::Ok;
 };
 
-/// Whether a technique with expected count `count` in (0, 1] runs this time: always at count >= 1
-/// (no random number drawn, so a count of 1 leaves the random stream as without counts), else with
-/// probability count (one number drawn).
+/// Whether a technique with expected count `count` in [0, 1] runs this time: always at count >= 1
+/// (no random number drawn, so a count of 1 leaves the random stream as without counts), never
+/// at count 0 (none drawn either), else with probability count (one number drawn).
 template <UniformRng R>
 bool draw_technique(float count, R& rng) {
-    return count >= 1.f || rng.uniform() < count;
+    return count >= 1.f || (count > 0.f && rng.uniform() < count);
 }
 
-/// Throws InvalidArgument unless `count` lies in (0, 1]; `what` names the option.
-inline void validate_count(const char* what, float count) {
-    if (!(count > 0.f && count <= 1.f))
+/// Throws InvalidArgument unless `count` lies in (0, 1], or in [0, 1] where `zero_allowed` (a
+/// technique that other techniques cover, THEORY 5.9); `what` names the option.
+inline void validate_count(const char* what, float count, bool zero_allowed = false) {
+    if (zero_allowed) {
+        if (!(count >= 0.f && count <= 1.f))
+            detail::fail(what, " = ", count,
+                         " is not allowed: an expected sample count must lie in [0, 1] (0: the technique never runs)");
+    } else if (!(count > 0.f && count <= 1.f)) {
         detail::fail(what, " = ", count, " is not allowed: an expected sample count must lie in (0, 1]");
+    }
 }
 
 /// Which technique produced a light contribution a MisRecorder sees.
@@ -179,8 +191,8 @@ inline void validate(const EstimatorOptions& opts) {
     if (!(opts.rr_max_survival > 0.f && opts.rr_max_survival <= 1.f))
         detail::fail("EstimatorOptions rr_max_survival = ", opts.rr_max_survival,
                      " is not allowed: it must lie in (0, 1]");
-    validate_count("EstimatorOptions nee_count", opts.nee_count);
-    validate_count("EstimatorOptions emission_segment_count", opts.emission_segment_count);
+    validate_count("EstimatorOptions nee_count", opts.nee_count, true);
+    validate_count("EstimatorOptions emission_segment_count", opts.emission_segment_count, true);
 }
 
 }  // namespace nsp

@@ -172,7 +172,7 @@ void record_emission_of(C& counter, float unweighted, const Pdfs& p, const Estim
                         EmissionTechnique t) noexcept {
     if constexpr (MisRecorder<C>) {
         const float count = opts.emission_segment_count;
-        const float p_seg = p.segment / count;
+        const float p_seg = count > 0.f ? p.segment / count : 0.f;  // at count 0 p.segment is 0 too
         const float drawn = t == EmissionTechnique::Collision ? p.collision
                             : t == EmissionTechnique::Segment ? p_seg
                                                               : p.nee;
@@ -218,9 +218,13 @@ public:
     using Heuristic = H;
     using Absorption = A;
 
-    /// Throws InvalidArgument on invalid roulette settings (see EstimatorOptions).
+    /// Throws InvalidArgument on invalid roulette settings or counts (see EstimatorOptions), and
+    /// on nee_count 0 with a strategy that reaches the lights by NEE alone.
     explicit VertexKernels(EstimatorOptions opts = {}, H heuristic = H{}) : opts_(opts), heuristic_(heuristic) {
         validate(opts);
+        if (St::samples_lights && !St::hits_lights && opts.nee_count == 0.f)
+            detail::fail("EstimatorOptions nee_count = 0 is not allowed with strategy ", St::name,
+                         ": NEE is its only way to the lights (a count of 0 needs a strategy that also hits them)");
     }
 
     const EstimatorOptions& options() const noexcept { return opts_; }

@@ -111,17 +111,18 @@ public:
 
     /// Throws InvalidArgument on invalid roulette settings (see EstimatorOptions) or a max_depth
     /// above MaxDepth (the vertex arrays' size).
-    /// `light_subpath_probability` in (0, 1]: the expected number of light subpaths per sample
+    /// `light_subpath_probability` in [0, 1]: the expected number of light subpaths per sample
     /// (THEORY 5.9). Each sample traces one with that probability; every strategy that uses it
     /// (connections, light tracing) then has that probability times its density in every weight
     /// and divides by it, so the estimate stays unbiased for any value. 1 (the default): always.
-    /// Throws InvalidArgument on a value outside (0, 1].
+    /// 0: never, and those strategies are absent from every weight (s = 0 and NEE reach every
+    /// light). EstimatorOptions::nee_count may be 0 too (s = 1 toward the lights absent), where
+    /// the scene has no delta light (else Status::InvalidInput). Throws InvalidArgument on a value
+    /// outside [0, 1].
     explicit BdptEstimator(EstimatorOptions opts = default_options(), H heuristic = H{},
                            float light_subpath_probability = 1.f)
         : kernels_(checked(opts), heuristic), light_probability_(light_subpath_probability) {
-        if (!(light_probability_ > 0.f && light_probability_ <= 1.f))
-            detail::fail("BdptEstimator light_subpath_probability = ", light_probability_,
-                         " is not allowed: it must lie in (0, 1]");
+        validate_count("BdptEstimator light_subpath_probability", light_probability_, true);
     }
 
     float light_subpath_probability() const noexcept { return light_probability_; }
@@ -379,6 +380,8 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
     using Spectrum = typename Sc::Spectrum;
     using V = VertexT<Sc>;
     if (!usable_ray(camera_ray)) return {Spectrum::Zero(), Status::InvalidInput};
+    // NEE at count 0 leaves the lights no path can hit unreached (EstimatorOptions::nee_count).
+    if (kernels_.options().nee_count == 0.f && sc.lights.has_delta_lights()) return {Spectrum::Zero(), Status::InvalidInput};
     // The subpaths' vertices, each written whole before it is read: a Vertex is an implicit-
     // lifetime aggregate, so the storage is left as it is instead of 67 vertices being set to
     // their defaults per sample (a fifth of a sample's time where the subpaths are short).

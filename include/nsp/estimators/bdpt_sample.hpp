@@ -170,7 +170,8 @@ struct BdptEstimator<Mis, H, A, MaxDepth, Ch>::BdptSample {
                                         : s == 1 ? (volume_x0 ? BdptTechnique::Fixed : BdptTechnique::Nee)
                                                  : BdptTechnique::Light;
             detail::record_bdpt(counter, float(double(f.mean()) * own), float(p_fixed),
-                                float(p_nee / double(nee_count)), float(p_light / double(est.light_probability_)),
+                                nee_count > 0.f ? float(p_nee / double(nee_count)) : 0.f,
+                                est.light_probability_ > 0.f ? float(p_light / double(est.light_probability_)) : 0.f,
                                 nee_count, est.light_probability_, group,
                                 splatted);
         } else {

@@ -58,6 +58,9 @@ RadianceSample<typename Sc::Spectral> trace_path(const K& k, const Sc& sc, const
     using State = PathState<Ch, St, typename K::Heuristic, typename K::Absorption, S, kEq>;
     using P = typename State::P;
     const EstimatorOptions& opts = k.options();
+    // NEE at count 0 leaves the lights no path can hit unreached (EstimatorOptions::nee_count).
+    if (St::samples_lights && opts.nee_count == 0.f && sc.lights.has_delta_lights())
+        return {Spectrum::Zero(), Status::InvalidInput};
     State st(k, selection, rng);
     Spectrum L = Spectrum::Zero();
     Status status = Status::Ok;
