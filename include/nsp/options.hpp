@@ -95,9 +95,9 @@ struct EstimatorOptions {
     /// segment. Below 1 it saves the technique's flight and lookup where the collision estimator
     /// and NEE find the emission well; the power grid's walk along the segment stays (the other
     /// techniques' weights need W). 0: it never runs and is absent from every weight (the
-    /// collision estimator reaches all emission, so nothing is lost). nsp::PathEstimator and nsp::SpectralPathEstimator, media and
-    /// surfaces, and nsp::BdptEstimator (on the camera segments' pieces; NeeCountLearner does
-    /// not learn it there).
+    /// collision estimator reaches all emission, so nothing is lost). nsp::PathEstimator and
+    /// nsp::SpectralPathEstimator, media and surfaces, and nsp::BdptEstimator (on the camera
+    /// segments' pieces; NeeCountLearner does not learn it there).
     float emission_segment_count = 1.f;
     /// The expected count of NEE toward the lights at each real vertex, in [0, 1] (THEORY 5.9,
     /// counts.hpp): NEE runs there with this probability, its estimate divided by it, and the MIS
@@ -108,10 +108,10 @@ struct EstimatorOptions {
     /// only where every light can be hit: a strategy that reaches lights by NEE alone (ratio-nee,
     /// equiangular-nee) refuses it at construction, and a scene with a delta light (a point or
     /// directional light) gives Status::InvalidInput and 0 (LightSampler::has_delta_lights()). A
-    /// light the host's geometry never reports as hit is the host's to leave out. nsp::PathEstimator and
-    /// nsp::SpectralPathEstimator (every strategy that samples lights, NEE from equiangular
-    /// vertices excepted: they exist for it); nsp::BdptEstimator (s = 1 toward the lights at each
-    /// camera vertex; NEE toward an emitting volume keeps count 1).
+    /// light the host's geometry never reports as hit is the host's to leave out.
+    /// nsp::PathEstimator and nsp::SpectralPathEstimator (every strategy that samples lights, NEE
+    /// from equiangular vertices excepted: they exist for it); nsp::BdptEstimator (s = 1 toward
+    /// the lights at each camera vertex; NEE toward an emitting volume keeps count 1).
     float nee_count = 1.f;
     /// nsp::BdptEstimator<bdpt::NullScattering> (grey and per channel): on every camera segment
     /// also draw one vertex by equiangular sampling toward the point lights on the part of the ray

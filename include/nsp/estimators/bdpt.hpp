@@ -381,7 +381,8 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
     using V = VertexT<Sc>;
     if (!usable_ray(camera_ray)) return {Spectrum::Zero(), Status::InvalidInput};
     // NEE at count 0 leaves the lights no path can hit unreached (EstimatorOptions::nee_count).
-    if (kernels_.options().nee_count == 0.f && sc.lights.has_delta_lights()) return {Spectrum::Zero(), Status::InvalidInput};
+    if (kernels_.options().nee_count == 0.f && sc.lights.has_delta_lights())
+        return {Spectrum::Zero(), Status::InvalidInput};
     // The subpaths' vertices, each written whole before it is read: a Vertex is an implicit-
     // lifetime aggregate, so the storage is left as it is instead of 67 vertices being set to
     // their defaults per sample (a fifth of a sample's time where the subpaths are short).
