@@ -58,9 +58,6 @@ RadianceSample<typename Sc::Spectral> trace_path(const K& k, const Sc& sc, const
     using State = PathState<Ch, St, typename K::Heuristic, typename K::Absorption, S, kEq>;
     using P = typename State::P;
     const EstimatorOptions& opts = k.options();
-    // NEE at count 0 leaves the lights no path can hit unreached (EstimatorOptions::nee_count).
-    if (St::samples_lights && opts.nee_count == 0.f && sc.lights.has_delta_lights())
-        return {Spectrum::Zero(), Status::InvalidInput};
     State st(k, selection, rng);
     Spectrum L = Spectrum::Zero();
     Status status = Status::Ok;
@@ -245,6 +242,13 @@ RadianceSample<typename Sc::Spectral> trace_path(const K& k, const Sc& sc, const
     return {L, status};
 }
 
+/// Whether kernels k refuse scene sc: NEE at count 0 leaves the lights no path can hit unreached
+/// (EstimatorOptions::nee_count). Checked before trace_path, outside its loop.
+template <class K, class Sc>
+bool refuses_nee_count(const K& k, const Sc& sc) noexcept {
+    return K::Strategy::samples_lights && k.options().nee_count == 0.f && sc.lights.has_delta_lights();
+}
+
 }  // namespace detail
 
 /// A path estimator with one pdf for every channel: strategy St, MIS heuristic H (mis::None
@@ -282,7 +286,8 @@ public:
         static_assert(!is_per_channel_majorant_v<typename Sc::MajorantType, typename Sc::MediumType>,
                       "nsp::PathEstimator drives every channel with one pdf and needs a grey majorant "
                       "(GlobalMajorant or GridMajorant); per-channel majorants go with nsp::SpectralPathEstimator");
-        if (!usable_ray(camera_ray)) return {Sc::Spectrum::Zero(), Status::InvalidInput};
+        if (!usable_ray(camera_ray) || detail::refuses_nee_count(kernels_, scene))
+            return {Sc::Spectrum::Zero(), Status::InvalidInput};
         return detail::trace_path<channels::Grey>(kernels_, scene, camera_ray, lambda, nullptr, rng, counter);
     }
 
@@ -341,7 +346,8 @@ public:
         static_assert(CP::own_pdfs || !is_per_channel_majorant_v<typename Sc::MajorantType, typename Sc::MediumType>,
                       "nsp::SpectralPathEstimator: spectral tracking shares one pdf over channels and needs a "
                       "grey majorant bounding every channel (GlobalMajorant)");
-        if (!usable_ray(camera_ray)) return {Sc::Spectrum::Zero(), Status::InvalidInput};
+        if (!usable_ray(camera_ray) || detail::refuses_nee_count(kernels_, scene))
+            return {Sc::Spectrum::Zero(), Status::InvalidInput};
         return detail::trace_path<CP>(kernels_, scene, camera_ray, lambda, &selection, rng, counter);
     }
 
