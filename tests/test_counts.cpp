@@ -139,21 +139,38 @@ TEST_CASE("NEE counts: single scattering from a point light at count 0.3 = quadr
     });
 }
 
+namespace {
+
+/// A grid cloud in [-1, 1]^3 (density 0.6 x coefficients sigma_a, sigma_s per channel; seed 7)
+/// under a sphere light and a sky of radiance `sky`: every light can be hit.
+template <SpectralMode S>
+auto lit_cloud(const typename S::Coefficient& sigma_a, const typename S::Coefficient& sigma_s,
+               const typename S::Coefficient& sky) {
+    using M = DenseGridMedium<S>;
+    const M medium = make_medium<M>(Box{Vec3(-1.f), Vec3(1.f)}, 0.6f, sigma_a, sigma_s, 7);
+    Lights<S> lights;
+    lights.set(SphereLight<S>{Vec3(1.6f, 0.4f, 0.2f), 0.5f, grey<S>(10.f)});
+    lights.set(EnvironmentLight<S>{sky});
+    return Scene(medium, GlobalMajorant<M>(medium), HenyeyGreensteinPhase(0.3f), lights);
+}
+/// lit_cloud's camera ray, and its options: roulette from the first vertex, survival at most 0.6.
+const Ray kCloudRay{Vec3(-3.f, 0.2f, 0.1f), glm::normalize(Vec3(1.f, 0.03f, 0.01f))};
+EstimatorOptions roulette_options() {
+    EstimatorOptions opts;
+    opts.rr_start_depth = 1;
+    opts.rr_max_survival = 0.6f;
+    return opts;
+}
+
+}  // namespace
+
 TEST_CASE("NEE counts: multiple scattering with roulette, a sphere light and a sky agrees with count 1") {
     // Albedo 0.8, thickness ~1.2, roulette from the first vertex (survival at most 0.6): both
     // techniques reach the sphere light and the sky, so the hit weight's count matters. Reference:
     // uni + NEE MIS at count 1, a separate run.
-    using M = DenseGridMedium<Mono>;
-    const Box box{Vec3(-1.f), Vec3(1.f)};
-    const M medium = make_medium<M>(box, 0.6f, grey<Mono>(0.2f), grey<Mono>(0.8f), 7);
-    Lights<Mono> lights;
-    lights.set(SphereLight<Mono>{Vec3(1.6f, 0.4f, 0.2f), 0.5f, grey<Mono>(10.f)});
-    lights.set(EnvironmentLight<Mono>{grey<Mono>(0.2f)});
-    const Ray ray{Vec3(-3.f, 0.2f, 0.1f), glm::normalize(Vec3(1.f, 0.03f, 0.01f))};
-    EstimatorOptions opts;
-    opts.rr_start_depth = 1;
-    opts.rr_max_survival = 0.6f;
-    const Scene scene(medium, GlobalMajorant<M>(medium), HenyeyGreensteinPhase(0.3f), lights);
+    const auto scene = lit_cloud<Mono>(grey<Mono>(0.2f), grey<Mono>(0.8f), grey<Mono>(0.2f));
+    const Ray& ray = kCloudRay;
+    const EstimatorOptions opts = roulette_options();
     const auto ref = estimate_radiance(PathEstimator<strategy::NullScatteringMis, mis::Balance>(opts), scene, ray,
                                        80000, 400);
     const Stat& r = ref.stat.ch[0];
@@ -384,15 +401,9 @@ TEST_CASE("NEE count 0: uni + NEE MIS is tracking + hits, the furnaces give 1, d
     // 70% here: 3.11 against 1.83 grey).
     using M = DenseGridMedium<Mono>;
     const Box box{Vec3(-1.f), Vec3(1.f)};
-    const M medium = make_medium<M>(box, 0.6f, grey<Mono>(0.2f), grey<Mono>(0.8f), 7);
-    Lights<Mono> lights;
-    lights.set(SphereLight<Mono>{Vec3(1.6f, 0.4f, 0.2f), 0.5f, grey<Mono>(10.f)});
-    lights.set(EnvironmentLight<Mono>{grey<Mono>(0.2f)});
-    EstimatorOptions opts;
-    opts.rr_start_depth = 1;
-    opts.rr_max_survival = 0.6f;
-    const Scene scene(medium, GlobalMajorant<M>(medium), HenyeyGreensteinPhase(0.3f), lights);
-    const Ray ray{Vec3(-3.f, 0.2f, 0.1f), glm::normalize(Vec3(1.f, 0.03f, 0.01f))};
+    const auto scene = lit_cloud<Mono>(grey<Mono>(0.2f), grey<Mono>(0.8f), grey<Mono>(0.2f));
+    const Ray& ray = kCloudRay;
+    const EstimatorOptions opts = roulette_options();
     auto like_unidirectional = [&](const auto& uni, const auto& zero, const auto& one, const auto& sc, const char* name) {
         CAPTURE(std::string(name));
         const auto u = estimate_radiance(uni, sc, ray, 40000, 901);
@@ -423,12 +434,8 @@ TEST_CASE("NEE count 0: uni + NEE MIS is tracking + hits, the furnaces give 1, d
                         PathEstimator<strategy::DirectionalMis, mis::Balance>(with_count(0.f, opts)),
                         PathEstimator<strategy::DirectionalMis, mis::Balance>(opts), scene, "directional-mis balance");
     {
-        using R = DenseGridMedium<Rgb>;
-        const R chroma = make_medium<R>(box, 0.6f, spec<Rgb>(0.2f, 0.1f, 0.4f), spec<Rgb>(0.8f, 0.4f, 1.2f), 7);
-        Lights<Rgb> rgb_lights;
-        rgb_lights.set(SphereLight<Rgb>{Vec3(1.6f, 0.4f, 0.2f), 0.5f, grey<Rgb>(10.f)});
-        rgb_lights.set(EnvironmentLight<Rgb>{spec<Rgb>(0.2f, 0.3f, 0.1f)});
-        const Scene rgb(chroma, GlobalMajorant<R>(chroma), HenyeyGreensteinPhase(0.3f), rgb_lights);
+        const auto rgb = lit_cloud<Rgb>(spec<Rgb>(0.2f, 0.1f, 0.4f), spec<Rgb>(0.8f, 0.4f, 1.2f),
+                                         spec<Rgb>(0.2f, 0.3f, 0.1f));
         using Spectral = SpectralPathEstimator<channels::SpectralMis, strategy::NullScatteringMis, mis::Balance>;
         like_unidirectional(SpectralPathEstimator<channels::SpectralMis, strategy::Unidirectional>(opts),
                             Spectral(with_count(0.f, opts)), Spectral(opts), rgb, "spectral uni-nee-mis");
@@ -464,6 +471,7 @@ TEST_CASE("NEE count 0: uni + NEE MIS is tracking + hits, the furnaces give 1, d
         Lights<Mono> point;
         point.set(PointLight<Mono>{Vec3(0.2f, 0.25f, -0.1f), grey<Mono>(2.f)});
         point.set(EnvironmentLight<Mono>{grey<Mono>(0.2f)});
+        const M medium = make_medium<M>(box, 0.6f, grey<Mono>(0.2f), grey<Mono>(0.8f), 7);  // lit_cloud's
         const Scene lamp(medium, GlobalMajorant<M>(medium), HenyeyGreensteinPhase(0.3f), point);
         const Ray ray{Vec3(-3.f, 0.2f, 0.1f), Vec3(1.f, 0.f, 0.f)};
         Pcg32 rng(4, 4);
@@ -484,17 +492,8 @@ TEST_CASE("NEE count 0: surfaces: the lit cube over a floor under a lamp and a s
     // geometry reports) can be hit, so every combining strategy is tracking + hits; against uni +
     // NEE MIS at count 1, 5 combined SE.
     using namespace nsp_test::grey_scenes;
-    Shapes shapes;
-    shapes.boxes.push_back({Vec3(-1.f), Vec3(1.f), {-1, -1, 0, -1}});
-    shapes.quads.push_back({Vec3(-3.f, -1.05f, 3.f), Vec3(6.f, 0.f, 0.f), Vec3(0.f, 0.f, -6.f), {0, -1, -1, -1}});
-    const QuadLight<S> lamp{Vec3(-0.6f, 2.6f, -0.6f), Vec3(1.2f, 0.f, 0.f), Vec3(0.f, 0.f, 1.2f), Spectrum::Constant(12.f)};
-    shapes.quads.push_back({lamp.corner, lamp.edge_u, lamp.edge_v, {-1, 0, -1, -1}});
-    const Sc sc(shapes, {medium(Box{Vec3(-1.f), Vec3(1.f)}, 0.3f, 1.2f, 0.6f)}, materials(0.6f),
-                Ls(LightSelection::Power, 4.f, {lamp}, {EnvironmentLight<S>{Spectrum::Constant(0.05f)}}), -1);
-    auto camera = [](Pcg32& rng) {
-        const float u = rng.uniform(), v = rng.uniform();
-        return Ray{Vec3(0.f, 0.3f, -4.5f), glm::normalize(Vec3(0.7f * (1.f - 2.f * u), 0.7f * (1.f - 2.f * v), 1.f))};
-    };
+    const Sc sc = cube_over_floor(true);
+    const auto camera = cube_camera;
     const Stat ref = estimate(PathEstimator<strategy::NullScatteringMis, mis::Balance>{}, sc, 40000, 621, camera);
     CHECK(ref.mean > 0.05);
     int seed = 630;
