@@ -17,8 +17,15 @@ std::vector<SceneEntry> make_catalogue() {
     // noise and the main job within its time.
     c.push_back({K::Cloud, "cloud",
                  "the grey cloud (extinction 20, albedo 0.9, HG g 0.9); A: a small bright light above "
-                 "(NEE should win), B: a large dim light behind (unidirectional should win)",
-                 {{"A", {K::Cloud, LightSetup::A}}, {"B", {K::Cloud, LightSetup::B}}},
+                 "(NEE should win), B: a large dim light behind (unidirectional should win), D: a bright "
+                 "sky and A's light at 1/400 (unidirectional should win)",
+                 {{"A", {K::Cloud, LightSetup::A}},
+                  {"B", {K::Cloud, LightSetup::B}},
+                  // D: where tracking alone is best (the case for NEE count 0), under both majorants
+                  {"D", {K::Cloud, LightSetup::D}, 0, true,
+                   {"unidirectional_grey_absorb-weight", "ratio-nee_grey_absorb-weight",
+                    "uni-nee-mis_grey_balance_absorb-weight", "uni-nee-mis_grey_balance_absorb-weight_learned"},
+                   {"global", "grid"}}},
                  mono, 64, 64, 256,
                  // every PathEstimator but the equiangular ones (their lamp is the fog's business)
                  {"unidirectional_grey", "ratio-nee_grey", "directional-mis_grey", "uni-nee-mis_grey",
@@ -33,9 +40,14 @@ std::vector<SceneEntry> make_catalogue() {
     // (or all) renders the Hero<4> tables as well.
     c.push_back({K::Chromatic, "chromatic",
                  "the cloud with extinction 5 : 20 : 80 in R : G : B (hero: a spectrum through them), albedo "
-                 "0.95; C1: a white environment, C2: set-up A's small light",
+                 "0.95; C1: a white environment, C2: set-up A's small light, C3: set-up D's sky and dim light",
                  {{"C1", {K::Chromatic, LightSetup::A, ChromaticSetup::Env}},
-                  {"C2", {K::Chromatic, LightSetup::A, ChromaticSetup::Small}}},
+                  {"C2", {K::Chromatic, LightSetup::A, ChromaticSetup::Small}},
+                  {"C3", {K::Chromatic, LightSetup::A, ChromaticSetup::SkyLamp}, 0, true,
+                   {"unidirectional_spectral-mis_absorb-weight_uniform", "ratio-nee_spectral-mis_absorb-weight_uniform",
+                    "uni-nee-mis_spectral-mis_balance_absorb-weight_uniform",
+                    "uni-nee-mis_spectral-mis_absorb-weight_uniform_learned"},
+                   {"global", "grid"}}},
                  {nsp::Rgb::name}, 32, 32, 128,
                  {"uni-nee-mis_grey_balance_absorb-weight",  // the grey-majorant baseline
                   "unidirectional_independent_absorb-weight_uniform", "uni-nee-mis_independent_absorb-weight",

@@ -7,6 +7,7 @@
 
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "scene_choice.hpp"
@@ -15,10 +16,17 @@ namespace nsp_examples {
 
 /// One light set-up of a scene, as --setup names it.
 struct SetupEntry {
+    SetupEntry(std::string name_, SceneChoice choice_, int spp_ = 0, bool in_default_run_ = true,
+               std::vector<std::string> estimators_ = {}, std::vector<std::string> majorants_ = {})
+        : name(std::move(name_)), choice(choice_), spp(spp_), in_default_run(in_default_run_),
+          estimators(std::move(estimators_)), majorants(std::move(majorants_)) {}
+
     std::string name;  ///< "A", "C1", "F3", ...
     SceneChoice choice;
     int spp = 0;                  ///< 0: the scene's
     bool in_default_run = true;   ///< rendered when --setup is not given
+    std::vector<std::string> estimators;  ///< empty: the scene's
+    std::vector<std::string> majorants;   ///< empty: the scene's
 };
 
 /// One example scene and its defaults.

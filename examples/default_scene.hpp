@@ -6,7 +6,9 @@
 //   A: a small, bright sphere light above the cloud, out of view: NEE finds it, unidirectional
 //      rarely hits it;
 //   B: a large, dim sphere light behind the cloud: phase sampling finds it, light sampling wastes
-//      samples where the forward-peaked phase function is small.
+//      samples where the forward-peaked phase function is small;
+//   D: a bright uniform sky with A's light dimmed to 1/400: tracking alone finds nearly all
+//      of the light, and NEE's shadow rays are mostly cost (the case for NEE count 0).
 // The camera sees the cloud from the front; B's light shows as a bright disc around it.
 // Further down: the chromatic cloud (C1, C2), the sparse medium (SA, SB), a fog bank lit by a
 // lamp (F1-F3, equiangular sampling) and a flame inside the cloud (P1, an emissive medium).
@@ -24,10 +26,13 @@
 
 namespace nsp_examples {
 
-/// The two light set-ups of the default scene.
-enum class LightSetup { A, B };
+/// The light set-ups of the default scene.
+enum class LightSetup { A, B, D };
 
-inline const char* name(LightSetup s) { return s == LightSetup::A ? "A" : "B"; }
+inline const char* name(LightSetup s) { return s == LightSetup::A ? "A" : s == LightSetup::B ? "B" : "D"; }
+
+/// Set-up D's sky radiance and its small light's radiance (A's light at 1/400: about 3 % of the light).
+inline constexpr float kSkyRadiance = 1.f, kDimLampRadiance = 20.f;
 
 /// Camera placement shared by the renderer and the tests: at `eye`, looking at the origin.
 inline constexpr float kEye[3] = {0.f, 0.f, -4.f};
@@ -98,12 +103,15 @@ inline constexpr float kSigmaS = 18.f, kSigmaA = 2.f;
 /// and what makes NEE's own variance in set-up A (a vertex whose path points at the light).
 inline constexpr float kPhaseG = 0.9f;
 
-/// The lights of set-up A or B.
+/// The lights of set-up A, B or D.
 template <nsp::SpectralMode S>
 nsp::Lights<S> default_lights(LightSetup setup) {
     nsp::Lights<S> lights;
     if (setup == LightSetup::A)  // above and in front of the cloud, out of view; subtends ~0.005 sr
         lights.set(nsp::SphereLight<S>{nsp::Vec3(0.8f, 2.2f, -0.6f), 0.1f, nsp::constant_coefficient<S>(8000.f)});
+    else if (setup == LightSetup::D)
+        lights.set(nsp::SphereLight<S>{nsp::Vec3(0.8f, 2.2f, -0.6f), 0.1f, nsp::constant_coefficient<S>(kDimLampRadiance)})
+            .set(nsp::EnvironmentLight<S>{nsp::constant_coefficient<S>(kSkyRadiance)});
     else  // behind the cloud, seen as a disc around it; a cone of half-angle ~44 deg at the cloud
         lights.set(nsp::SphereLight<S>{nsp::Vec3(0.f, 0.f, 4.f), 2.8f, nsp::constant_coefficient<S>(1.f)});
     return lights;
@@ -135,9 +143,12 @@ inline constexpr float kChromaticAlbedo = 0.95f;
 enum class ChromaticSetup {
     Env,    ///< 1: a constant white environment; phase sampling finds it (unidirectional paths dominate)
     Small,  ///< 2: set-up A's small bright sphere light above the cloud; NEE matters
+    SkyLamp,  ///< 3: set-up D's lights: a bright white sky and A's light dimmed; tracking alone is best
 };
 
-inline const char* name(ChromaticSetup s) { return s == ChromaticSetup::Env ? "C1" : "C2"; }
+inline const char* name(ChromaticSetup s) {
+    return s == ChromaticSetup::Env ? "C1" : s == ChromaticSetup::Small ? "C2" : "C3";
+}
 
 /// The chromatic extinction as a coefficient of mode S. In Hero mode a piecewise-linear spectrum
 /// through the RGB values at 610 (R), 550 (G) and 465 nm (B), flat beyond.
@@ -163,6 +174,8 @@ nsp::Lights<S> chromatic_lights(ChromaticSetup setup) {
     nsp::Lights<S> lights;
     if (setup == ChromaticSetup::Env)
         lights.set(nsp::EnvironmentLight<S>{nsp::constant_coefficient<S>(1.f)});
+    else if (setup == ChromaticSetup::SkyLamp)
+        return default_lights<S>(LightSetup::D);
     else
         lights.set(nsp::SphereLight<S>{nsp::Vec3(0.8f, 2.2f, -0.6f), 0.1f, nsp::constant_coefficient<S>(8000.f)});
     return lights;

@@ -128,9 +128,13 @@ std::vector<TablePlan> plan(const Options& o) {
             for (const SetupEntry& setup : d.setups)
                 if (s == setup.name) choices.push_back(setup);
         const std::vector<std::string_view> modes = o.modes.empty() ? d.modes : o.modes;
-        const std::vector<std::string>& tokens = !o.estimators.empty() ? o.estimators : d.estimators;
-        const std::vector<std::string>& majorants = !o.majorants.empty() ? o.majorants : d.majorants;
         for (const SetupEntry& setup : choices) {
+            const std::vector<std::string>& tokens = !o.estimators.empty()       ? o.estimators
+                                                     : !setup.estimators.empty() ? setup.estimators
+                                                                                 : d.estimators;
+            const std::vector<std::string>& majorants = !o.majorants.empty()       ? o.majorants
+                                                        : !setup.majorants.empty() ? setup.majorants
+                                                                                   : d.majorants;
             for (const auto mode : modes) {
                 TablePlan t{setup.choice, mode, o.width.value_or(d.width), o.height.value_or(d.height),
                             o.spp.value_or(setup.spp > 0 ? setup.spp : d.spp), {}, std::nullopt};

@@ -130,7 +130,9 @@ void print_learned_counts(const std::vector<Row>& rows) {
             for (int j = 0; j < nsp::NeeCountLearner::kCandidates; ++j) {
                 const float c = nsp::NeeCountLearner::candidate(j);
                 const auto n = std::count(counts.begin(), counts.end(), c);
-                if (n > 0) std::printf(" 1/%d: %lld", 1 << j, (long long)n);
+                if (n == 0) continue;
+                if (c == 0.f) std::printf(" 0: %lld", (long long)n);
+                else std::printf(" 1/%d: %lld", 1 << j, (long long)n);
             }
         };
         histogram(r.runs[0].nee_counts);

@@ -122,7 +122,7 @@ public:
             }
             std::ostringstream note;  // not "(" + std::to_string(..): GCC 12 warns (-Wrestrict, bug 105329)
             note << "learned counts (" << name << ", a " << pilot
-                 << "-spp pilot at counts 1 per 16x16 tile), tiles at 1, 1/2, .., 1/64: NEE";
+                 << "-spp pilot at counts 1 per 16x16 tile), tiles at 1, 1/2, .., 1/64, 0: NEE";
             for (const int n : nee) note << ' ' << n;
             note << "; emission segment";
             for (const int n : segment) note << ' ' << n;

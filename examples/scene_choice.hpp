@@ -11,14 +11,14 @@ namespace nsp_examples {
 
 /// Which of the scenes of default_scene.hpp a render uses.
 enum class SceneKind {
-    Cloud,      ///< the grey cloud (set-ups A, B)
-    Chromatic,  ///< the chromatic cloud, extinction 1 : 4 : 16 (set-ups C1, C2)
+    Cloud,      ///< the grey cloud (set-ups A, B, D)
+    Chromatic,  ///< the chromatic cloud, extinction 1 : 4 : 16 (set-ups C1, C2, C3)
     Sparse,     ///< the sparse grey medium, a plume and five puffs (set-ups SA, SB: A's and B's lights)
     Fog,        ///< a fog bank lit by a lamp (set-ups F1, F2, F3)
     Plume,      ///< a flame inside the cloud, an emissive medium (set-up P1)
 };
 
-/// One light set-up of one scene: A or B of the grey cloud, C1 or C2 of the chromatic cloud, SA or
+/// One light set-up of one scene: A, B or D of the grey cloud, C1, C2 or C3 of the chromatic cloud, SA or
 /// SB of the sparse medium (set-up A's or B's lights), F1, F2 or F3 of the fog, P1 of the plume.
 struct SceneChoice {
     SceneKind kind = SceneKind::Cloud;
@@ -26,7 +26,7 @@ struct SceneChoice {
     ChromaticSetup chromatic = ChromaticSetup::Env;  ///< with SceneKind::Chromatic
     FogSetup fog = FogSetup::F1;                     ///< with SceneKind::Fog
 
-    /// "A", "B", "C1", "C2", "SA", "SB", "F1", "F2", "F3" or "P1".
+    /// "A", "B", "D", "C1", "C2", "C3", "SA", "SB", "F1", "F2", "F3" or "P1".
     const char* name() const {
         switch (kind) {
             case SceneKind::Chromatic: return nsp_examples::name(chromatic);

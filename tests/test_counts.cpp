@@ -372,8 +372,9 @@ void check_prediction(const Prediction& p, const std::string& name, WorkToleranc
     }
     MESSAGE(name << ": predicted / measured variance at 1, 1/2, 1/8, 1/64: " << p.predicted[0] << " / " << p.measured[0]
                  << ", " << p.predicted[1] << " / " << p.measured[1] << ", " << p.predicted[3] << " / " << p.measured[3]
-                 << ", " << p.predicted[6] << " / " << p.measured[6] << "; work per sample " << p.measured_cost[0]
-                 << " .. " << p.measured_cost[6] << "; chosen " << p.chosen);
+                 << ", " << p.predicted[6] << " / " << p.measured[6] << ", 0: " << p.predicted[7] << " / "
+                 << p.measured[7] << "; work per sample " << p.measured_cost[0] << " .. " << p.measured_cost[7]
+                 << "; chosen " << p.chosen);
 }
 
 /// The choice is the measured best: variance x cost at the chosen count within 10 % of the best
@@ -449,11 +450,11 @@ TEST_CASE("NEE count 0: uni + NEE MIS is tracking + hits, the furnaces give 1, d
         const M white = make_medium<M>(box, 1.f, grey<Mono>(0.f), grey<Mono>(1.f), 42);
         const auto maj = GlobalMajorant<M>(white);
         const Scene furnace(white, GlobalMajorant<M>(white, 2.f * maj.value()), HenyeyGreensteinPhase(0.5f), sky);
-        const Ray ray{Vec3(-3.f, 0.2f, 0.1f), glm::normalize(Vec3(1.f, -0.05f, 0.02f))};
+        const Ray furnace_ray{Vec3(-3.f, 0.2f, 0.1f), glm::normalize(Vec3(1.f, -0.05f, 0.02f))};
         int seed = 700;
         auto check = [&](const auto& est, const char* name) {
             CAPTURE(std::string(name));
-            const auto res = estimate_radiance(est, furnace, ray, 20000, std::uint64_t(++seed));
+            const auto res = estimate_radiance(est, furnace, furnace_ray, 20000, std::uint64_t(++seed));
             const Stat& s = res.stat.ch[0];
             CAPTURE(s.mean);
             CAPTURE(s.se());
@@ -473,17 +474,26 @@ TEST_CASE("NEE count 0: uni + NEE MIS is tracking + hits, the furnaces give 1, d
         point.set(EnvironmentLight<Mono>{grey<Mono>(0.2f)});
         const M medium = make_medium<M>(box, 0.6f, grey<Mono>(0.2f), grey<Mono>(0.8f), 7);  // lit_cloud's
         const Scene lamp(medium, GlobalMajorant<M>(medium), HenyeyGreensteinPhase(0.3f), point);
-        const Ray ray{Vec3(-3.f, 0.2f, 0.1f), Vec3(1.f, 0.f, 0.f)};
+        const Ray lamp_ray{Vec3(-3.f, 0.2f, 0.1f), Vec3(1.f, 0.f, 0.f)};
         Pcg32 rng(4, 4);
         LookupCount counter;
-        const auto a = PathEstimator<strategy::NullScatteringMis, mis::Balance>(with_count(0.f)).radiance(lamp, ray, {}, rng, counter);
+        const auto a = PathEstimator<strategy::NullScatteringMis, mis::Balance>(with_count(0.f)).radiance(lamp, lamp_ray, {}, rng, counter);
         CHECK(a.status == Status::InvalidInput);
         CHECK(a.value[0] == 0.f);
-        const auto b = PathEstimator<strategy::EquiangularMis, mis::Balance>(with_count(0.f)).radiance(lamp, ray, {}, rng, counter);
+        const auto b = PathEstimator<strategy::EquiangularMis, mis::Balance>(with_count(0.f)).radiance(lamp, lamp_ray, {}, rng, counter);
         CHECK(b.status == Status::InvalidInput);
         // Count 1e-3 still reaches it.
-        const auto c = PathEstimator<strategy::NullScatteringMis, mis::Balance>(with_count(1e-3f)).radiance(lamp, ray, {}, rng, counter);
+        const auto c = PathEstimator<strategy::NullScatteringMis, mis::Balance>(with_count(1e-3f)).radiance(lamp, lamp_ray, {}, rng, counter);
         CHECK(c.status == Status::Ok);
+        // A learner pilots that scene at count 1: the estimator tells it that NEE count 0 is
+        // refused here, so it never offers it, even for a sample whose point light was blocked.
+        NeeCountLearner learner;
+        CHECK(learner.allowed(NeeCountLearner::kZero));
+        Pcg32 rng2(5, 5);
+        const auto d = PathEstimator<strategy::NullScatteringMis, mis::Balance>().radiance(lamp, lamp_ray, {}, rng2, learner);
+        CHECK(d.status == Status::Ok);
+        CHECK_FALSE(learner.allowed(NeeCountLearner::kZero));
+        CHECK(learner.allowed(NeeCountLearner::kZero - 1));
     }
 }
 
@@ -725,7 +735,7 @@ TEST_CASE("NeeCountLearner: bookkeeping") {
             const float u = i % 2 ? 3.f : 1.f;
             for (int k = 0; k < 10; ++k) l.lookup();
             l.record_light(u, 0.f, 1.f, 0.f, 1.f, LightTechnique::Nee);
-            l.record_shadow_walk(5.0, true);   // + kShadowRayCost 1: scales with the count
+            l.record_shadow_walk(5.0, true);   // + per_shadow_walk 1: scales with the count
             l.record_shadow_walk(2.0, false);  // an equiangular vertex's: its 1 fixed stays at any count
             l.end_sample(double(u));
         }
@@ -738,6 +748,91 @@ TEST_CASE("NeeCountLearner: bookkeeping") {
         CHECK(l.predicted_cost(0) == doctest::Approx(12.0 + 1.0).epsilon(1e-9));
         CHECK(l.predicted_cost(1) == doctest::Approx(6.0 + 3.0 + 1.0).epsilon(1e-9));
     }
+    SUBCASE("count 0: chosen where tracking finds every light NEE does and NEE only costs; never where it cannot") {
+        // Each sample: a hit and an NEE sample of the same light at equal densities, u alternating
+        // 1 and 3 (each contribution u / 2 at count 1); at count c the estimate is u / (1 + c) from
+        // the hit plus B u / (1 + c) / c from NEE: expectation u, Bernoulli variance
+        // c (1 - c) E[u^2] / (1 + c)^2 with E[u^2] = 5, which is 0 at c = 0 and at c = 1. The
+        // diagonal corrections sum to 0, so the variance at 0 and 1 is the pixels' 10 / 9. Work
+        // per sample: 10 lookups, NEE's walk 5 + 1: 12 + 1 at count 1, 5 + 1 at 0.
+        auto pilot = [](NeeCountLearner& l, bool one_nee_only_contribution) {
+            for (int i = 0; i < 200; ++i) {
+                const float u = i % 2 ? 3.f : 1.f;
+                for (int k = 0; k < 10; ++k) l.lookup();
+                l.record_light(u, 1.f, 1.f, 0.f, 1.f, LightTechnique::Hit);
+                l.record_light(u, 1.f, 1.f, 0.f, 1.f, LightTechnique::Nee);
+                // A contribution that tracking cannot make (p_hit 0, as of a point light): count 0
+                // would lose it.
+                if (one_nee_only_contribution && i == 17) l.record_light(1e-3f, 0.f, 1.f, 0.f, 1.f, LightTechnique::Nee);
+                l.record_shadow_walk(5.0, true);
+                l.end_sample(double(u));
+                if (i % 10 == 9) l.end_pixel();
+            }
+        };
+        constexpr int kZero = NeeCountLearner::kZero;
+        NeeCountLearner l;
+        pilot(l, false);
+        CHECK(l.predicted_variance(kZero) == doctest::Approx(10.0 / 9.0).epsilon(1e-9));
+        CHECK(l.predicted_variance(0) == doctest::Approx(10.0 / 9.0).epsilon(1e-9));
+        CHECK(l.predicted_variance(2) == doctest::Approx(10.0 / 9.0 + 0.75 * 5.0 / 4.0 / (1.25 * 1.25)).epsilon(1e-9));
+        CHECK(l.predicted_cost(kZero) == doctest::Approx(6.0).epsilon(1e-9));
+        CHECK(l.predicted_cost(0) == doctest::Approx(12.0).epsilon(1e-9));
+        CHECK(NeeCountLearner::candidate(kZero) == 0.f);
+        CHECK(NeeCountLearner::candidate_index(0.f) == kZero);
+        CHECK(l.allowed(kZero));
+        CHECK(l.choose() == 0.f);
+        CHECK_FALSE(l.summary().open);
+        TechniqueCounts zero;
+        zero.nee = 0.f;
+        // A scene with a delta light: 1/64, the best of the others (variance x cost 1.187 x 6.09
+        // against 1.111 x 12 at count 1).
+        NeeCountLearner refused;
+        refused.nee_count_may_be_0(false);
+        pilot(refused, false);
+        CHECK_FALSE(refused.allowed(kZero));
+        CHECK(refused.choose() == NeeCountLearner::candidate(6));
+        CHECK(std::isinf(refused.summary().efficiency[std::size_t(kZero) * NeeCountLearner::kCandidates]));
+        NeeCountLearner merged = l;
+        merged.merge(refused);
+        CHECK_FALSE(merged.allowed(kZero));
+        // One contribution only NEE can make: never 0, whatever it saves.
+        NeeCountLearner lost;
+        pilot(lost, true);
+        CHECK_FALSE(lost.allowed(kZero));
+        CHECK(lost.allowed(kZero - 1));
+        CHECK(lost.choose() == NeeCountLearner::candidate(6));
+        CHECK(NeeCountLearner::choose_counts(lost.summary(), zero).nee == NeeCountLearner::candidate(6));
+    }
+    SUBCASE("the host's own costs: a CostModel in its unit, checked by name") {
+        // 10 lookups at 0.5 and 10 DDA steps at 0.1 (work 6), of which an NEE walk's 3, its run at
+        // 4, 2 per sample: 6 - 3 of fixed work + NEE's 3 + 4 scaled by the count, + 2.
+        CostModel costs;
+        costs.per_sample = 2.0;
+        costs.per_lookup = 0.5;
+        costs.per_dda_step = 0.1;
+        costs.per_shadow_walk = 4.0;
+        NeeCountLearner l(costs);
+        for (int i = 0; i < 4; ++i) {
+            for (int k = 0; k < 10; ++k) l.lookup();
+            l.majorant_steps(10);
+            CHECK(l.work() == doctest::Approx(6.0 * (i + 1)));
+            l.record_shadow_walk(3.0, true);
+            l.end_sample(1.0);
+        }
+        CHECK(l.predicted_cost(0) == doctest::Approx(3.0 + 7.0 + 2.0).epsilon(1e-12));
+        CHECK(l.predicted_cost(1) == doctest::Approx(3.0 + 3.5 + 2.0).epsilon(1e-12));
+        CHECK(l.predicted_cost(NeeCountLearner::kZero) == doctest::Approx(3.0 + 2.0).epsilon(1e-12));
+        for (const double bad : {-1.0, double(NAN), double(INFINITY)}) {
+            CAPTURE(bad);
+            CostModel c;
+            c.per_light_walk = bad;
+            CHECK_THROWS_WITH_AS(NeeCountLearner{c}, doctest::Contains("CostModel::per_light_walk"), InvalidArgument);
+        }
+        CostModel free_samples;
+        free_samples.per_sample = 0.0;
+        CHECK_THROWS_WITH_AS(NeeCountLearner{free_samples}, doctest::Contains("per_sample is 0.000000; it must be finite and > 0"),
+                             InvalidArgument);
+    }
     SUBCASE("NEE and the emission segment technique are learned jointly") {
         // Each sample: a NEE contribution u_l (alternating 1 and 3, NEE the only technique) and a
         // segment contribution 2 (the segment technique the only one); the estimate u_l + 2.
@@ -748,7 +843,7 @@ TEST_CASE("NeeCountLearner: bookkeeping") {
             l.record_light(u, 0.f, 1.f, 0.f, 1.f, LightTechnique::Nee);
             l.record_shadow_walk(5.0, true);
             l.record_emission(2.f, 0.f, 1.f, 0.f, 1.f, EmissionTechnique::Segment);
-            l.record_segment_walk(3.0);  // + kShadowRayCost 1: scales with the segment count
+            l.record_segment_walk(3.0);  // + per_segment_walk 1: scales with the segment count
             l.end_sample(double(u) + 2.0);
             if (i % 10 == 9) l.end_pixel();  // ten pixels of ten samples
         }
@@ -808,7 +903,7 @@ TEST_CASE("NeeCountLearner: bookkeeping") {
         NeeCountLearner image;
         for (int i = 0; i < 50; ++i) pilot(image, {{1.f, false}, {3.f, false}});
         const TechniqueCounts image_counts = image.choose_counts();
-        REQUIRE(image_counts.nee == NeeCountLearner::candidate(6));
+        REQUIRE(image_counts.nee == 0.f);  // NEE finds nothing tracking does not: count 0
         CHECK_FALSE(image.summary().open);  // its own choice stands, whatever the fallback
         CHECK(image.choose_counts(TechniqueCounts{}).nee == image_counts.nee);
 
@@ -826,9 +921,16 @@ TEST_CASE("NeeCountLearner: bookkeeping") {
         CHECK(tile.choose_counts(eighth).nee == eighth.nee);
         CHECK(NeeCountLearner::choose_counts(summary, eighth).nee == eighth.nee);
         CHECK(tile.choose_counts(eighth).emission_segment == 1.f);
-        CHECK(tile.choose_counts(image_counts).nee == 1.f);  // predicted worse at 1/64: count 1
+        CHECK(tile.choose_counts(image_counts).nee == 1.f);  // 0 would lose its NEE-only light: count 1
+        CHECK(std::isinf(summary.efficiency[std::size_t(NeeCountLearner::kZero) * kC]));
+        // A tile as small whose lights tracking finds as well: 0 by its own pilot (NEE's walk is
+        // all but one of a sample's 22 units, and drops with it at every sample).
+        NeeCountLearner covered;
+        pilot(covered, {{1.f, false}, {0.72f, false}, {2.f, false}, {0.5f, false}});
+        CHECK(covered.choose() == 0.f);
+        CHECK(covered.choose_counts(image_counts).nee == 0.f);
         // Counts that are not candidates count as 1: the tile's own choice.
-        for (const float bad : {0.3f, 0.f, -0.125f, 2.f, std::nanf("")}) {
+        for (const float bad : {0.3f, -0.125f, 2.f, std::nanf("")}) {
             CAPTURE(bad);
             TechniqueCounts f;
             f.nee = bad;
@@ -858,7 +960,7 @@ TEST_CASE("NeeCountLearner: bookkeeping") {
             l.record_bdpt(1.f, 0.f, 0.f, 1.f, 1.f, 1.f, BdptTechnique::Light, false);
             l.record_bdpt(1.f, 0.f, 0.f, 1.f, 1.f, 1.f, BdptTechnique::Light, false);
             l.record_bdpt(1.f, 0.f, 0.f, 1.f, 1.f, 1.f, BdptTechnique::Light, true);
-            l.record_light_walk(3.0);  // + kShadowRayCost 1: scales with the light subpath count
+            l.record_light_walk(3.0);  // + per_light_walk 1: scales with the light subpath count
             l.end_sample(double(a) + 2.0);
             if (i % 10 == 9) l.end_pixel();
         }

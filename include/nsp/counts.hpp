@@ -6,7 +6,8 @@
 // runs its estimate divides by n, and every MIS weight takes n p in place of its pdf p. That keeps
 // the estimator unbiased for any n in (0, 1] and lets a technique that does not pay for itself be
 // drawn rarely; n = 0 removes the technique from every weight, unbiased where the others cover
-// what it samples (EstimatorOptions says where nsp allows it; the learner does not choose it). The adaptive equiangular probability (EstimatorOptions::adaptive_equiangular),
+// what it samples (EstimatorOptions says where nsp allows it). The adaptive equiangular
+// probability (EstimatorOptions::adaptive_equiangular),
 // BDPT's light_subpath_probability, the NEE count (EstimatorOptions::nee_count) and the emission
 // segment technique's count (EstimatorOptions::emission_segment_count) are such counts.
 //
@@ -21,9 +22,11 @@
 // Var[F(n)] = Var[A(n)] + E[B(n)] (total variance), estimated without bias from the pilot's own
 // paths, covariances within a path included (the ones that matter where tracking alone is nearly
 // noiseless, as in a furnace). NeeCountLearner keeps that for a ladder of candidate counts over a
-// pixel tile and picks the count that minimises variance x cost, the cost being density lookups
-// and DDA steps (deterministic, unlike time; a shadow walk's fixed work counted as one lookup) with
-// the shadow walks' share scaled by n (THEORY 5.9). Volume emission is the same with the
+// pixel tile (1, 1/2, ..., 1/64 and 0) and picks the count that minimises variance x cost, the
+// cost being the host's CostModel of density lookups, DDA steps and technique runs (by default in
+// lookups: deterministic, unlike time) with the shadow walks' share scaled by n (THEORY 5.9).
+// Count 0 is a candidate only where no pilot contribution needs the technique (its balance
+// denominator without it is 0, as for a point light) and the scene allows it (no delta lights). Volume emission is the same with the
 // collision estimator in tracking's place and the segment technique in NEE's (NEE toward the
 // volume at a fixed count): the learner keeps both ladders and picks the pair of counts. Under
 // BdptEstimator the pair is NEE's count and the light subpath probability: every strategy's
@@ -35,6 +38,8 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <limits>
+#include <string>
 #include <utility>
 
 #include "core/counter.hpp"
@@ -53,6 +58,22 @@ struct TechniqueCounts {
     float light_subpath = 1.f;
 };
 
+/// What a host's work costs the learner's prediction, in the host's own unit (seconds, lookups,
+/// anything proportional): a sample costs per_sample plus per_lookup per density lookup and
+/// per_dda_step per grid-majorant DDA step, plus per_shadow_walk per NEE shadow walk (the light
+/// sample, the phase or BSDF evaluation, the host's own ray casts: what it costs besides its
+/// lookups), per_segment_walk per run of the emission segment technique and per_light_walk per
+/// light subpath walk or connection. The default is nsp's own model in lookups. A host that times
+/// its parts passes them here; only the ratios matter.
+struct CostModel {
+    double per_sample = 1.0;
+    double per_lookup = 1.0;
+    double per_dda_step = double(kDdaStepCost);
+    double per_shadow_walk = 1.0;
+    double per_segment_walk = 1.0;
+    double per_light_walk = 1.0;
+};
+
 /// Learns a tile's expected counts from pilot samples rendered at counts 1 with the learner as
 /// their lookup counter (see the header), for the balance heuristic: under PathEstimator and
 /// SpectralPathEstimator the NEE count (EstimatorOptions::nee_count) and, in emissive media, the
@@ -63,35 +84,65 @@ struct TechniqueCounts {
 /// and end_pixel() after each pixel's samples; choose_counts() then gives the counts (choose() the
 /// NEE count alone). Where the second technique never ran its count stays 1 and the NEE count is
 /// what it would be without it. Deterministic: the same samples in the same order give the same
-/// counts. Host-side and fixed-size (no heap, about 32 KiB); one per tile.
+/// counts. Host-side and fixed-size (no heap, about 40 KiB); one per tile.
+///
+/// Count 0 drops a technique from every weight. The learner offers it only where the pilot saw no
+/// contribution that the other techniques cannot make (a pair of counts at which some recorded
+/// contribution's balance denominator is 0 is never chosen) and, for NEE, where the scene has no
+/// delta light (the estimators tell the learner through nee_count_may_be_0; a host that drives
+/// the kernels itself calls it with false for such a scene, as those refuse NEE count 0).
 ///
 /// BDPT's light subpath is one draw per sample for all of its strategies, so its Bernoulli
 /// variance is that of the sum of its contributions to the sample's own pixel; its splats (t = 1)
 /// land on other pixels, whose variance they add to by their second moment (their means there,
-/// spread over the image, are left out). Its counts are predicted without the diagonal correction
-/// (a path one tile's light subpath splats may be drawn by another tile's camera subpaths).
+/// spread over the image, are left out). At light subpath count 0 the prediction takes the
+/// diagonal correction (see add_contribution) over every contribution, splats included: exact
+/// over the image, approximate per tile (a path one tile's light subpath splats may be drawn by
+/// another tile's camera subpaths). BDPT's NEE count is not offered 0: with light tracing a
+/// splatted path's camera-side strategies are drawn on other pixels, and the variance at NEE
+/// count 0 of what NEE alone drew here is not predicted well per pixel.
 class NeeCountLearner {
 public:
     static constexpr bool enabled = true;
-    static constexpr int kCandidates = 7;  ///< counts 1, 1/2, ..., 1/64 (for each technique)
+    static constexpr int kCandidates = 8;  ///< counts 1, 1/2, ..., 1/64 and 0 (for each technique)
+    static constexpr int kZero = kCandidates - 1;  ///< the index of count 0
 
-    /// The j-th candidate count, 2^-j.
-    static constexpr float candidate(int j) noexcept { return 1.f / float(1 << j); }
+    /// The j-th candidate count: 2^-j, and 0 for j = kZero.
+    static constexpr float candidate(int j) noexcept { return j == kZero ? 0.f : 1.f / float(1 << j); }
     /// The index j of a candidate count (the inverse of candidate()), e.g. of a chosen one.
-    static int candidate_index(float count) noexcept { return int(std::lround(-std::log2(count))); }
+    static int candidate_index(float count) noexcept {
+        return count == 0.f ? kZero : int(std::lround(-std::log2(count)));
+    }
 
-    /// A shadow walk's work besides its lookups and steps (the light sample, the phase or BSDF
-    /// evaluation, the walk's set-up), in lookups: an assumption of the cost model, about what a
-    /// lookup costs. The segment technique's run (its point's draw, its walk's set-up), a light
-    /// subpath's walk and each of its connections count the same.
-    static constexpr double kShadowRayCost = 1.0;
+    /// A learner whose cost prediction uses `costs` (see CostModel). Throws InvalidArgument
+    /// naming a cost that is negative or not finite, or per_sample not > 0.
+    explicit NeeCountLearner(const CostModel& costs = {}) : costs_(costs) {
+        const auto check = [](const char* what, double v, bool positive) {
+            if (!std::isfinite(v) || v < 0.0 || (positive && v == 0.0))
+                throw InvalidArgument(std::string("nsp::NeeCountLearner: CostModel::") + what + " is " +
+                                      std::to_string(v) + "; it must be finite and " + (positive ? "> 0" : ">= 0"));
+        };
+        check("per_sample", costs.per_sample, true);
+        check("per_lookup", costs.per_lookup, false);
+        check("per_dda_step", costs.per_dda_step, false);
+        check("per_shadow_walk", costs.per_shadow_walk, false);
+        check("per_segment_walk", costs.per_segment_walk, false);
+        check("per_light_walk", costs.per_light_walk, false);
+    }
+    const CostModel& costs() const noexcept { return costs_; }
+
+    /// Whether the scene allows NEE count 0 (no delta lights); false rules count 0 out for NEE.
+    /// The estimators call it on every sample.
+    void nee_count_may_be_0(bool allowed) noexcept { nee_zero_refused_ = nee_zero_refused_ || !allowed; }
 
     void lookup() noexcept { ++lookups_; }
     void majorant_steps(std::uint64_t k) noexcept { steps_ += k; }
     std::uint64_t count() const noexcept { return lookups_; }
     std::uint64_t steps() const noexcept { return steps_; }  ///< grid-majorant DDA steps (as LookupCount's)
-    /// The work so far in lookups: lookups + kDdaStepCost x DDA steps.
-    double work() const noexcept { return double(lookups_) + double(kDdaStepCost) * double(steps_); }
+    /// The work so far in the CostModel's unit: per_lookup x lookups + per_dda_step x DDA steps.
+    double work() const noexcept {
+        return costs_.per_lookup * double(lookups_) + costs_.per_dda_step * double(steps_);
+    }
 
     /// Called by the estimator for every light contribution both techniques can make (see
     /// detail::record_light). A pilot at a count other than 1 has no NEE sample at some vertices:
@@ -113,6 +164,7 @@ public:
     void record_bdpt(float f_over_ref, float p_fixed, float p_nee, float p_light, float nee_count, float light_count,
                      BdptTechnique t, bool splat) noexcept {
         set_second(Second::LightSubpath);
+        nee_zero_refused_ = true;  // BDPT's NEE count stays above 0 (see the class comment)
         if (nee_count != 1.f || light_count != 1.f) invalid_ = true;
         double v1 = 0.0, d1 = 0.0;
         if (!at_counts_1(f_over_ref, p_fixed, p_nee, p_light, v1, d1)) return;
@@ -121,7 +173,18 @@ public:
             for (int jl = 0; jl < kCandidates; ++jl) {
                 const std::size_t k = pair(jn, jl);
                 const double cn = candidate(jn), cl = candidate(jl), d = h + cn * n + cl * l;
+                if (!(d > 0.0)) lost_ |= std::uint64_t(1) << k;  // only the counted groups draw it
                 const double x = d > 0.0 ? u / d : 0.0;
+                // At light subpath count 0 the diagonal correction of add_contribution, splats
+                // included: over the image every path's draws by every strategy are recorded by
+                // some sample, so the sum estimates the image's second moment there (a splat lands
+                // on another pixel: a tile's share is approximate). It carries the variance of
+                // what only the light subpaths drew in the pilot; at counts above 0 their
+                // Bernoulli terms do, and the prediction is exact per pixel without it.
+                if (jl == kZero) {
+                    const double c = t == BdptTechnique::Fixed ? 1.0 : t == BdptTechnique::Nee ? cn : cl;
+                    path_diagonal_[k] += (d > 0.0 ? u * u / (d1 * d) : 0.0) - c * x * x;
+                }
                 switch (t) {
                     case BdptTechnique::Fixed: path_delta_[k] += x - v1; break;
                     case BdptTechnique::Nee:
@@ -143,19 +206,19 @@ public:
     /// `counted`: the walk runs with the NEE count, so its share of the cost scales with it (the
     /// walks from equiangular vertices run at any count: their work stays in the base).
     void record_shadow_walk(double w, bool counted) noexcept {
-        if (counted) nee_work_ += w + kShadowRayCost;
-        fixed_work_ += kShadowRayCost;
+        if (counted) nee_work_ += w + costs_.per_shadow_walk;
+        fixed_work_ += costs_.per_shadow_walk;
     }
     /// Called by the estimator after each run of the emission segment technique with its work.
     void record_segment_walk(double w) noexcept {
         set_second(Second::Segment);
-        add_second_work(w);
+        add_second_work(w, costs_.per_segment_walk);
     }
     /// Called by BdptEstimator after a light subpath's walk and after each of its connections'
     /// shadow walks with the work it took: all of it scales with the light subpath count.
     void record_light_walk(double w) noexcept {
         set_second(Second::LightSubpath);
-        add_second_work(w);
+        add_second_work(w, costs_.per_light_walk);
     }
 
     /// The host, after each pilot sample: its estimate for its own pixel (the channel mean the
@@ -213,6 +276,8 @@ public:
         z_n_ += o.z_n_;
         z_dof_ += o.z_dof_;
         invalid_ = invalid_ || o.invalid_;
+        nee_zero_refused_ = nee_zero_refused_ || o.nee_zero_refused_;
+        lost_ |= o.lost_;
         if (o.second_ != Second::None) set_second(o.second_);
         for (std::size_t k = 0; k < kPairs; ++k) {
             variance_sum_[k] += o.variance_sum_[k];
@@ -236,14 +301,14 @@ public:
         return a + b;
     }
     /// Predicted work per sample at NEE candidate j and second candidate js, in lookups: lookups
-    /// and DDA steps (work()), with each counted technique's share (its walks' work and
-    /// kShadowRayCost each) scaled by its count, +1 per sample for the camera ray (so that a tile
-    /// whose paths never meet the medium has a cost).
+    /// and DDA steps (work()), with each counted technique's share (its walks' work and its
+    /// per-run cost each) scaled by its count, + per_sample (so that a tile whose paths never meet
+    /// the medium has a cost), all in the CostModel's unit.
     double predicted_cost(int j, int js = 0) const noexcept {
         if (samples_ == 0) return 1.0;
         const double base = work() + fixed_work_ - nee_work_ - second_work_;
         return (base + double(candidate(j)) * nee_work_ + double(candidate(js)) * second_work_) / double(samples_) +
-               1.0;
+               costs_.per_sample;
     }
 
     /// A count below 1 must pay for itself beyond the pilot's noise: a pair is taken only where its
@@ -261,8 +326,8 @@ public:
     /// (plain MIS) is the safe side.
     static constexpr double kSignificance = 2.0;
 
-    /// The candidate pair with the smallest predicted variance x cost among those that pass the
-    /// significance test above (ties to the larger counts); counts 1 when there is nothing to
+    /// The candidate pair with the smallest predicted variance x cost among the allowed ones
+    /// (allowed()) that pass the significance test above (ties to the larger counts); counts 1 when there is nothing to
     /// learn from (fewer than two samples in pixels with two or more, no variance at counts 1) or the pilot
     /// did not run at counts 1.
     TechniqueCounts choose_counts() const noexcept {
@@ -271,7 +336,7 @@ public:
         double best_e = predicted_variance(0, 0) * predicted_cost(0, 0);
         for (int jn = 0; jn < kCandidates; ++jn)
             for (int js = 0; js < kCandidates; ++js) {
-                if (jn == 0 && js == 0) continue;
+                if ((jn == 0 && js == 0) || !allowed(jn, js)) continue;
                 const double e = predicted_variance(jn, js) * predicted_cost(jn, js);
                 if (!(e < best_e)) continue;
                 // Better than every pair with one or both of its reduced counts at 1, significantly.
@@ -286,15 +351,15 @@ public:
         (second_ == Second::LightSubpath ? out.light_subpath : out.emission_segment) = candidate(best_s);
         return out;
     }
-    /// What choose_counts(fallback) needs of a tile once its pilot is done, about 210 bytes (the
-    /// learner itself is about 32 KiB): a host keeps one per tile until every tile's pilot has run
+    /// What choose_counts(fallback) needs of a tile once its pilot is done, about 270 bytes (the
+    /// learner itself is about 40 KiB): a host keeps one per tile until every tile's pilot has run
     /// and their learners are merged into the image's.
     struct Summary {
         TechniqueCounts own;        ///< choose_counts()
         bool open = false;          ///< `own` is counts 1 for want of a significant gain, not of data
         bool light_subpath = false; ///< the second count is the light subpath probability
         /// Per pair (NEE candidate x second candidate, row-major): predicted variance x cost
-        /// over that at counts 1.
+        /// over that at counts 1; infinite at pairs not allowed().
         std::array<float, std::size_t(kCandidates) * std::size_t(kCandidates)> efficiency{};
     };
     Summary summary() const noexcept {
@@ -307,7 +372,9 @@ public:
         for (int jn = 0; jn < kCandidates; ++jn)
             for (int js = 0; js < kCandidates; ++js)
                 out.efficiency[pair(jn, js)] =
-                    out.open ? float(predicted_variance(jn, js) * predicted_cost(jn, js) / e1) : 1.f;
+                    !allowed(jn, js) ? std::numeric_limits<float>::infinity()
+                    : out.open       ? float(predicted_variance(jn, js) * predicted_cost(jn, js) / e1)
+                                     : 1.f;
         return out;
     }
 
@@ -315,9 +382,9 @@ public:
     /// the image's counts, choose_counts() of every tile's learner merged (merge()), whose pooled
     /// pilot is many times larger. The tile's own choice where it passes the significance test or
     /// where it had nothing to learn from; otherwise `fallback` where the tile's predicted variance
-    /// x cost at it is no larger than at counts 1, else counts 1: a tile whose pilot shows that NEE
-    /// pays (a small bright light in it alone) keeps count 1 whatever the image chose. Counts in
-    /// `fallback` that are not candidates (2^-j, j < kCandidates) count as 1.
+    /// x cost at it is no larger than at counts 1 (and it is allowed there), else counts 1: a tile
+    /// whose pilot shows that NEE pays (a small bright light in it alone) keeps count 1 whatever
+    /// the image chose. Counts in `fallback` that are not candidates count as 1.
     static TechniqueCounts choose_counts(const Summary& tile, const TechniqueCounts& fallback) noexcept {
         if (!tile.open) return tile.own;
         const int fn = candidate_or_1(fallback.nee);
@@ -336,6 +403,12 @@ public:
     float choose() const noexcept { return choose_counts().nee; }
 
     bool invalid_pilot() const noexcept { return invalid_; }
+    /// Whether the pair of candidates (jn, js) may be chosen: no recorded contribution has a
+    /// balance denominator of 0 there (only a technique at count 0 could draw it), and NEE count
+    /// 0 only where nee_count_may_be_0 was never told false.
+    bool allowed(int jn, int js = 0) const noexcept {
+        return !((lost_ >> pair(jn, js)) & 1u) && !(nee_zero_refused_ && jn == kZero);
+    }
     std::uint64_t samples() const noexcept { return samples_; }
     double nee_work() const noexcept { return nee_work_; }  ///< NEE's work in lookups (see predicted_cost)
     /// The segment technique's work (0 under BDPT).
@@ -347,10 +420,12 @@ private:
     static constexpr std::size_t kPairs = std::size_t(kCandidates) * std::size_t(kCandidates);
     /// The candidate index of `count`, 0 (count 1) where it is not a candidate.
     static int candidate_or_1(float count) noexcept {
+        if (count == 0.f) return kZero;
         if (!(count > 0.f && count <= 1.f)) return 0;
         const int j = candidate_index(count);
         return j >= 0 && j < kCandidates && candidate(j) == count ? j : 0;
     }
+    static_assert(kPairs <= 64, "lost_ holds a bit per pair");
     using PerPair = std::array<double, kPairs>;
     static constexpr std::size_t pair(int jn, int js) noexcept { return std::size_t(jn * kCandidates + js); }
 
@@ -362,9 +437,9 @@ private:
         if (second_ != Second::None && second_ != s) invalid_ = true;
         second_ = s;
     }
-    void add_second_work(double w) noexcept {
-        second_work_ += w + kShadowRayCost;
-        fixed_work_ += kShadowRayCost;
+    void add_second_work(double w, double per_run) noexcept {
+        second_work_ += w + per_run;
+        fixed_work_ += per_run;
     }
 
     /// One pilot sample as the significance test needs it: its estimate and, per candidate pair,
@@ -464,6 +539,9 @@ private:
         const double u = f_over_ref, h = p_fixed, n = p_counted, o = p_other;
         for (int j = 0; j < kCandidates; ++j) {
             const double c = candidate(j), d = h + c * n + o;
+            if (!(d > 0.0))  // only the counted technique draws it: count 0 would lose it
+                for (int i = 0; i < kCandidates; ++i)
+                    lost_ |= std::uint64_t(1) << (axis == Axis::Nee ? pair(j, i) : pair(i, j));
             const double x = d > 0.0 ? u / d : 0.0;
             // The contribution's own second moment at count c, E[(its estimate)^2]: x^2 drawn by a
             // technique of fixed count, c x^2 by the counted one (the sum of its A and B parts).
@@ -486,7 +564,9 @@ private:
     std::uint64_t lookups_ = 0, steps_ = 0, samples_ = 0, variance_samples_ = 0, z_n_ = 0, z_dof_ = 0;
     double fixed_work_ = 0.0, nee_work_ = 0.0, second_work_ = 0.0;
     int pixel_n_ = 0;
-    bool invalid_ = false;
+    bool invalid_ = false, nee_zero_refused_ = false;
+    std::uint64_t lost_ = 0;  // a bit per pair: a recorded contribution's denominator is 0 there
+    CostModel costs_;
     Second second_ = Second::None;
     // The current sample, per pair: the change of its estimate from count 1, its Bernoulli
     // variance (and splats' second moments), its diagonal correction, its light subpath's

@@ -63,6 +63,13 @@ void record_segment_walk(C& counter, double before) noexcept {
     if constexpr (MisRecorder<C>) counter.record_segment_walk(counter.work() - before);
     else (void)counter, (void)before;
 }
+/// Tells a recorder that learns counts (NeeCountLearner::nee_count_may_be_0) whether the scene
+/// allows NEE count 0; nothing on any other counter.
+template <class C>
+void record_nee_count_may_be_0(C& counter, bool allowed) noexcept {
+    if constexpr (requires { counter.nee_count_may_be_0(allowed); }) counter.nee_count_may_be_0(allowed);
+    else (void)counter, (void)allowed;
+}
 /// counter.work() on a MisRecorder, else 0 (what record_shadow_walk takes as `before`).
 template <class C>
 double recorder_work(const C& counter) noexcept {

@@ -383,6 +383,7 @@ RadianceSample<typename Sc::Spectral> BdptEstimator<Mis, H, A, MaxDepth, Ch>::tr
     // NEE at count 0 leaves the lights no path can hit unreached (EstimatorOptions::nee_count).
     if (kernels_.options().nee_count == 0.f && sc.lights.has_delta_lights())
         return {Spectrum::Zero(), Status::InvalidInput};
+    detail::record_nee_count_may_be_0(counter, !sc.lights.has_delta_lights());
     // The subpaths' vertices, each written whole before it is read: a Vertex is an implicit-
     // lifetime aggregate, so the storage is left as it is instead of 67 vertices being set to
     // their defaults per sample (a fifth of a sample's time where the subpaths are short).

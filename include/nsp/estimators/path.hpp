@@ -288,6 +288,7 @@ public:
                       "(GlobalMajorant or GridMajorant); per-channel majorants go with nsp::SpectralPathEstimator");
         if (!usable_ray(camera_ray) || detail::refuses_nee_count(kernels_, scene))
             return {Sc::Spectrum::Zero(), Status::InvalidInput};
+        detail::record_nee_count_may_be_0(counter, !scene.lights.has_delta_lights());
         return detail::trace_path<channels::Grey>(kernels_, scene, camera_ray, lambda, nullptr, rng, counter);
     }
 
@@ -348,6 +349,7 @@ public:
                       "grey majorant bounding every channel (GlobalMajorant)");
         if (!usable_ray(camera_ray) || detail::refuses_nee_count(kernels_, scene))
             return {Sc::Spectrum::Zero(), Status::InvalidInput};
+        detail::record_nee_count_may_be_0(counter, !scene.lights.has_delta_lights());
         return detail::trace_path<CP>(kernels_, scene, camera_ray, lambda, &selection, rng, counter);
     }
 
