@@ -139,7 +139,7 @@ Options parse_command_line(int argc, char** argv) {
     // What is rendered
     value("--scene", "LIST", "cloud, chromatic, sparse, fog, plume, both (cloud,chromatic), all",
           [&](std::string_view v) { parse_scenes(o, v); });
-    value("--setup", "LIST", "A, B, C1, C2, SA, SB, F1, F2, F3, P1, all (default: all but SB)",
+    value("--setup", "LIST", "A, B, D, C1, C2, C3, SA, SB, F1, F2, F3, P1, all (default: all but SB)",
           [&](std::string_view v) { parse_setups(o, v); });
     value("--spectral", "LIST", "spectral modes: mono, rgb, hero, both (= mono,rgb), all",
           [&](std::string_view v) { parse_modes(o, v); });
@@ -175,6 +175,8 @@ Options parse_command_line(int argc, char** argv) {
     value("--width", "W", "image width", [&](std::string_view v) { o.width = parse_number<int>("--width", v, 1, 16384); });
     value("--height", "H", "image height",
           [&](std::string_view v) { o.height = parse_number<int>("--height", v, 1, 16384); });
+    value("--pilot-count", "C", "learned rows: run the pilot at NEE and segment count C in [1/64, 1] (default 1)",
+          [&](std::string_view v) { o.pilot_count = parse_number<float>("--pilot-count", v, 1.f / 64.f, 1.f); });
     value("--runs", "K", "render each row K times (seeds seed..seed+K-1), report medians",
           [&](std::string_view v) { o.runs = parse_number<int>("--runs", v, 1, 1000); });
     value("--reference-spp", "N", "effective variance against an N-spp reference (chromatic, fog, plume)",

@@ -19,6 +19,7 @@ struct Options {
     int threads = 1;                        ///< default: hardware concurrency
     std::uint64_t seed = 1;
     int runs = 1;
+    float pilot_count = 1.f;  ///< --pilot-count: the learned rows' pilot NEE and segment count
     std::optional<int> reference_spp;  ///< --reference-spp: effective (error-based) variance
     nsp::EstimatorOptions estimator;   ///< max depth, equiangular and emission-segment settings
     std::string out = "out";

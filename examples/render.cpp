@@ -63,6 +63,7 @@ std::vector<Job> plan_jobs(const std::vector<TablePlan>& tables, const Options& 
         rq.threads = o.threads;
         rq.seed = seed;
         rq.estimator = o.estimator;
+        rq.pilot_count = o.pilot_count;
         rq.majorant = o.majorant;
         return rq;
     };

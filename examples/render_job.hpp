@@ -56,6 +56,9 @@ struct RenderRequest {
     /// and at most 16 (a 16x16 tile then learns from 512 to 4096 samples; the pilot costs 1/32 of
     /// the render at full NEE cost).
     static int pilot_spp(int spp) { return std::min(spp, std::clamp(spp / 32, 2, 16)); }
+    /// The pilot's NEE and emission segment count (nsp::NeeCountLearner::pilot_counts): below 1
+    /// the pilot costs less and still predicts every candidate without bias (--pilot-count).
+    float pilot_count = 1.f;
 };
 
 /// What one render measured. The estimates of each sample are taken as linear RGB (mono: the value
@@ -78,6 +81,7 @@ struct RenderStats {
     /// With RenderRequest::learn_nee_counts: the NEE count chosen for each tile (row-major tiles),
     /// and on an emissive medium the emission segment count (empty otherwise).
     std::vector<float> nee_counts, segment_counts;
+    float pilot_count = 1.f;  ///< the pilot's NEE (and segment) count
 
     /// The mean over the 3 channels of channel_variance.
     double variance_per_channel() const {

@@ -232,13 +232,21 @@ RenderStats render(const typename C::Scene& scene, const RenderRequest& rq, std:
 
     if constexpr (C::learns_nee_count) {
         if (rq.learn_nee_counts) {
-            // Pass 1: the pilot, tile by tile, at count 1.
+            // Pass 1: the pilot, tile by tile, at rq.pilot_count (NEE and segment).
+            nsp::TechniqueCounts pilot_counts;
+            pilot_counts.nee = rq.pilot_count;
+            pilot_counts.emission_segment = C::MediumKind::emissive ? rq.pilot_count : 1.f;
+            nsp::EstimatorOptions pilot_options = rq.estimator;
+            pilot_options.nee_count = pilot_counts.nee;
+            pilot_options.emission_segment_count = pilot_counts.emission_segment;
+            const Estimator pilot_estimator{pilot_options};
             const int ts = rq.tile_size, tiles_x = (w + ts - 1) / ts, tiles_y = (h + ts - 1) / ts;
             const int pilot = RenderRequest::pilot_spp(rq.spp);
             std::vector<PixelState> px(std::size_t(w) * std::size_t(h));
             for (std::size_t p = 0; p < px.size(); ++p) px[p].rng = nsp::Pcg32(rq.seed, p);
             constexpr bool kEmissive = C::MediumKind::emissive;
             st.nee_counts.assign(std::size_t(tiles_x) * std::size_t(tiles_y), 1.f);
+            st.pilot_count = rq.pilot_count;
             if (kEmissive) st.segment_counts.assign(st.nee_counts.size(), 1.f);
             // Slot j learns tiles j, j + kSlots, ... in order (threads take whole slots) and merges
             // their learners, so the image's counts do not depend on the thread count. A tile
@@ -246,7 +254,8 @@ RenderStats render(const typename C::Scene& scene, const RenderRequest& rq, std:
             // where its pilot predicts them no worse than counts 1 (NeeCountLearner::Summary).
             constexpr int kSlots = 16;
             const int n_tiles = tiles_x * tiles_y;
-            std::vector<nsp::NeeCountLearner> slots(static_cast<std::size_t>(kSlots));
+            std::vector<nsp::NeeCountLearner> slots(static_cast<std::size_t>(kSlots),
+                                                    nsp::NeeCountLearner({}, pilot_counts));
             std::vector<nsp::NeeCountLearner::Summary> summaries(static_cast<std::size_t>(n_tiles));
             std::atomic<int> next_slot{0};
             auto pilot_work = [&](ThreadTotals& out) {
@@ -254,13 +263,13 @@ RenderStats render(const typename C::Scene& scene, const RenderRequest& rq, std:
                 const double cpu0 = thread_cpu_seconds();
                 for (int j; (j = next_slot.fetch_add(1)) < kSlots;)
                     for (int tile = j; tile < n_tiles; tile += kSlots) {
-                        nsp::NeeCountLearner learner;
+                        nsp::NeeCountLearner learner({}, pilot_counts);
                         const int x0 = (tile % tiles_x) * ts, y0 = (tile / tiles_x) * ts;
                         for (int y = y0; y < std::min(h, y0 + ts); ++y)
                             for (int x = x0; x < std::min(w, x0 + ts); ++x) {
                                 PixelState& state = px[std::size_t(y) * std::size_t(w) + std::size_t(x)];
                                 for (int k = 0; k < pilot; ++k)
-                                    learner.end_sample(sample(estimator, learner, state, x, y, t));
+                                    learner.end_sample(sample(pilot_estimator, learner, state, x, y, t));
                                 learner.end_pixel();
                             }
                         summaries[std::size_t(tile)] = learner.summary();
@@ -272,7 +281,7 @@ RenderStats render(const typename C::Scene& scene, const RenderRequest& rq, std:
                 out = t;
             };
             run_pool(pilot_work, pilot_totals);
-            nsp::NeeCountLearner image;
+            nsp::NeeCountLearner image({}, pilot_counts);
             for (const nsp::NeeCountLearner& l : slots) image.merge(l);
             const nsp::TechniqueCounts image_counts = image.choose_counts();
             for (int tile = 0; tile < n_tiles; ++tile) {

@@ -124,8 +124,9 @@ void print_learned_counts(const std::vector<Row>& rows) {
         const int spp = r.runs[0].samples > 0 && !r.runs[0].nee_counts.empty()
                             ? int(r.runs[0].samples / std::uint64_t(std::max<std::size_t>(1, r.runs[0].pixels)))
                             : 0;
-        std::printf("learned NEE counts (%s, %d-spp pilot at count 1 per %dx%d tile, nsp::NeeCountLearner): tiles at",
-                    r.c.name.c_str(), RenderRequest::pilot_spp(spp), defaults.tile_size, defaults.tile_size);
+        std::printf("learned NEE counts (%s, %d-spp pilot at count %g per %dx%d tile, nsp::NeeCountLearner): tiles at",
+                    r.c.name.c_str(), RenderRequest::pilot_spp(spp), double(r.runs[0].pilot_count), defaults.tile_size,
+                    defaults.tile_size);
         auto histogram = [](const std::vector<float>& counts) {
             for (int j = 0; j < nsp::NeeCountLearner::kCandidates; ++j) {
                 const float c = nsp::NeeCountLearner::candidate(j);

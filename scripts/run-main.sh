@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Fresh-machine command 1: set up, build nsp_render (only that target: the tests and benchmarks
 # are run-tests.sh's business), and run the main job. Without arguments:
-#  1. nsp_render's default run: the grey cloud (set-ups A, B) with every estimator, the
-#     chromatic cloud (set-ups C1, C2, rgb and hero, 32x32) with the spectral estimators, the
+#  1. nsp_render's default run: the grey cloud (set-ups A, B with every estimator; D, a bright
+#     sky, with the ones it compares), the chromatic cloud (set-ups C1-C3, rgb, 32x32) with the
+#     spectral estimators, the
 #     sparse medium (set-up SA, mono, 64x64, 256 spp) with each grey strategy under the global
 #     and the grid majorant, the fog lit by a lamp (set-ups F1, F2, F3, mono, 64x64) with
 #     tracking + NEE, equiangular + NEE and their three-way MIS, and the flame in the plume

@@ -114,9 +114,22 @@ public:
         return count == 0.f ? kZero : int(std::lround(-std::log2(count)));
     }
 
-    /// A learner whose cost prediction uses `costs` (see CostModel). Throws InvalidArgument
-    /// naming a cost that is negative or not finite, or per_sample not > 0.
-    explicit NeeCountLearner(const CostModel& costs = {}) : costs_(costs) {
+    /// A learner whose cost prediction uses `costs` (see CostModel), for a pilot rendered at
+    /// counts `pilot` (see pilot_counts()). Throws InvalidArgument naming a cost that is negative
+    /// or not finite, per_sample not > 0, or a pilot count outside (0, 1] (the light subpath's
+    /// must be 1).
+    explicit NeeCountLearner(const CostModel& costs = {}, const TechniqueCounts& pilot = {})
+        : costs_(costs), pilot_(pilot) {
+        const auto check_count = [](const char* what, float v) {
+            if (!(v > 0.f && v <= 1.f))
+                throw InvalidArgument(std::string("nsp::NeeCountLearner: the pilot's ") + what + " count is " +
+                                      std::to_string(v) + "; it must be in (0, 1]");
+        };
+        check_count("NEE", pilot.nee);
+        check_count("emission segment", pilot.emission_segment);
+        if (pilot.light_subpath != 1.f)
+            throw InvalidArgument("nsp::NeeCountLearner: the pilot's light subpath probability is " +
+                                  std::to_string(pilot.light_subpath) + "; a BDPT pilot runs at 1");
         const auto check = [](const char* what, double v, bool positive) {
             if (!std::isfinite(v) || v < 0.0 || (positive && v == 0.0))
                 throw InvalidArgument(std::string("nsp::NeeCountLearner: CostModel::") + what + " is " +
@@ -130,6 +143,12 @@ public:
         check("per_light_walk", costs.per_light_walk, false);
     }
     const CostModel& costs() const noexcept { return costs_; }
+    /// The counts the pilot runs at (EstimatorOptions::nee_count, emission_segment_count): 1 by
+    /// default. A pilot at NEE count c has NEE samples at a fraction c of its vertices; the
+    /// learner re-weights them by 1 / c (and takes the pilot's own Bernoulli variance out), so it
+    /// predicts every candidate without bias from a pilot that costs less. BdptEstimator's pilot
+    /// runs at counts 1. A contribution recorded at other counts makes the pilot invalid.
+    const TechniqueCounts& pilot_counts() const noexcept { return pilot_; }
 
     /// Whether the scene allows NEE count 0 (no delta lights); false rules count 0 out for NEE.
     /// The estimators call it on every sample.
@@ -145,18 +164,19 @@ public:
     }
 
     /// Called by the estimator for every light contribution both techniques can make (see
-    /// detail::record_light). A pilot at a count other than 1 has no NEE sample at some vertices:
-    /// the learner then reports invalid_pilot() and chooses 1.
+    /// detail::record_light). A contribution at a count other than the pilot's makes the learner
+    /// report invalid_pilot() and choose 1.
     void record_light(float f_over_ref, float p_hit, float p_nee, float p_other, float count,
                       LightTechnique t) noexcept {
-        add_contribution(Axis::Nee, f_over_ref, p_hit, p_nee, p_other, count, t == LightTechnique::Nee);
+        add_contribution(Axis::Nee, f_over_ref, p_hit, p_nee, p_other, count, pilot_.nee, t == LightTechnique::Nee);
     }
     /// Called by the estimator for every volume emission contribution of a combining strategy
-    /// (see detail::record_emission); a pilot at a segment count other than 1 is invalid as above.
+    /// (see detail::record_emission); at a segment count other than the pilot's it is invalid as above.
     void record_emission(float f_over_ref, float p_collision, float p_segment, float p_nee, float count,
                          EmissionTechnique t) noexcept {
         set_second(Second::Segment);
-        add_contribution(Axis::Second, f_over_ref, p_collision, p_segment, p_nee, count, t == EmissionTechnique::Segment);
+        add_contribution(Axis::Second, f_over_ref, p_collision, p_segment, p_nee, count, pilot_.emission_segment,
+                         t == EmissionTechnique::Segment);
     }
     /// Called by BdptEstimator for every strategy's contribution (see detail::record_bdpt): at
     /// NEE count c_n and light subpath count c_l it is x = u / (p_fixed + c_n p_nee + c_l p_light),
@@ -166,8 +186,9 @@ public:
         set_second(Second::LightSubpath);
         nee_zero_refused_ = true;  // BDPT's NEE count stays above 0 (see the class comment)
         if (nee_count != 1.f || light_count != 1.f) invalid_ = true;
+        if (pilot_.nee != 1.f || pilot_.emission_segment != 1.f) invalid_ = true;
         double v1 = 0.0, d1 = 0.0;
-        if (!at_counts_1(f_over_ref, p_fixed, p_nee, p_light, v1, d1)) return;
+        if (!at_pilot(f_over_ref, p_fixed, p_nee, p_light, 1.0, v1, d1)) return;
         const double u = f_over_ref, h = p_fixed, n = p_nee, l = p_light;
         for (int jn = 0; jn < kCandidates; ++jn)
             for (int jl = 0; jl < kCandidates; ++jl) {
@@ -204,7 +225,8 @@ public:
     }
     /// Called by the estimator after each NEE shadow walk with the work (work()) it took;
     /// `counted`: the walk runs with the NEE count, so its share of the cost scales with it (the
-    /// walks from equiangular vertices run at any count: their work stays in the base).
+    /// walks from equiangular vertices run at any count: their work stays in the base). The
+    /// counted walks' work, measured at the pilot's count, scales by candidate / pilot count.
     void record_shadow_walk(double w, bool counted) noexcept {
         if (counted) nee_work_ += w + costs_.per_shadow_walk;
         fixed_work_ += costs_.per_shadow_walk;
@@ -266,6 +288,9 @@ public:
 
     /// Adds another learner's statistics (a tile learned in pieces; both after end_pixel).
     void merge(const NeeCountLearner& o) noexcept {
+        // Pilots at different counts do not pool (their work scales differently).
+        if (o.samples_ > 0 && (o.pilot_.nee != pilot_.nee || o.pilot_.emission_segment != pilot_.emission_segment))
+            invalid_ = true;
         lookups_ += o.lookups_;
         steps_ += o.steps_;
         fixed_work_ += o.fixed_work_;
@@ -298,7 +323,7 @@ public:
         const std::size_t k = pair(j, js);
         const double a = variance_samples_ > 0 ? variance_sum_[k] / double(variance_samples_) : 0.0;
         const double b = samples_ > 0 ? bernoulli_[k] / double(samples_) : 0.0;
-        return a + b;
+        return std::max(a + b, 0.0);  // below 0 only by noise, with a pilot at a count below 1
     }
     /// Predicted work per sample at NEE candidate j and second candidate js, in lookups: lookups
     /// and DDA steps (work()), with each counted technique's share (its walks' work and its
@@ -307,7 +332,10 @@ public:
     double predicted_cost(int j, int js = 0) const noexcept {
         if (samples_ == 0) return 1.0;
         const double base = work() + fixed_work_ - nee_work_ - second_work_;
-        return (base + double(candidate(j)) * nee_work_ + double(candidate(js)) * second_work_) / double(samples_) +
+        const double second_pilot = second_ == Second::Segment ? double(pilot_.emission_segment) : 1.0;
+        return (base + double(candidate(j)) / double(pilot_.nee) * nee_work_ +
+                double(candidate(js)) / second_pilot * second_work_) /
+                   double(samples_) +
                costs_.per_sample;
     }
 
@@ -511,14 +539,15 @@ private:
         return mean + kSignificance * se < 0.0;
     }
 
-    /// A recorded contribution u at counts 1: its balance denominator d1 = a + b + c and its value
-    /// v1 = u / d1; false where it cannot enter the prediction (a negative or NaN pdf, u zero or
-    /// not finite, no or an infinite denominator).
-    static bool at_counts_1(float u, float a, float b, float c, double& v1, double& d1) noexcept {
+    /// A recorded contribution u at the pilot's count `cp` of the technique of pdf b: its balance
+    /// denominator dp = a + cp b + c and its value in the pilot's estimate vp = u / dp; false
+    /// where it cannot enter the prediction (a negative or NaN pdf, u zero or not finite, no or an
+    /// infinite denominator).
+    static bool at_pilot(float u, float a, float b, float c, double cp, double& vp, double& dp) noexcept {
         if (!(a >= 0.f && b >= 0.f && c >= 0.f) || !std::isfinite(u) || u == 0.f) return false;
-        d1 = double(a) + double(b) + double(c);
-        if (!(d1 > 0.0) || !std::isfinite(d1)) return false;
-        v1 = double(u) / d1;
+        dp = double(a) + cp * double(b) + double(c);
+        if (!(dp > 0.0) || !std::isfinite(dp)) return false;
+        vp = double(u) / dp;
         return true;
     }
 
@@ -531,11 +560,17 @@ private:
     /// counted technique's where it runs (its weight c n / D over its count c): B x with B a
     /// Bernoulli draw of mean c, whose expectation c x and variance c (1 - c) x^2 go to A and B.
     /// It depends on one axis's count: every pair with that candidate gets the same terms.
+    ///
+    /// A pilot at count cp < 1 has the counted technique's draw with probability cp: each term
+    /// of such a draw is divided by cp (unbiased over the pilot's draws), and the variance
+    /// the pilot's own draw adds to the re-weighted estimate, c^2 (1 - cp) / cp x^2 in
+    /// expectation, is taken out of B by its unbiased estimate c^2 (1 - cp) / cp^2 x^2.
     void add_contribution(Axis axis, float f_over_ref, float p_fixed, float p_counted, float p_other, float count,
-                          bool drawn_by_counted) noexcept {
-        if (count != 1.f) invalid_ = true;
-        double v1 = 0.0, d1 = 0.0;
-        if (!at_counts_1(f_over_ref, p_fixed, p_counted, p_other, v1, d1)) return;
+                          float pilot_count, bool drawn_by_counted) noexcept {
+        if (count != pilot_count) invalid_ = true;
+        const double cp = pilot_count;
+        double v1 = 0.0, d1 = 0.0;  // at the pilot's count
+        if (!at_pilot(f_over_ref, p_fixed, p_counted, p_other, cp, v1, d1)) return;
         const double u = f_over_ref, h = p_fixed, n = p_counted, o = p_other;
         for (int j = 0; j < kCandidates; ++j) {
             const double c = candidate(j), d = h + c * n + o;
@@ -548,10 +583,11 @@ private:
             // Its expectation over the techniques is int f^2 / D(c), which u^2 / (D(1) D(c)) from
             // any technique's draw estimates too, with far less noise where the drawing technique
             // is the rare one; the difference goes into `diagonal` (expectation 0).
-            const double own = drawn_by_counted ? c * x * x : x * x;
+            const double own = drawn_by_counted ? c / cp * x * x : x * x;
             const double diagonal = (d > 0.0 ? u * u / (d1 * d) : 0.0) - own;
-            const double delta = drawn_by_counted ? c * x - v1 : x - v1;
-            const double bernoulli = drawn_by_counted ? c * (1.0 - c) * x * x : 0.0;
+            const double delta = drawn_by_counted ? c / cp * x - v1 : x - v1;
+            const double bernoulli =
+                drawn_by_counted ? (c * (1.0 - c) / cp - c * c * (1.0 - cp) / (cp * cp)) * x * x : 0.0;
             for (int i = 0; i < kCandidates; ++i) {
                 const std::size_t k = axis == Axis::Nee ? pair(j, i) : pair(i, j);
                 path_diagonal_[k] += diagonal;
@@ -567,6 +603,7 @@ private:
     bool invalid_ = false, nee_zero_refused_ = false;
     std::uint64_t lost_ = 0;  // a bit per pair: a recorded contribution's denominator is 0 there
     CostModel costs_;
+    TechniqueCounts pilot_;
     Second second_ = Second::None;
     // The current sample, per pair: the change of its estimate from count 1, its Bernoulli
     // variance (and splats' second moments), its diagonal correction, its light subpath's
