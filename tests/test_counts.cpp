@@ -840,6 +840,24 @@ TEST_CASE("NeeCountLearner: bookkeeping") {
         NeeCountLearner merged = l;
         merged.merge(refused);
         CHECK_FALSE(merged.allowed(kZero));
+        CHECK_FALSE(merged.invalid_pilot());
+        // Learners of different pilot counts or cost units do not pool.
+        TechniqueCounts quarter;
+        quarter.nee = 0.25f;
+        NeeCountLearner other_pilot({}, quarter);
+        pilot(other_pilot, false);  // its records at count 1 make it invalid by itself too
+        NeeCountLearner pooled = l;
+        pooled.merge(other_pilot);
+        CHECK(pooled.invalid_pilot());
+        CostModel seconds;
+        seconds.per_lookup = 2e-8;
+        NeeCountLearner other_costs(seconds);
+        pilot(other_costs, false);
+        CHECK_FALSE(other_costs.invalid_pilot());
+        NeeCountLearner pooled_costs = l;
+        pooled_costs.merge(other_costs);
+        CHECK(pooled_costs.invalid_pilot());
+        CHECK(pooled_costs.choose() == 1.f);
         // One contribution only NEE can make: never 0, whatever it saves.
         NeeCountLearner lost;
         pilot(lost, true);

@@ -26,9 +26,10 @@
 // cost being the host's CostModel of density lookups, DDA steps and technique runs (by default in
 // lookups: deterministic, unlike time) with the shadow walks' share scaled by n (THEORY 5.9).
 // Count 0 is a candidate only where no pilot contribution needs the technique (its balance
-// denominator without it is 0, as for a point light) and the scene allows it (no delta lights). Volume emission is the same with the
-// collision estimator in tracking's place and the segment technique in NEE's (NEE toward the
-// volume at a fixed count): the learner keeps both ladders and picks the pair of counts. Under
+// denominator without it is 0, as for a point light) and the scene allows it (no delta lights).
+// A pilot may also run below count 1 (NeeCountLearner::pilot_counts). Volume emission is the
+// same with the collision estimator in tracking's place and the segment technique in NEE's (NEE
+// toward the volume at a fixed count): the learner keeps both ladders and picks the pair. Under
 // BdptEstimator the pair is NEE's count and the light subpath probability: every strategy's
 // contribution is u / (p_fixed + n p_nee + c p_light) at counts (n, c), the NEE draws independent
 // per camera vertex, the light subpath one draw for all of its connections and splats.
@@ -286,10 +287,17 @@ public:
         pixel_sum2_ = {};
     }
 
-    /// Adds another learner's statistics (a tile learned in pieces; both after end_pixel).
+    /// Adds another learner's statistics (a tile learned in pieces; both after end_pixel). Both
+    /// must have the same pilot counts and costs, else the result is invalid_pilot().
     void merge(const NeeCountLearner& o) noexcept {
-        // Pilots at different counts do not pool (their work scales differently).
-        if (o.samples_ > 0 && (o.pilot_.nee != pilot_.nee || o.pilot_.emission_segment != pilot_.emission_segment))
+        // Pilots at different counts or in different cost units do not pool.
+        const CostModel& a = costs_;
+        const CostModel& b = o.costs_;
+        if (o.samples_ > 0 &&
+            (o.pilot_.nee != pilot_.nee || o.pilot_.emission_segment != pilot_.emission_segment ||
+             a.per_sample != b.per_sample || a.per_lookup != b.per_lookup || a.per_dda_step != b.per_dda_step ||
+             a.per_shadow_walk != b.per_shadow_walk || a.per_segment_walk != b.per_segment_walk ||
+             a.per_light_walk != b.per_light_walk))
             invalid_ = true;
         lookups_ += o.lookups_;
         steps_ += o.steps_;
