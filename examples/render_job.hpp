@@ -55,7 +55,7 @@ struct RenderRequest {
     /// The pilot's samples per pixel: spp / 32, at least 2 (a pixel's sample variance needs two)
     /// and at most 16 (a 16x16 tile then learns from 512 to 4096 samples; the pilot costs 1/32 of
     /// the render at full NEE cost).
-    static int pilot_spp(int spp) { return std::min(spp, std::clamp(spp / 32, 2, 16)); }
+    static int pilot_spp(int spp) { return nsp::TileCounts::pilot_spp(spp); }
     /// The pilot's NEE and emission segment count (nsp::NeeCountLearner::pilot_counts): below 1
     /// the pilot costs less and still predicts every candidate without bias (--pilot-count).
     float pilot_count = 1.f;

@@ -240,40 +240,35 @@ RenderStats render(const typename C::Scene& scene, const RenderRequest& rq, std:
             pilot_options.nee_count = pilot_counts.nee;
             pilot_options.emission_segment_count = pilot_counts.emission_segment;
             const Estimator pilot_estimator{pilot_options};
-            const int ts = rq.tile_size, tiles_x = (w + ts - 1) / ts, tiles_y = (h + ts - 1) / ts;
+            // The protocol of docs/integration.md (nsp::TileCounts): slot j learns tiles j, j +
+            // kSlots, ... in order (threads take whole slots), so the counts do not depend on the
+            // thread count; a tile keeps its own counts where its pilot shows they pay, else it
+            // takes the image's where its pilot predicts them no worse than counts 1.
+            nsp::TileCounts plan(w, h, rq.tile_size, {}, pilot_counts);
             const int pilot = RenderRequest::pilot_spp(rq.spp);
             std::vector<PixelState> px(std::size_t(w) * std::size_t(h));
             for (std::size_t p = 0; p < px.size(); ++p) px[p].rng = nsp::Pcg32(rq.seed, p);
             constexpr bool kEmissive = C::MediumKind::emissive;
-            st.nee_counts.assign(std::size_t(tiles_x) * std::size_t(tiles_y), 1.f);
+            const int n_tiles = plan.tile_count();
+            st.nee_counts.assign(std::size_t(n_tiles), 1.f);
             st.pilot_count = rq.pilot_count;
             if (kEmissive) st.segment_counts.assign(st.nee_counts.size(), 1.f);
-            // Slot j learns tiles j, j + kSlots, ... in order (threads take whole slots) and merges
-            // their learners, so the image's counts do not depend on the thread count. A tile
-            // keeps its own counts where its pilot shows they pay, else it takes the image's
-            // where its pilot predicts them no worse than counts 1 (NeeCountLearner::Summary).
-            constexpr int kSlots = 16;
-            const int n_tiles = tiles_x * tiles_y;
-            std::vector<nsp::NeeCountLearner> slots(static_cast<std::size_t>(kSlots),
-                                                    nsp::NeeCountLearner({}, pilot_counts));
-            std::vector<nsp::NeeCountLearner::Summary> summaries(static_cast<std::size_t>(n_tiles));
             std::atomic<int> next_slot{0};
             auto pilot_work = [&](ThreadTotals& out) {
                 ThreadTotals t;
                 const double cpu0 = thread_cpu_seconds();
-                for (int j; (j = next_slot.fetch_add(1)) < kSlots;)
-                    for (int tile = j; tile < n_tiles; tile += kSlots) {
-                        nsp::NeeCountLearner learner({}, pilot_counts);
-                        const int x0 = (tile % tiles_x) * ts, y0 = (tile / tiles_x) * ts;
-                        for (int y = y0; y < std::min(h, y0 + ts); ++y)
-                            for (int x = x0; x < std::min(w, x0 + ts); ++x) {
+                for (int j; (j = next_slot.fetch_add(1)) < nsp::TileCounts::kSlots;)
+                    for (const int tile : plan.slot_tiles(j)) {
+                        nsp::NeeCountLearner learner = plan.learner();
+                        const nsp::TileCounts::Rect r = plan.tile_rect(tile);
+                        for (int y = r.y0; y < r.y1; ++y)
+                            for (int x = r.x0; x < r.x1; ++x) {
                                 PixelState& state = px[std::size_t(y) * std::size_t(w) + std::size_t(x)];
                                 for (int k = 0; k < pilot; ++k)
                                     learner.end_sample(sample(pilot_estimator, learner, state, x, y, t));
                                 learner.end_pixel();
                             }
-                        summaries[std::size_t(tile)] = learner.summary();
-                        slots[std::size_t(j)].merge(learner);
+                        plan.add(tile, learner);
                         t.counter.n += learner.count();
                         t.counter.steps += learner.steps();
                     }
@@ -281,12 +276,9 @@ RenderStats render(const typename C::Scene& scene, const RenderRequest& rq, std:
                 out = t;
             };
             run_pool(pilot_work, pilot_totals);
-            nsp::NeeCountLearner image({}, pilot_counts);
-            for (const nsp::NeeCountLearner& l : slots) image.merge(l);
-            const nsp::TechniqueCounts image_counts = image.choose_counts();
+            plan.choose();
             for (int tile = 0; tile < n_tiles; ++tile) {
-                const nsp::TechniqueCounts n =
-                    nsp::NeeCountLearner::choose_counts(summaries[std::size_t(tile)], image_counts);
+                const nsp::TechniqueCounts& n = plan.counts(tile);
                 st.nee_counts[std::size_t(tile)] = n.nee;
                 if (kEmissive) st.segment_counts[std::size_t(tile)] = n.emission_segment;
             }
@@ -307,7 +299,7 @@ RenderStats render(const typename C::Scene& scene, const RenderRequest& rq, std:
                 for (int y; (y = next_row.fetch_add(1)) < h;) {
                     for (int x = 0; x < w; ++x) {
                         const std::size_t pixel = std::size_t(y) * std::size_t(w) + std::size_t(x);
-                        const std::size_t tile = std::size_t((y / ts) * tiles_x + x / ts);
+                        const std::size_t tile = std::size_t(plan.tile_at(x, y));
                         const int js = kEmissive ? nsp::NeeCountLearner::candidate_index(st.segment_counts[tile]) : 0;
                         const Estimator& est =
                             at_count[std::size_t(nsp::NeeCountLearner::candidate_index(st.nee_counts[tile]) * kS + js)];

@@ -1073,6 +1073,84 @@ TEST_CASE("NeeCountLearner: bookkeeping") {
     }
 }
 
+TEST_CASE("TileCounts: the host protocol gives every tile the counts of the manual one, whatever the order of slots") {
+    // 6 x 4 tiles of 16 pixels (24 tiles, so slots 0-7 hold two): synthetic pilots as in the
+    // fallback test above (a light tracking finds as well as NEE, NEE's walk most of a sample's
+    // work), every third tile with a light only NEE finds. The protocol's counts against the
+    // manual protocol of docs/integration.md (slots merged in order, the image's choice as the
+    // fallback), with the slots added in two different orders: the same counts and the same
+    // image predictions to the bit.
+    auto pilot = [](NeeCountLearner& l, int t) {
+        for (int i = 0; i < 8; ++i) {
+            const bool only_nee = t % 3 == 0 && i == 3;
+            const float u = 0.5f + 0.25f * float((i * 7 + t) % 5);
+            for (int k = 0; k < 21; ++k) l.lookup();
+            if (!only_nee) l.record_light(u, 1.f, 1.f, 0.f, 1.f, LightTechnique::Hit);
+            l.record_light(u, only_nee ? 0.f : 1.f, 1.f, 0.f, 1.f, LightTechnique::Nee);
+            l.record_shadow_walk(20.0, true);
+            l.end_sample(double(u));
+            if (i % 2 == 1) l.end_pixel();
+        }
+    };
+    auto run = [&](const std::vector<int>& slot_order) {
+        TileCounts tc(96, 64, 16);
+        for (const int j : slot_order)
+            for (const int t : tc.slot_tiles(j)) {
+                NeeCountLearner l = tc.learner();
+                pilot(l, t);
+                tc.add(t, l);
+            }
+        tc.choose();
+        return tc;
+    };
+    std::vector<int> forward(TileCounts::kSlots), backward(TileCounts::kSlots);
+    for (int j = 0; j < TileCounts::kSlots; ++j) forward[std::size_t(j)] = j, backward[std::size_t(j)] = TileCounts::kSlots - 1 - j;
+    const TileCounts a = run(forward), b = run(backward);
+    REQUIRE(a.tile_count() == 24);
+    CHECK(a.tile_at(95, 63) == 23);
+    CHECK(a.tile_rect(23).x1 == 96);
+    // The manual protocol.
+    std::vector<NeeCountLearner> slots(TileCounts::kSlots);
+    std::vector<NeeCountLearner::Summary> summaries(24);
+    for (int t = 0; t < 24; ++t) {
+        NeeCountLearner l;
+        pilot(l, t);
+        summaries[std::size_t(t)] = l.summary();
+        slots[std::size_t(t % TileCounts::kSlots)].merge(l);
+    }
+    NeeCountLearner image;
+    for (const NeeCountLearner& l : slots) image.merge(l);
+    const TechniqueCounts image_counts = image.choose_counts();
+    CHECK(a.image_counts().nee == image_counts.nee);
+    CHECK(a.image().predicted_variance(3) == image.predicted_variance(3));
+    CHECK(b.image().predicted_variance(3) == a.image().predicted_variance(3));
+    int own = 0, from_image = 0, ones = 0;
+    for (int t = 0; t < 24; ++t) {
+        CAPTURE(t);
+        const TechniqueCounts manual = NeeCountLearner::choose_counts(summaries[std::size_t(t)], image_counts);
+        CHECK(a.counts(t).nee == manual.nee);
+        CHECK(b.counts(t).nee == manual.nee);
+        CHECK(a.source(t) == b.source(t));
+        (a.source(t) == TileCounts::Source::Own ? own : a.source(t) == TileCounts::Source::Image ? from_image : ones)++;
+        // A tile with a light only NEE finds never takes count 0.
+        if (t % 3 == 0) CHECK(a.counts(t).nee != 0.f);
+    }
+    MESSAGE("TileCounts: image NEE count " << image_counts.nee << "; tiles: " << own << " own, " << from_image
+                                           << " the image's, " << ones << " kept at 1");
+    CHECK(own + from_image + ones == 24);
+    // Misuse is refused by name.
+    TileCounts tc(96, 64, 16);
+    NeeCountLearner l = tc.learner();
+    pilot(l, 17);
+    CHECK_THROWS_WITH_AS(tc.add(17, l), doctest::Contains("out of order; slot 1 expects tile 1"), std::logic_error);
+    CHECK_THROWS_WITH_AS(tc.add(24, l), doctest::Contains("tile 24 is not in [0, 24)"), InvalidArgument);
+    CHECK_THROWS_WITH_AS(tc.choose(), doctest::Contains("tile 0 was not added"), std::logic_error);
+    CHECK_THROWS_WITH_AS(TileCounts(0, 64), doctest::Contains("width is 0"), InvalidArgument);
+    CHECK(TileCounts::pilot_spp(256) == 8);
+    CHECK(TileCounts::pilot_spp(2) == 2);
+    CHECK(TileCounts::pilot_spp(4096) == 16);
+}
+
 TEST_CASE("NEE counts: a count outside [0, 1] is rejected by name, by BDPT too; 0 where NEE is a strategy's only way") {
     for (const float bad : {-0.5f, 1.5f, std::nanf("")}) {
         CAPTURE(bad);

@@ -37,5 +37,6 @@
 #include "scene.hpp"
 #include "spectrum.hpp"
 #include "surface_scene.hpp"
+#include "tile_counts.hpp"
 #include "tracking.hpp"
 #include "vertex.hpp"
