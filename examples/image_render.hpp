@@ -41,42 +41,34 @@ auto count_ladder(Make make) {
     return ladder;
 }
 
-/// The pilot of render_pixels and render_splatting: an nsp::NeeCountLearner per tile x tile tile
-/// of the res x res image, `pilot_pixel(out, learner, x, y)` running pixel (x, y)'s pilot samples
-/// with it as their counter (and end_sample after each). Slot j learns tiles j, j + kSlots, ...
-/// in order and merges their learners, threads taking whole slots (`run_pool(work)` runs
-/// work(Out&) on each thread's totals), so the result does not depend on the thread count. Each
-/// tile's Summary goes to `summaries` (when given, n_tiles entries); each tile's lookups, steps
-/// and the thread CPU time to the thread's totals. Returns every tile's learner merged.
+/// The pilot of render_pixels and render_splatting on `plan` (nsp::TileCounts, the protocol of
+/// docs/integration.md): threads take whole slots (`run_pool(work)` runs work(Out&) on each
+/// thread's totals), a slot's tiles in order, so the counts do not depend on the thread count;
+/// `pilot_pixel(out, learner, x, y)` runs pixel (x, y)'s pilot samples with the tile's learner as
+/// their counter (and end_sample after each). Each tile's lookups, steps and the thread CPU time
+/// go to the thread's totals. Ends with plan.choose().
 template <class Out, class Pool, class PilotPixel>
-nsp::NeeCountLearner learn_tiles(int res, int tile, Pool&& run_pool, PilotPixel&& pilot_pixel,
-                                 std::vector<nsp::NeeCountLearner::Summary>* summaries) {
-    constexpr int kSlots = 16;
-    const int tiles_x = (res + tile - 1) / tile, n_tiles = tiles_x * tiles_x;
-    std::vector<nsp::NeeCountLearner> slots(static_cast<std::size_t>(kSlots));
+void learn_tiles(nsp::TileCounts& plan, Pool&& run_pool, PilotPixel&& pilot_pixel) {
     std::atomic<int> next_slot{0};
     auto learn = [&](Out& out) {
         const double cpu0 = thread_cpu_seconds();
-        for (int j; (j = next_slot.fetch_add(1)) < kSlots;)
-            for (int t = j; t < n_tiles; t += kSlots) {
-                nsp::NeeCountLearner learner;
-                const int x0 = (t % tiles_x) * tile, y0 = (t / tiles_x) * tile;
-                for (int y = y0; y < std::min(res, y0 + tile); ++y)
-                    for (int x = x0; x < std::min(res, x0 + tile); ++x) {
+        for (int j; (j = next_slot.fetch_add(1)) < nsp::TileCounts::kSlots;)
+            for (const int t : plan.slot_tiles(j)) {
+                nsp::NeeCountLearner learner = plan.learner();
+                const nsp::TileCounts::Rect r = plan.tile_rect(t);
+                for (int y = r.y0; y < r.y1; ++y)
+                    for (int x = r.x0; x < r.x1; ++x) {
                         pilot_pixel(out, learner, x, y);
                         learner.end_pixel();
                     }
-                if (summaries) (*summaries)[std::size_t(t)] = learner.summary();
-                slots[std::size_t(j)].merge(learner);
+                plan.add(t, learner);
                 out.lookups += learner.count();
                 out.steps += learner.steps();
             }
         out.cpu += thread_cpu_seconds() - cpu0;
     };
     run_pool(learn);
-    nsp::NeeCountLearner all;
-    for (const nsp::NeeCountLearner& l : slots) all.merge(l);
-    return all;
+    plan.choose();
 }
 
 /// The core of render_image and render_image_learned: `ladder` holds the estimator at every
@@ -140,17 +132,13 @@ Row render_pixels(const Sc& scene, const std::vector<E>& ladder, const std::stri
     const int first = std::min(pilot, spp);
     if (first > 0) {
         // Each tile keeps its own counts where its pilot shows they pay, else takes the image's
-        // where its pilot predicts them no worse than counts 1 (NeeCountLearner::Summary).
-        std::vector<nsp::NeeCountLearner::Summary> summaries(static_cast<std::size_t>(n_tiles));
-        const nsp::NeeCountLearner image = learn_tiles<Totals>(
-            res, kTile, run_pool,
-            [&](Totals& out, nsp::NeeCountLearner& learner, int x, int y) {
-                run_samples(out, ladder[0], learner, x, y, first, [&](double v) { learner.end_sample(v); });
-            },
-            &summaries);
-        const nsp::TechniqueCounts image_counts = image.choose_counts();
+        // where its pilot predicts them no worse than counts 1 (nsp::TileCounts).
+        nsp::TileCounts plan(res, res, kTile);
+        learn_tiles<Totals>(plan, run_pool, [&](Totals& out, nsp::NeeCountLearner& learner, int x, int y) {
+            run_samples(out, ladder[0], learner, x, y, first, [&](double v) { learner.end_sample(v); });
+        });
         for (int t = 0; t < n_tiles; ++t) {
-            const nsp::TechniqueCounts c = nsp::NeeCountLearner::choose_counts(summaries[std::size_t(t)], image_counts);
+            const nsp::TechniqueCounts& c = plan.counts(t);
             if (chosen) (*chosen)[std::size_t(t)] = c;
             if (ladder.size() == std::size_t(kC * kC))
                 tile_pair[std::size_t(t)] = std::size_t(nsp::NeeCountLearner::candidate_index(c.nee) * kC +
@@ -287,13 +275,11 @@ Row render_splatting(const Sc& scene, const std::vector<E>& ladder, const Cam& c
     };
     const int first = std::min(pilot, spp);
     if (first > 0) {
-        const nsp::NeeCountLearner all = learn_tiles<Buffers>(
-            res, kTile, run_pool,
-            [&](Buffers& out, nsp::NeeCountLearner& learner, int x, int y) {
-                run_samples(out, ladder[0], learner, x, y, 0, first, [&](double v) { learner.end_sample(v); });
-            },
-            nullptr);
-        const nsp::TechniqueCounts c = all.choose_counts();
+        nsp::TileCounts plan(res, res, kTile);
+        learn_tiles<Buffers>(plan, run_pool, [&](Buffers& out, nsp::NeeCountLearner& learner, int x, int y) {
+            run_samples(out, ladder[0], learner, x, y, 0, first, [&](double v) { learner.end_sample(v); });
+        });
+        const nsp::TechniqueCounts c = plan.image_counts();
         if (chosen) *chosen = c;
         if (ladder.size() == std::size_t(kC * kC))
             pair = std::size_t(nsp::NeeCountLearner::candidate_index(c.nee) * kC +

@@ -57,6 +57,7 @@ struct TechniqueCounts {
     float nee = 1.f;
     float emission_segment = 1.f;
     float light_subpath = 1.f;
+    bool operator==(const TechniqueCounts&) const = default;
 };
 
 /// What a host's work costs the learner's prediction, in the host's own unit (seconds, lookups,
@@ -73,6 +74,7 @@ struct CostModel {
     double per_shadow_walk = 1.0;
     double per_segment_walk = 1.0;
     double per_light_walk = 1.0;
+    bool operator==(const CostModel&) const = default;
 };
 
 /// Learns a tile's expected counts from pilot samples rendered at counts 1 with the learner as
@@ -291,14 +293,7 @@ public:
     /// must have the same pilot counts and costs, else the result is invalid_pilot().
     void merge(const NeeCountLearner& o) noexcept {
         // Pilots at different counts or in different cost units do not pool.
-        const CostModel& a = costs_;
-        const CostModel& b = o.costs_;
-        if (o.samples_ > 0 &&
-            (o.pilot_.nee != pilot_.nee || o.pilot_.emission_segment != pilot_.emission_segment ||
-             a.per_sample != b.per_sample || a.per_lookup != b.per_lookup || a.per_dda_step != b.per_dda_step ||
-             a.per_shadow_walk != b.per_shadow_walk || a.per_segment_walk != b.per_segment_walk ||
-             a.per_light_walk != b.per_light_walk))
-            invalid_ = true;
+        if (o.samples_ > 0 && (!(o.pilot_ == pilot_) || !(o.costs_ == costs_))) invalid_ = true;
         lookups_ += o.lookups_;
         steps_ += o.steps_;
         fixed_work_ += o.fixed_work_;

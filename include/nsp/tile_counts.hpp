@@ -125,9 +125,9 @@ public:
             const NeeCountLearner::Summary& s = summaries_[std::size_t(t)];
             const TechniqueCounts c = NeeCountLearner::choose_counts(s, image_counts_);
             counts_[std::size_t(t)] = c;
-            sources_[std::size_t(t)] = !s.open                         ? Source::Own
-                                       : same(c, TechniqueCounts{}) ? Source::CountsOne
-                                                                      : Source::Image;
+            sources_[std::size_t(t)] = !s.open                  ? Source::Own
+                                       : c == TechniqueCounts{} ? Source::CountsOne
+                                                                : Source::Image;
         }
         chosen_ = true;
     }
@@ -143,10 +143,6 @@ public:
     const NeeCountLearner::Summary& summary(int t) const { return summaries_.at(std::size_t(t)); }
 
 private:
-    static bool same(const TechniqueCounts& a, const TechniqueCounts& b) noexcept {
-        return a.nee == b.nee && a.emission_segment == b.emission_segment && a.light_subpath == b.light_subpath;
-    }
-
     int width_, height_, tile_, tiles_x_ = 0, tiles_y_ = 0;
     CostModel costs_;
     TechniqueCounts pilot_;
