@@ -1151,6 +1151,128 @@ TEST_CASE("TileCounts: the host protocol gives every tile the counts of the manu
     CHECK(TileCounts::pilot_spp(4096) == 16);
 }
 
+TEST_CASE("TileCounts: a pilot learned in halves weighs each pixel by the other half's predictions") {
+    // Synthetic pilots (a light tracking finds as well as NEE, NEE's walk most of the work; in
+    // the odd half of tile 1 a second, noisier one): pilot_weight(x, y) is the inverse-variance
+    // weight n_p V_c / (n_p V_c + n_r V_p) from the *other* half's predicted variance at the
+    // pilot's counts (1) and the tile's chosen counts, so a pixel's weight does not depend on its
+    // own samples; a tile added whole, or a pixel with fewer than 2 samples on a side, weighs
+    // every sample the same.
+    auto pilot = [](NeeCountLearner& l, int t, double spread) {
+        for (int i = 0; i < 16; ++i) {
+            // tracking's and NEE's estimates, NEE's the noisier: its count 1 halves tracking's
+            // noise and adds a quarter of its own
+            const float hit = 0.5f + float(spread) * float((i * 7 + t) % 5 - 2);
+            const float nee = 0.5f + 3.f * float(spread) * float((i * 3 + 1) % 4) - 4.5f * float(spread);
+            for (int k = 0; k < 21; ++k) l.lookup();
+            l.record_light(2.f * hit, 1.f, 1.f, 0.f, 1.f, LightTechnique::Hit);
+            l.record_light(2.f * nee, 1.f, 1.f, 0.f, 1.f, LightTechnique::Nee);
+            l.record_shadow_walk(20.0, true);
+            l.end_sample(double(hit) + double(nee));
+            if (i % 4 == 3) l.end_pixel();
+        }
+    };
+    TileCounts tc(32, 16, 16);
+    CHECK(tc.tile_count() == 2);
+    NeeCountLearner even = tc.learner(), odd = tc.learner(), whole = tc.learner();
+    pilot(even, 0, 0.05);
+    pilot(odd, 0, 0.08);  // the halves differ: each pixel's weight shows which half it came from
+    pilot(whole, 1, 0.05);
+    pilot(whole, 1, 0.1);
+    tc.add(0, even, odd);
+    CHECK(tc.pilot_weight(3, 4, 2, 16) == doctest::Approx(2.0 / 16.0));  // before choose(): equal
+    tc.add(1, whole);
+    tc.choose();
+    const TechniqueCounts c = tc.counts(0);
+    REQUIRE(c.nee < 1.f);  // the tile learned a count below the pilot's
+    const int jn = NeeCountLearner::candidate_index(c.nee);
+    auto expected = [&](const NeeCountLearner& other, int np, int nr) {
+        const double vp = other.predicted_variance(0, 0), vc = other.predicted_variance(jn, 0);
+        return double(np) * vc / (double(np) * vc + double(nr) * vp);
+    };
+    CHECK(tc.pilot_weight(3, 5, 2, 16) == doctest::Approx(expected(odd, 2, 14)));  // x + y even: odd's
+    CHECK(tc.pilot_weight(3, 4, 2, 16) == doctest::Approx(expected(even, 2, 14)));
+    CHECK(tc.pilot_weight(3, 4, 4, 64) == doctest::Approx(expected(even, 4, 60)));
+    CHECK(tc.pilot_weight(3, 4, 2, 16) != doctest::Approx(2.0 / 16.0));  // the weight is not trivial
+    CHECK(tc.pilot_weight(3, 4, 2, 16) != doctest::Approx(tc.pilot_weight(3, 5, 2, 16)));
+    CHECK(tc.pilot_weight(20, 4, 2, 16) == doctest::Approx(2.0 / 16.0));   // tile 1: added whole
+    CHECK(tc.pilot_weight(3, 4, 2, 3) == doctest::Approx(2.0 / 3.0));      // one sample after the pilot
+    CHECK(tc.pilot_weight(3, 4, 1, 16) == doctest::Approx(1.0 / 16.0));    // one sample in it
+    CHECK_THROWS_WITH_AS(tc.pilot_weight(3, 4, 17, 16), doctest::Contains("pilot_samples is 17; it must be in [0, spp = 16]"),
+                         InvalidArgument);
+}
+
+TEST_CASE("TileCounts: pixels weighted by pilot_weight after a pilot at count 1/4 give the furnace's 1") {
+    // The white furnace (albedo 1, unit sky: L = 1 along every ray) through a 32 x 32 image of
+    // parallel rays, the protocol of docs/integration.md with a pilot at NEE count 1/4 learned in
+    // halves: each pixel's estimate a m_pilot + (1 - a) m_rest with a = pilot_weight. Its mean
+    // over the pixels is 1 within 5 standard errors, the SE from each pixel's own variance
+    // a^2 s_p^2 / n_p + (1 - a)^2 s_r^2 / n_r (pixels independent); fixed seeds.
+    using M = DenseGridMedium<Mono>;
+    const Box box{Vec3(-1.f), Vec3(1.f)};
+    Lights<Mono> lights;
+    lights.set(EnvironmentLight<Mono>{grey<Mono>(1.f)});
+    const auto medium = make_medium<M>(box, 1.f, grey<Mono>(0.f), grey<Mono>(1.f), 42);
+    const Scene scene(medium, GlobalMajorant<M>(medium), HenyeyGreensteinPhase(0.5f), lights);
+    using Est = PathEstimator<strategy::NullScatteringMis, mis::Balance>;
+    constexpr int kW = 32, kSpp = 16;
+    TechniqueCounts pilot_counts;
+    pilot_counts.nee = 0.25f;
+    TileCounts tc(kW, kW, 16, {}, pilot_counts);
+    const int np = TileCounts::pilot_spp(kSpp), nr = kSpp - np;
+    auto ray_at = [](int x, int y) {
+        return Ray{Vec3(-3.f, -0.9f + 1.8f * (float(y) + 0.5f) / kW, -0.9f + 1.8f * (float(x) + 0.5f) / kW), Vec3(1.f, 0.f, 0.f)};
+    };
+    std::vector<Pcg32> rng;
+    for (int p = 0; p < kW * kW; ++p) rng.emplace_back(515, std::uint64_t(p));
+    std::vector<Stat> pilot_stat(kW * kW), rest_stat(kW * kW);
+    const Est pilot_est(with_count(0.25f));
+    for (int j = 0; j < TileCounts::kSlots; ++j)
+        for (const int t : tc.slot_tiles(j)) {
+            std::array<NeeCountLearner, 2> half{tc.learner(), tc.learner()};
+            const TileCounts::Rect r = tc.tile_rect(t);
+            for (int y = r.y0; y < r.y1; ++y)
+                for (int x = r.x0; x < r.x1; ++x) {
+                    NeeCountLearner& l = half[std::size_t((x + y) & 1)];
+                    for (int k = 0; k < np; ++k) {
+                        const auto res = pilot_est.radiance(scene, ray_at(x, y), {}, rng[std::size_t(y * kW + x)], l);
+                        REQUIRE(res.status == Status::Ok);
+                        pilot_stat[std::size_t(y * kW + x)].add(double(res.value[0]));
+                        l.end_sample(double(res.value[0]));
+                    }
+                    l.end_pixel();
+                }
+            tc.add(t, half[0], half[1]);
+        }
+    tc.choose();
+    Stat mean;
+    double var_sum = 0.0;
+    int weighted = 0;
+    LookupCount counter;
+    for (int y = 0; y < kW; ++y)
+        for (int x = 0; x < kW; ++x) {
+            const std::size_t p = std::size_t(y * kW + x);
+            const Est est(with_count(tc.counts(tc.tile_at(x, y)).nee));
+            for (int k = 0; k < nr; ++k) {
+                const auto res = est.radiance(scene, ray_at(x, y), {}, rng[p], counter);
+                REQUIRE(res.status == Status::Ok);
+                rest_stat[p].add(double(res.value[0]));
+            }
+            const double a = tc.pilot_weight(x, y, np, kSpp);
+            REQUIRE(a >= 0.0);
+            REQUIRE(a <= 1.0);
+            if (std::abs(a - double(np) / kSpp) > 0.01 * double(np) / kSpp) ++weighted;
+            mean.add(a * pilot_stat[p].mean + (1.0 - a) * rest_stat[p].mean);
+            var_sum += a * a * pilot_stat[p].variance() / np + (1.0 - a) * (1.0 - a) * rest_stat[p].variance() / nr;
+        }
+    const double se = std::sqrt(var_sum) / double(kW * kW);
+    MESSAGE("weighted furnace: mean " << mean.mean << " +- " << se << "; NEE counts " << tc.counts(0).nee << ", "
+                                      << tc.counts(3).nee << "; " << weighted << " of " << kW * kW
+                                      << " pixels weigh their pilot other than 1/8");
+    CHECK(weighted > 0);
+    CHECK(std::abs(mean.mean - 1.0) <= kSigmas * se + kRoundingFloor);
+}
+
 TEST_CASE("NEE counts: a count outside [0, 1] is rejected by name, by BDPT too; 0 where NEE is a strategy's only way") {
     for (const float bad : {-0.5f, 1.5f, std::nanf("")}) {
         CAPTURE(bad);
