@@ -175,8 +175,24 @@ Options parse_command_line(int argc, char** argv) {
     value("--width", "W", "image width", [&](std::string_view v) { o.width = parse_number<int>("--width", v, 1, 16384); });
     value("--height", "H", "image height",
           [&](std::string_view v) { o.height = parse_number<int>("--height", v, 1, 16384); });
-    value("--pilot-count", "C", "learned rows: run the pilot at NEE and segment count C in [1/64, 1] (default 1)",
+    value("--pilot-count", "C", "learned rows: run the pilot at NEE and segment count C in [1/64, 1] (default 0.25)",
           [&](std::string_view v) { o.pilot_count = parse_number<float>("--pilot-count", v, 1.f / 64.f, 1.f); });
+    value("--pilot-weight", "W",
+          "learned rows: a pixel's pilot samples weigh by the variance its tile predicts (variance, default) "
+          "or as much as its other samples (equal)",
+          [&](std::string_view v) {
+              if (v != "variance" && v != "equal")
+                  throw UsageError("--pilot-weight: expected variance or equal, got '" + std::string(v) + "'", true);
+              o.weigh_pilot = v == "variance";
+          });
+    value("--count-cost", "M",
+          "learned rows: the learner's cost, density lookups as LTUV counts them (lookups, default) or nsp's "
+          "default cost model (model)",
+          [&](std::string_view v) {
+              if (v != "lookups" && v != "model")
+                  throw UsageError("--count-cost: expected lookups or model, got '" + std::string(v) + "'", true);
+              o.lookup_costs = v == "lookups";
+          });
     value("--runs", "K", "render each row K times (seeds seed..seed+K-1), report medians",
           [&](std::string_view v) { o.runs = parse_number<int>("--runs", v, 1, 1000); });
     value("--reference-spp", "N", "effective variance against an N-spp reference (chromatic, fog, plume)",

@@ -19,7 +19,9 @@ struct Options {
     int threads = 1;                        ///< default: hardware concurrency
     std::uint64_t seed = 1;
     int runs = 1;
-    float pilot_count = 1.f;  ///< --pilot-count: the learned rows' pilot NEE and segment count
+    float pilot_count = 0.25f;  ///< --pilot-count: the learned rows' pilot NEE and segment count
+    bool weigh_pilot = true;  ///< --pilot-weight variance (true) or equal
+    bool lookup_costs = true; ///< --count-cost lookups (true) or model
     std::optional<int> reference_spp;  ///< --reference-spp: effective (error-based) variance
     nsp::EstimatorOptions estimator;   ///< max depth, equiangular and emission-segment settings
     std::string out = "out";

@@ -64,6 +64,8 @@ std::vector<Job> plan_jobs(const std::vector<TablePlan>& tables, const Options& 
         rq.seed = seed;
         rq.estimator = o.estimator;
         rq.pilot_count = o.pilot_count;
+        rq.weigh_pilot = o.weigh_pilot;
+        rq.lookup_costs = o.lookup_costs;
         rq.majorant = o.majorant;
         return rq;
     };

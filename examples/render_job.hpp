@@ -46,10 +46,10 @@ struct RenderRequest {
     std::string label;  ///< for the line shown in place while it renders (on a terminal)
     bool pixel_stats = false;  ///< also return every pixel's mean and sample variance (RenderStats)
     /// Learn the NEE count per tile (combinations with learns_nee_count only): the first
-    /// pilot_spp(spp) samples of every pixel at count 1 with an nsp::NeeCountLearner per
-    /// tile_size^2 tile, the rest at the tile's chosen count (its own where its pilot shows it
+    /// pilot_spp(spp) samples of every pixel at pilot_count with an nsp::NeeCountLearner per
+    /// half of each tile_size^2 tile, the rest at the tile's chosen count (its own where its pilot shows it
     /// pays, else the image's where its pilot predicts that no worse than count 1). Every sample,
-    /// the pilot's too, is in the stats.
+    /// the pilot's too, is in the image and the stats (weighed as weigh_pilot says).
     bool learn_nee_counts = false;
     int tile_size = 16;
     /// The pilot's samples per pixel: spp / 32, at least 2 (a pixel's sample variance needs two)
@@ -57,8 +57,18 @@ struct RenderRequest {
     /// the render at full NEE cost).
     static int pilot_spp(int spp) { return nsp::TileCounts::pilot_spp(spp); }
     /// The pilot's NEE and emission segment count (nsp::NeeCountLearner::pilot_counts): below 1
-    /// the pilot costs less and still predicts every candidate without bias (--pilot-count).
-    float pilot_count = 1.f;
+    /// the pilot costs less and still predicts every candidate without bias (--pilot-count; 1/4
+    /// by default, with weigh_pilot: docs/counts.md, "A cheaper pilot").
+    float pilot_count = 0.25f;
+    /// A pixel's pilot samples weigh in its estimate by the variance its tile's other half
+    /// predicts (nsp::TileCounts::pilot_weight; --pilot-weight variance), or as many samples
+    /// (false; --pilot-weight equal).
+    bool weigh_pilot = true;
+    /// The learner's cost: density lookups, what the tables' LTUV counts (nsp::CostModel with
+    /// per_lookup 1, per_sample 1/64 so that a tile without lookups still has a cost, nothing for
+    /// DDA steps or technique runs; --count-cost lookups), or nsp's default model (false;
+    /// --count-cost model).
+    bool lookup_costs = true;
 };
 
 /// What one render measured. The estimates of each sample are taken as linear RGB (mono: the value

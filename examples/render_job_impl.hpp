@@ -2,6 +2,7 @@
 // by the per-mode translation units that instantiate render_combination<S>.
 #pragma once
 
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -47,6 +48,16 @@ struct Welford {
         m2 += d * (x - mean);
     }
 };
+
+/// The mean a m_p + (1 - a) m_r of two independent sample means (n_p and n_r samples, n_p, n_r
+/// >= 2) and its variance, times n_p + n_r (per sample, comparable to an unweighted pixel's),
+/// each side's variance from its own samples (unbiased; with a = n_p / (n_p + n_r) it is the
+/// plain mean's).
+inline std::pair<double, double> weighted_mean(const Welford& p, int np, const Welford& r, int nr, double a) {
+    const double var = a * a * p.m2 / double(np - 1) / double(np) +
+                       (1.0 - a) * (1.0 - a) * r.m2 / double(nr - 1) / double(nr);
+    return {a * p.mean + (1.0 - a) * r.mean, var * double(np + nr)};
+}
 
 /// Per-thread accumulators, summed after the join.
 struct ThreadTotals {
@@ -143,19 +154,50 @@ struct PixelState {
     std::array<Welford, 3> channel{};
     Welford channel_mean{};
     Eigen::Array3d sum = Eigen::Array3d::Zero();
-    int k = 0;  ///< samples so far
+    int k = 0;  ///< samples so far (since the pilot, once end_pilot ran)
+    /// The pilot's statistics (learned rows), kept apart from the rest's by end_pilot().
+    std::array<Welford, 3> pilot_channel{};
+    Welford pilot_channel_mean{};
+    int pilot_k = 0;
+    void end_pilot() {
+        pilot_channel = channel;
+        pilot_channel_mean = channel_mean;
+        pilot_k = k;
+        channel = {};
+        channel_mean = {};
+        sum = Eigen::Array3d::Zero();
+        k = 0;
+    }
+    /// Folds the pilot's statistics back into the running ones (the pairwise update of Welford
+    /// sums: Chan, Golub and LeVeque).
+    void merge_pilot() {
+        const int n = pilot_k + k;
+        if (pilot_k == 0 || n == 0) return;
+        const auto merged = [&](const Welford& p, const Welford& r) {
+            const double d = r.mean - p.mean;
+            return Welford{p.mean + d * double(k) / double(n), p.m2 + r.m2 + d * d * double(pilot_k) * double(k) / double(n)};
+        };
+        for (int i = 0; i < 3; ++i) {
+            channel[std::size_t(i)] = merged(pilot_channel[std::size_t(i)], channel[std::size_t(i)]);
+            sum[i] = channel[std::size_t(i)].mean * double(n);
+        }
+        channel_mean = merged(pilot_channel_mean, channel_mean);
+        k = n;
+        pilot_k = 0;
+    }
 };
 
 /// Renders `scene` with combination C's estimator: per pixel, `spp` jittered camera rays (and in
 /// Hero mode a wavelength draw per path); one Pcg32 stream per pixel (so images do not depend on
 /// the thread count); rows handed out to threads through an atomic counter. Writes the mean
 /// linear RGB into `rgb`. With rq.learn_nee_counts (C::learns_nee_count), a first pass renders
-/// each tile's pilot samples at NEE count 1 with an nsp::NeeCountLearner as their counter, tiles
-/// handed out to threads in fixed slots (the chosen counts do not depend on the thread count); a
-/// tile keeps its own counts where its pilot shows they pay, else takes the image's (every tile's
-/// pilot merged) where its pilot predicts them no worse than counts 1; the second pass renders
-/// the rest at each tile's counts (NEE's and, on an emissive medium, the emission segment
-/// technique's).
+/// each tile's pilot samples at rq.pilot_count with an nsp::NeeCountLearner per half of the tile
+/// as their counter, tiles handed out to threads in fixed slots (the chosen counts do not depend
+/// on the thread count); a tile keeps its own counts where its pilot shows they pay, else takes
+/// the image's (every tile's pilot merged) where its pilot predicts them no worse than counts 1;
+/// the second pass renders the rest at each tile's counts (NEE's and, on an emissive medium, the
+/// emission segment technique's), and a pixel's pilot mean weighs pilot_weight in its estimate
+/// (rq.weigh_pilot) or as many samples.
 template <class C>
 RenderStats render(const typename C::Scene& scene, const RenderRequest& rq, std::vector<float>& rgb) {
     using S = typename C::Spectral;
@@ -204,6 +246,22 @@ RenderStats render(const typename C::Scene& scene, const RenderRequest& rq, std:
         px.channel_mean.add(c.mean(), px.k);
         return double(r.value.mean());
     };
+    // A learned row's pixel: its pilot mean weighs a, the rest's 1 - a (weighted_mean).
+    auto finish_learned_pixel = [&](const PixelState& px, std::size_t pixel, double a, ThreadTotals& t) {
+        const int np = px.pilot_k, nr = px.k;
+        t.variance_of_mean_sum += weighted_mean(px.pilot_channel_mean, np, px.channel_mean, nr, a).second;
+        for (int i = 0; i < 3; ++i) {
+            const auto [m, var] =
+                weighted_mean(px.pilot_channel[std::size_t(i)], np, px.channel[std::size_t(i)], nr, a);
+            t.variance_sum[std::size_t(i)] += var;
+            t.mean_sum[std::size_t(i)] += m;
+            rgb[3 * pixel + std::size_t(i)] = float(m);
+            if (rq.pixel_stats) {
+                pixel_mean[3 * pixel + std::size_t(i)] = m;
+                pixel_variance[3 * pixel + std::size_t(i)] = var;
+            }
+        }
+    };
     auto finish_pixel = [&](const PixelState& px, std::size_t pixel, ThreadTotals& t) {
         const double n1 = double(rq.spp - 1);
         t.variance_of_mean_sum += px.channel_mean.m2 / n1;
@@ -244,7 +302,12 @@ RenderStats render(const typename C::Scene& scene, const RenderRequest& rq, std:
             // kSlots, ... in order (threads take whole slots), so the counts do not depend on the
             // thread count; a tile keeps its own counts where its pilot shows they pay, else it
             // takes the image's where its pilot predicts them no worse than counts 1.
-            nsp::TileCounts plan(w, h, rq.tile_size, {}, pilot_counts);
+            nsp::CostModel costs;
+            if (rq.lookup_costs) {
+                costs.per_sample = 1.0 / 64.0;
+                costs.per_dda_step = costs.per_shadow_walk = costs.per_segment_walk = costs.per_light_walk = 0.0;
+            }
+            nsp::TileCounts plan(w, h, rq.tile_size, costs, pilot_counts);
             const int pilot = RenderRequest::pilot_spp(rq.spp);
             std::vector<PixelState> px(std::size_t(w) * std::size_t(h));
             for (std::size_t p = 0; p < px.size(); ++p) px[p].rng = nsp::Pcg32(rq.seed, p);
@@ -259,18 +322,29 @@ RenderStats render(const typename C::Scene& scene, const RenderRequest& rq, std:
                 const double cpu0 = thread_cpu_seconds();
                 for (int j; (j = next_slot.fetch_add(1)) < nsp::TileCounts::kSlots;)
                     for (const int tile : plan.slot_tiles(j)) {
-                        nsp::NeeCountLearner learner = plan.learner();
+                        // Two halves of the tile's pixels (x + y even, odd): each half's pilot is
+                        // weighted by the other's predictions (TileCounts::pilot_weight).
+                        std::array<nsp::NeeCountLearner, 2> half{plan.learner(), plan.learner()};
                         const nsp::TileCounts::Rect r = plan.tile_rect(tile);
                         for (int y = r.y0; y < r.y1; ++y)
                             for (int x = r.x0; x < r.x1; ++x) {
                                 PixelState& state = px[std::size_t(y) * std::size_t(w) + std::size_t(x)];
+                                nsp::NeeCountLearner& learner = half[std::size_t((x + y) & 1)];
                                 for (int k = 0; k < pilot; ++k)
                                     learner.end_sample(sample(pilot_estimator, learner, state, x, y, t));
                                 learner.end_pixel();
+                                state.end_pilot();
                             }
-                        plan.add(tile, learner);
-                        t.counter.n += learner.count();
-                        t.counter.steps += learner.steps();
+                        for (const nsp::NeeCountLearner& l : half) {
+                            t.counter.n += l.count();
+                            t.counter.steps += l.steps();
+                        }
+                        if (rq.weigh_pilot) {
+                            plan.add(tile, half[0], half[1]);
+                        } else {
+                            half[0].merge(half[1]);
+                            plan.add(tile, half[0]);
+                        }
                     }
                 t.cpu_seconds = thread_cpu_seconds() - cpu0;
                 out = t;
@@ -304,8 +378,13 @@ RenderStats render(const typename C::Scene& scene, const RenderRequest& rq, std:
                         const Estimator& est =
                             at_count[std::size_t(nsp::NeeCountLearner::candidate_index(st.nee_counts[tile]) * kS + js)];
                         PixelState& state = px[pixel];
-                        while (state.k < rq.spp) sample(est, t.counter, state, x, y, t);
-                        finish_pixel(state, pixel, t);
+                        while (state.pilot_k + state.k < rq.spp) sample(est, t.counter, state, x, y, t);
+                        if (state.pilot_k >= 2 && state.k >= 2) {
+                            finish_learned_pixel(state, pixel, plan.pilot_weight(x, y, state.pilot_k, rq.spp), t);
+                        } else {  // fewer than 2 on one side: every sample weighs the same
+                            state.merge_pilot();
+                            finish_pixel(state, pixel, t);
+                        }
                     }
                     progress.update(rows_done.fetch_add(1) + 1, h);
                 }
