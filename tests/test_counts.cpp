@@ -1152,12 +1152,12 @@ TEST_CASE("TileCounts: the host protocol gives every tile the counts of the manu
 }
 
 TEST_CASE("TileCounts: a pilot learned in halves weighs each pixel by the other half's predictions") {
-    // Synthetic pilots (a light tracking finds as well as NEE, NEE's walk most of the work; in
-    // the odd half of tile 1 a second, noisier one): pilot_weight(x, y) is the inverse-variance
-    // weight n_p V_c / (n_p V_c + n_r V_p) from the *other* half's predicted variance at the
-    // pilot's counts (1) and the tile's chosen counts, so a pixel's weight does not depend on its
-    // own samples; a tile added whole, or a pixel with fewer than 2 samples on a side, weighs
-    // every sample the same.
+    // Synthetic pilots (a light tracking finds as well as NEE, NEE's walk most of the work; the
+    // halves of tile 0 differ in spread): pilot_weight(x, y) is the inverse-variance weight
+    // n_p V_c / (n_p V_c + n_r V_p) from the *other* half's predicted variance at the pilot's
+    // counts (1) and at the counts that half chooses alone, so a pixel's weight does not depend
+    // on its own samples; a tile added whole, or a pixel with fewer than 2 samples on a side,
+    // weighs every sample the same.
     auto pilot = [](NeeCountLearner& l, int t, double spread) {
         for (int i = 0; i < 16; ++i) {
             // tracking's and NEE's estimates, NEE's the noisier: its count 1 halves tracking's
@@ -1183,13 +1183,16 @@ TEST_CASE("TileCounts: a pilot learned in halves weighs each pixel by the other 
     CHECK(tc.pilot_weight(3, 4, 2, 16) == doctest::Approx(2.0 / 16.0));  // before choose(): equal
     tc.add(1, whole);
     tc.choose();
-    const TechniqueCounts c = tc.counts(0);
-    REQUIRE(c.nee < 1.f);  // the tile learned a count below the pilot's
-    const int jn = NeeCountLearner::candidate_index(c.nee);
+    REQUIRE(tc.counts(0).nee < 1.f);  // the tile learned a count below the pilot's
+    // The other half's variance at its own choice (not the tile's, which the pixel's own pilot
+    // helped choose).
     auto expected = [&](const NeeCountLearner& other, int np, int nr) {
+        const int jn = NeeCountLearner::candidate_index(other.choose_counts().nee);
         const double vp = other.predicted_variance(0, 0), vc = other.predicted_variance(jn, 0);
         return double(np) * vc / (double(np) * vc + double(nr) * vp);
     };
+    CHECK(even.choose_counts().nee < 1.f);
+    CHECK(odd.choose_counts().nee < 1.f);
     CHECK(tc.pilot_weight(3, 5, 2, 16) == doctest::Approx(expected(odd, 2, 14)));  // x + y even: odd's
     CHECK(tc.pilot_weight(3, 4, 2, 16) == doctest::Approx(expected(even, 2, 14)));
     CHECK(tc.pilot_weight(3, 4, 4, 64) == doctest::Approx(expected(even, 4, 60)));
@@ -1199,6 +1202,8 @@ TEST_CASE("TileCounts: a pilot learned in halves weighs each pixel by the other 
     CHECK(tc.pilot_weight(3, 4, 2, 3) == doctest::Approx(2.0 / 3.0));      // one sample after the pilot
     CHECK(tc.pilot_weight(3, 4, 1, 16) == doctest::Approx(1.0 / 16.0));    // one sample in it
     CHECK_THROWS_WITH_AS(tc.pilot_weight(3, 4, 17, 16), doctest::Contains("pilot_samples is 17; it must be in [0, spp = 16]"),
+                         InvalidArgument);
+    CHECK_THROWS_WITH_AS(tc.pilot_weight(32, 4, 2, 16), doctest::Contains("pixel (32, 4) is not in the 32 x 16 image"),
                          InvalidArgument);
 }
 

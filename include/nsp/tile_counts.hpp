@@ -29,8 +29,9 @@ namespace nsp {
 /// (pilot_weight), so that it costs little where its count is the noisy one. Threads: add() may
 /// run concurrently for tiles of different slots (tile % kSlots); the tiles of one slot must be
 /// added in increasing order (one thread per slot, as slot_tiles() lists them), which makes the
-/// merged learners, and so every count, the same for any thread count. Host-side: it allocates (kSlots learners, a Summary per tile) and
-/// throws; nothing of it runs in a kernel.
+/// merged learners, and so every count, the same for any thread count. Host-side: it allocates
+/// (kSlots learners; per tile a Summary and two halves' predictions, about 300 bytes) and throws;
+/// nothing of it runs in a kernel.
 class TileCounts {
 public:
     static constexpr int kSlots = 16;  ///< learners merged in parallel (about 40 KiB each)
@@ -63,6 +64,7 @@ public:
         next_.assign(std::size_t(kSlots), 0);
         for (int j = 0; j < kSlots; ++j) next_[std::size_t(j)] = j;
         summaries_.resize(std::size_t(tile_count()));
+        halves_.resize(std::size_t(tile_count()));
         counts_.assign(std::size_t(tile_count()), TechniqueCounts{});
         sources_.assign(std::size_t(tile_count()), Source::Own);
     }
@@ -109,9 +111,9 @@ public:
     }
     /// Tile t's pilot is done, learned in two halves of its pixels: `even` from the pixels with
     /// x + y even, `odd` from the others. The tile's counts are chosen from both merged, as by
-    /// add(t, learner); each half's predicted variances are kept (a float per candidate pair) so
-    /// that a pixel's pilot samples can be weighted by the other half's (pilot_weight). Throws as
-    /// add(t, learner).
+    /// add(t, learner); each half's predicted variances at the pilot's counts and at its own
+    /// choice are kept so that a pixel's pilot samples can be weighted by the other half's
+    /// (pilot_weight). Throws as add(t, learner).
     void add(int t, const NeeCountLearner& even, const NeeCountLearner& odd) {
         check_add(t);
         NeeCountLearner both = even;
@@ -119,68 +121,51 @@ public:
         summaries_[std::size_t(t)] = both.summary();
         slots_[std::size_t(t % kSlots)].merge(both);
         next_[std::size_t(t % kSlots)] = t + kSlots;
-        if (halves_.empty()) halves_.resize(std::size_t(tile_count()));
         Halves& h = halves_[std::size_t(t)];
         h.learned = true;
-        for (int half = 0; half < 2; ++half)
-            for (int jn = 0; jn < NeeCountLearner::kCandidates; ++jn)
-                for (int js = 0; js < NeeCountLearner::kCandidates; ++js)
-                    h.variance[std::size_t(half)][pair(jn, js)] =
-                        float((half == 0 ? even : odd).predicted_variance(jn, js));
+        for (int half = 0; half < 2; ++half) {
+            const NeeCountLearner& l = half == 0 ? even : odd;
+            const NeeCountLearner::Summary own = l.summary();  // its choose_counts() and axis
+            const int cn = candidate_of(own.own.nee),
+                      cs = candidate_of(own.light_subpath ? own.own.light_subpath : own.own.emission_segment);
+            const int pn = candidate_of(pilot_.nee), ps = candidate_of(pilot_.emission_segment);
+            if (cn < 0 || cs < 0 || pn < 0 || ps < 0) continue;  // equal weights
+            h.pilot_variance[std::size_t(half)] = float(l.predicted_variance(pn, ps));
+            h.chosen_variance[std::size_t(half)] = float(l.predicted_variance(cn, cs));
+        }
     }
 
     /// The weight of pixel (x, y)'s pilot mean in its estimate, after choose(): the pixel's
     /// estimate is a m_pilot + (1 - a) m_rest, the means of its `pilot_samples` pilot samples and
-    /// of the other spp - pilot_samples. Where its tile was added in halves and the pilot's counts
-    /// are candidates, a = n_p V_c / (n_p V_c + n_r V_p) (inverse-variance weights), V_p and V_c
-    /// the variance per sample that the *other* half of the tile predicts at the pilot's counts
-    /// and at the tile's counts: a pilot at a low count that is noisy where NEE pays weighs little
-    /// there. The weight is then independent of the pixel's own samples, so the estimate stays
-    /// unbiased (its samples are unbiased at either counts, and the rest are drawn after the
-    /// counts are fixed). Elsewhere (one learner per tile, no variance predicted, fewer than 2
-    /// samples on either side) a = pilot_samples / spp: every sample weighs the same. Throws
-    /// InvalidArgument where pilot_samples is not in [0, spp].
+    /// of the other spp - pilot_samples. Where its tile was added in halves,
+    /// a = n_p V_c / (n_p V_c + n_r V_p) (inverse-variance weights), V_p and V_c the variance per
+    /// sample that the *other* half of the tile predicts at the pilot's counts and at the counts
+    /// that half alone chooses (its choose_counts(), most often the tile's): a pilot at a low
+    /// count that is noisy where NEE pays weighs little there. Nothing of the pixel's own samples
+    /// enters the weight (not even through the tile's counts, which its pilot helped choose), so
+    /// its estimate stays unbiased: E[a m_pilot] = E[a] L, and the rest, drawn after the counts
+    /// are fixed, has mean L whatever they are. Elsewhere (one learner per tile, a count that is
+    /// not a candidate, no variance predicted, fewer than 2 samples on either side) a =
+    /// pilot_samples / spp: every sample weighs the same. Throws InvalidArgument for a pixel
+    /// outside the image or pilot_samples not in [0, spp].
     double pilot_weight(int x, int y, int pilot_samples, int spp) const {
         if (pilot_samples < 0 || pilot_samples > spp)
             throw InvalidArgument("nsp::TileCounts::pilot_weight: pilot_samples is " + std::to_string(pilot_samples) +
                                   "; it must be in [0, spp = " + std::to_string(spp) + "]");
+        if (x < 0 || x >= width_ || y < 0 || y >= height_)
+            throw InvalidArgument("nsp::TileCounts::pilot_weight: pixel (" + std::to_string(x) + ", " +
+                                  std::to_string(y) + ") is not in the " + std::to_string(width_) + " x " +
+                                  std::to_string(height_) + " image");
         const double equal = spp > 0 ? double(pilot_samples) / double(spp) : 0.0;
         const int t = tile_at(x, y), rest = spp - pilot_samples;
-        if (!chosen_ || halves_.empty() || !halves_[std::size_t(t)].learned || pilot_samples < 2 || rest < 2)
-            return equal;
-        const int pn = candidate_of(pilot_.nee), ps = candidate_of(pilot_.emission_segment);
-        const TechniqueCounts& c = counts_[std::size_t(t)];
-        const int cn = candidate_of(c.nee), cs = candidate_of(c.emission_segment);
-        if (pn < 0 || ps < 0 || cn < 0 || cs < 0) return equal;
-        const auto& v = halves_[std::size_t(t)].variance[std::size_t(1 - ((x + y) & 1))];
-        const double vp = v[pair(pn, ps)], vc = v[pair(cn, cs)];
+        if (!chosen_ || !halves_[std::size_t(t)].learned || pilot_samples < 2 || rest < 2) return equal;
+        const Halves& h = halves_[std::size_t(t)];
+        const std::size_t other = std::size_t(1 - ((x + y) & 1));
+        const double vp = h.pilot_variance[other], vc = h.chosen_variance[other];
         if (!(vp > 0.0 && vc > 0.0 && std::isfinite(vp) && std::isfinite(vc))) return equal;
         const double np = double(pilot_samples) * vc, nr = double(rest) * vp;
         return np / (np + nr);
     }
-
-private:
-    void check_add(int t) const {
-        if (chosen_) throw std::logic_error("nsp::TileCounts::add after choose()");
-        if (t < 0 || t >= tile_count())
-            throw InvalidArgument("nsp::TileCounts::add: tile " + std::to_string(t) + " is not in [0, " +
-                             std::to_string(tile_count()) + ")");
-        const std::size_t j = std::size_t(t % kSlots);
-        if (next_[j] != t)
-            throw std::logic_error("nsp::TileCounts::add: tile " + std::to_string(t) + " out of order; slot " +
-                             std::to_string(j) + " expects tile " + std::to_string(next_[j]) + " next");
-    }
-    static constexpr std::size_t kPairs = std::size_t(NeeCountLearner::kCandidates) * NeeCountLearner::kCandidates;
-    static constexpr std::size_t pair(int jn, int js) noexcept {
-        return std::size_t(jn) * std::size_t(NeeCountLearner::kCandidates) + std::size_t(js);
-    }
-    /// The candidate index of `count`, -1 where it is not a candidate.
-    static int candidate_of(float count) noexcept {
-        const int j = NeeCountLearner::candidate_index(count);
-        return j >= 0 && j < NeeCountLearner::kCandidates && NeeCountLearner::candidate(j) == count ? j : -1;
-    }
-
-public:
 
     /// Every tile added: merges the slots in order into the image's learner, chooses its counts
     /// and each tile's (its own where its pilot shows a gain, else the image's where it predicts
@@ -215,6 +200,22 @@ public:
     const NeeCountLearner::Summary& summary(int t) const { return summaries_.at(std::size_t(t)); }
 
 private:
+    void check_add(int t) const {
+        if (chosen_) throw std::logic_error("nsp::TileCounts::add after choose()");
+        if (t < 0 || t >= tile_count())
+            throw InvalidArgument("nsp::TileCounts::add: tile " + std::to_string(t) + " is not in [0, " +
+                             std::to_string(tile_count()) + ")");
+        const std::size_t j = std::size_t(t % kSlots);
+        if (next_[j] != t)
+            throw std::logic_error("nsp::TileCounts::add: tile " + std::to_string(t) + " out of order; slot " +
+                             std::to_string(j) + " expects tile " + std::to_string(next_[j]) + " next");
+    }
+    /// The candidate index of `count`, -1 where it is not a candidate.
+    static int candidate_of(float count) noexcept {
+        const int j = NeeCountLearner::candidate_index(count);
+        return j >= 0 && j < NeeCountLearner::kCandidates && NeeCountLearner::candidate(j) == count ? j : -1;
+    }
+
     int width_, height_, tile_, tiles_x_ = 0, tiles_y_ = 0;
     CostModel costs_;
     TechniqueCounts pilot_;
@@ -222,12 +223,13 @@ private:
     std::vector<int> next_;  // per slot: the tile add() expects next
     std::vector<NeeCountLearner::Summary> summaries_;
     std::vector<TechniqueCounts> counts_;
-    /// Per tile added in halves: each half's predicted variance per candidate pair.
+    /// Per tile added in halves: each half's predicted variance at the pilot's counts and at
+    /// the counts it chooses alone (0: no weight from it).
     struct Halves {
         bool learned = false;
-        std::array<std::array<float, kPairs>, 2> variance{};
+        std::array<float, 2> pilot_variance{}, chosen_variance{};
     };
-    std::vector<Halves> halves_;  // empty until a tile is added in halves
+    std::vector<Halves> halves_;
     std::vector<Source> sources_;
     NeeCountLearner image_;
     TechniqueCounts image_counts_;
