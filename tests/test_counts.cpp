@@ -1278,6 +1278,81 @@ TEST_CASE("TileCounts: pixels weighted by pilot_weight after a pilot at count 1/
     CHECK(std::abs(mean.mean - 1.0) <= kSigmas * se + kRoundingFloor);
 }
 
+TEST_CASE("TileCounts: a scout raises the pilot's counts where NEE pays, not where it does not") {
+    // A 32 x 32 image of parallel rays through a heterogeneous grey medium, the scout of the
+    // protocol (2 samples of one pixel in 16 at NEE count 1/4, then end_scout()). Under a small
+    // bright sphere light (radius 0.1 at distance 3, radiance 100: tracking alone rarely finds
+    // it) the scout predicts count 1 best and the pilot runs there; in the white furnace (albedo
+    // 1 under a unit sky: tracking alone is exact, NEE only adds variance and walks) the pilot
+    // stays at 1/4, although the scout's own choice there (with a significance test) is 1: the
+    // pilot takes the best prediction at or above its counts, without one. Fixed seeds.
+    using M = DenseGridMedium<Mono>;
+    const Box box{Vec3(-1.f), Vec3(1.f)};
+    using Est = PathEstimator<strategy::NullScatteringMis, mis::Balance>;
+    constexpr int kW = 32, kSpp = 64;
+    auto ray_at = [](int x, int y) {
+        return Ray{Vec3(-3.f, -0.9f + 1.8f * (float(y) + 0.5f) / kW, -0.9f + 1.8f * (float(x) + 0.5f) / kW), Vec3(1.f, 0.f, 0.f)};
+    };
+    TechniqueCounts floor;
+    floor.nee = 0.25f;
+    auto scout = [&](const auto& scene) {
+        TileCounts tc(kW, kW, 16, {}, floor);
+        const Est est(with_count(0.25f));
+        int pixels = 0;
+        for (int j = 0; j < TileCounts::kSlots; ++j)
+            for (const int t : tc.slot_tiles(j)) {
+                NeeCountLearner l = tc.scout_learner();
+                const TileCounts::Rect r = tc.tile_rect(t);
+                for (int y = r.y0; y < r.y1; ++y)
+                    for (int x = r.x0; x < r.x1; ++x) {
+                        if (!TileCounts::is_scout(x, y)) continue;
+                        ++pixels;
+                        Pcg32 rng(77, std::uint64_t(y * kW + x));
+                        for (int k = 0; k < TileCounts::scout_spp(kSpp); ++k) {
+                            const auto res = est.radiance(scene, ray_at(x, y), {}, rng, l);
+                            REQUIRE(res.status == Status::Ok);
+                            l.end_sample(double(res.value[0]));
+                        }
+                        l.end_pixel();
+                    }
+                tc.add_scout(t, l);
+            }
+        CHECK(pixels == kW * kW / 16);
+        CHECK(tc.pilot_counts().nee == 0.25f);  // before end_scout(): the constructed counts
+        tc.end_scout();
+        return tc;
+    };
+    Lights<Mono> small, sky;
+    small.set(SphereLight<Mono>{Vec3(0.f, 3.f, 0.f), 0.1f, grey<Mono>(100.f)});
+    sky.set(EnvironmentLight<Mono>{grey<Mono>(1.f)});
+    const auto lit = make_medium<M>(box, 1.f, grey<Mono>(0.2f), grey<Mono>(0.8f), 42);
+    const auto white = make_medium<M>(box, 1.f, grey<Mono>(0.f), grey<Mono>(1.f), 42);
+    const TileCounts pays = scout(Scene(lit, GlobalMajorant<M>(lit), HenyeyGreensteinPhase(0.5f), small));
+    const TileCounts furnace = scout(Scene(white, GlobalMajorant<M>(white), HenyeyGreensteinPhase(0.5f), sky));
+    MESSAGE("scout: small light: pilot at NEE count " << pays.pilot_counts().nee << " (scout's choice "
+                                                      << pays.scout_counts().nee << "); furnace: "
+                                                      << furnace.pilot_counts().nee << " (scout's choice "
+                                                      << furnace.scout_counts().nee << ")");
+    CHECK(pays.pilot_counts().nee == 1.f);
+    CHECK(pays.learner().pilot_counts().nee == 1.f);  // the pilot's learners expect the raised counts
+    CHECK(furnace.pilot_counts().nee == 0.25f);
+    CHECK(furnace.pilot_counts().emission_segment == 1.f);  // nothing emits: the segment's stays 1
+
+    // Misuse is refused by name.
+    TileCounts tc(kW, kW, 16, {}, floor);
+    tc.add_scout(0, tc.scout_learner());
+    CHECK_THROWS_WITH_AS(tc.end_scout(), doctest::Contains("end_scout: tile 1 was not added"), std::logic_error);
+    CHECK_THROWS_WITH_AS(tc.add(1, tc.learner()), doctest::Contains("the scout was not ended"), std::logic_error);
+    for (const int t : {1, 2, 3}) tc.add_scout(t, tc.scout_learner());
+    tc.end_scout();  // a scout that recorded nothing leaves the pilot where it was
+    CHECK(tc.pilot_counts().nee == 0.25f);
+    CHECK_THROWS_WITH_AS(tc.add_scout(0, tc.scout_learner()), doctest::Contains("add_scout after end_scout"),
+                         std::logic_error);
+    CHECK_THROWS_WITH_AS(tc.end_scout(), doctest::Contains("end_scout twice"), std::logic_error);
+    tc.add(0, tc.learner());  // the pilot's tiles start again from tile 0
+    CHECK_THROWS_WITH_AS(tc.choose(), doctest::Contains("choose: tile 1 was not added"), std::logic_error);
+}
+
 TEST_CASE("NEE counts: a count outside [0, 1] is rejected by name, by BDPT too; 0 where NEE is a strategy's only way") {
     for (const float bad : {-0.5f, 1.5f, std::nanf("")}) {
         CAPTURE(bad);

@@ -8,6 +8,7 @@
 #include <array>
 #include <cmath>
 #include <cstddef>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -18,6 +19,11 @@
 namespace nsp {
 
 /// Expected counts per pixel tile of a width x height image (THEORY 5.9, docs/counts.md). A host
+///  0. (optional) renders a scout: scout_spp(spp) samples of each scout pixel (is_scout) at the
+///     constructed pilot counts, scout_learner() as the counter, handed per tile to add_scout(),
+///     then end_scout(); the scout's samples are not in the image. It raises the pilot's counts
+///     to those the scout predicts best among the counts at or above them, so that where NEE
+///     pays image-wide the pilot runs where the rest will and its samples are as good as theirs;
 ///  1. renders each tile's pilot (pilot_spp(spp) samples per pixel, the estimator at
 ///     pilot_counts(), learner() as the lookup counter: end_sample after each sample with the
 ///     sample's channel mean, end_pixel after each pixel) and hands the learner to add();
@@ -48,7 +54,7 @@ public:
     /// size that is not > 0, or what NeeCountLearner refuses.
     TileCounts(int width, int height, int tile_size = 16, const CostModel& costs = {},
                const TechniqueCounts& pilot = {})
-        : width_(width), height_(height), tile_(tile_size), costs_(costs), pilot_(pilot) {
+        : width_(width), height_(height), tile_(tile_size), costs_(costs), floor_(pilot), pilot_(pilot) {
         const auto positive = [](const char* what, int v) {
             if (v <= 0)
                 throw InvalidArgument(std::string("nsp::TileCounts: ") + what + " is " + std::to_string(v) +
@@ -94,17 +100,74 @@ public:
         return out;
     }
 
-    /// The counts the pilot runs at (EstimatorOptions::nee_count, emission_segment_count).
+    /// The scout's pixels: one in kScoutStride^2, (x, y) with x % kScoutStride and y %
+    /// kScoutStride both kScoutStride / 2.
+    static constexpr int kScoutStride = 4;
+    static constexpr bool is_scout(int x, int y) noexcept {
+        return x % kScoutStride == kScoutStride / 2 && y % kScoutStride == kScoutStride / 2;
+    }
+    /// The scout's samples per scout pixel: 2 (at most spp). Over a 128 x 128 image, 2048
+    /// samples at 1/16 of a 2-spp pass: 1/512 of a 256-spp render's samples.
+    static constexpr int scout_spp(int spp) noexcept { return std::min(spp, 2); }
+    /// A fresh learner for one tile's scout pixels, at the constructed pilot counts.
+    NeeCountLearner scout_learner() const { return NeeCountLearner(costs_, floor_); }
+    /// Tile t's scout pixels are done (none is fine: an empty learner): merges `l` into slot t %
+    /// kSlots. Every tile, in slot_tiles() order per slot, as add(). Throws InvalidArgument for a
+    /// tile out of range, std::logic_error for one out of order, or after end_scout() or add().
+    void add_scout(int t, const NeeCountLearner& l) {
+        if (scout_ended_ || adding_) throw std::logic_error("nsp::TileCounts::add_scout after end_scout() or add()");
+        check_add(t);
+        scouting_ = true;
+        slots_[std::size_t(t % kSlots)].merge(l);
+        next_[std::size_t(t % kSlots)] = t + kSlots;
+    }
+    /// Every tile scouted: merges the slots in order and sets pilot_counts() to the pair, among
+    /// the candidates at or above the constructed pilot counts, with the smallest predicted
+    /// variance x cost over the scout pooled (ties to the larger counts; no significance test:
+    /// every such pair is a fair pilot). Unchanged where the scout recorded nothing to predict
+    /// from. A BDPT pilot's light subpath stays at 1. Throws std::logic_error where a tile was
+    /// not scouted, or twice.
+    void end_scout() {
+        if (scout_ended_ || adding_) throw std::logic_error("nsp::TileCounts::end_scout twice or after add()");
+        check_all_added("end_scout");
+        NeeCountLearner scout(costs_, floor_);
+        for (const NeeCountLearner& l : slots_) scout.merge(l);
+        const int fn = candidate_of(floor_.nee), fs = candidate_of(floor_.emission_segment);
+        const bool segment_axis = !scout.summary().light_subpath;
+        if (!scout.invalid_pilot() && scout.predicted_variance(0, 0) > 0.0 && fn >= 0 && fs >= 0) {
+            // From the lowest counts up, so that ties go to the larger; a prediction that is not
+            // > 0 (a small sample's can be) is no evidence for its pair.
+            int bn = fn, bs = segment_axis ? fs : 0;
+            double best = std::numeric_limits<double>::infinity();
+            for (int jn = fn; jn >= 0; --jn)
+                for (int js = segment_axis ? fs : 0; js >= 0; --js) {
+                    const double e = scout.predicted_variance(jn, js) * scout.predicted_cost(jn, js);
+                    if (scout.allowed(jn, js) && e > 0.0 && e <= best) bn = jn, bs = js, best = e;
+                }
+            pilot_.nee = NeeCountLearner::candidate(bn);
+            if (segment_axis) pilot_.emission_segment = NeeCountLearner::candidate(bs);
+        }
+        scout_ = scout.summary().own;
+        const NeeCountLearner prototype(costs_, pilot_);
+        slots_.assign(std::size_t(kSlots), prototype);
+        for (int j = 0; j < kSlots; ++j) next_[std::size_t(j)] = j;
+        scout_ended_ = true;
+    }
+    /// The scout's own choice of counts (after end_scout(); counts 1 before or without one).
+    const TechniqueCounts& scout_counts() const noexcept { return scout_; }
+
+    /// The counts the pilot runs at (EstimatorOptions::nee_count, emission_segment_count): the
+    /// constructed ones, raised by end_scout() where a scout ran.
     const TechniqueCounts& pilot_counts() const noexcept { return pilot_; }
     /// A fresh learner for one tile's pilot.
     NeeCountLearner learner() const { return NeeCountLearner(costs_, pilot_); }
 
     /// Tile t's pilot is done: keeps its Summary and merges its learner into slot t % kSlots.
     /// Throws InvalidArgument for a tile out of range, std::logic_error for one out of its slot's
-    /// order or after choose(). Its pilot samples then weigh as many of the pixel's samples
-    /// (pilot_weight).
+    /// order, after choose(), or after add_scout() without end_scout(). Its pilot samples then
+    /// weigh as many of the pixel's samples (pilot_weight).
     void add(int t, const NeeCountLearner& l) {
-        check_add(t);
+        check_pilot_add(t);
         summaries_[std::size_t(t)] = l.summary();
         slots_[std::size_t(t % kSlots)].merge(l);
         next_[std::size_t(t % kSlots)] = t + kSlots;
@@ -115,7 +178,7 @@ public:
     /// choice are kept so that a pixel's pilot samples can be weighted by the other half's
     /// (pilot_weight). Throws as add(t, learner).
     void add(int t, const NeeCountLearner& even, const NeeCountLearner& odd) {
-        check_add(t);
+        check_pilot_add(t);
         NeeCountLearner both = even;
         both.merge(odd);
         summaries_[std::size_t(t)] = both.summary();
@@ -171,10 +234,7 @@ public:
     /// and each tile's (its own where its pilot shows a gain, else the image's where it predicts
     /// them no worse than counts 1, else 1). Throws std::logic_error where a tile is missing.
     void choose() {
-        for (int j = 0; j < kSlots; ++j)
-            if (next_[std::size_t(j)] < tile_count())
-                throw std::logic_error("nsp::TileCounts::choose: tile " + std::to_string(next_[std::size_t(j)]) +
-                                 " was not added");
+        check_all_added("choose");
         image_ = NeeCountLearner(costs_, pilot_);
         for (const NeeCountLearner& l : slots_) image_.merge(l);
         image_counts_ = image_.choose_counts();
@@ -200,6 +260,18 @@ public:
     const NeeCountLearner::Summary& summary(int t) const { return summaries_.at(std::size_t(t)); }
 
 private:
+    void check_all_added(const char* what) const {
+        for (int j = 0; j < kSlots; ++j)
+            if (next_[std::size_t(j)] < tile_count())
+                throw std::logic_error(std::string("nsp::TileCounts::") + what + ": tile " +
+                                       std::to_string(next_[std::size_t(j)]) + " was not added");
+    }
+    void check_pilot_add(int t) {
+        if (scouting_ && !scout_ended_)
+            throw std::logic_error("nsp::TileCounts::add: the scout was not ended (end_scout())");
+        check_add(t);
+        adding_ = true;
+    }
     void check_add(int t) const {
         if (chosen_) throw std::logic_error("nsp::TileCounts::add after choose()");
         if (t < 0 || t >= tile_count())
@@ -218,7 +290,8 @@ private:
 
     int width_, height_, tile_, tiles_x_ = 0, tiles_y_ = 0;
     CostModel costs_;
-    TechniqueCounts pilot_;
+    TechniqueCounts floor_, pilot_, scout_;  // the constructed pilot counts, the pilot's, the scout's choice
+    bool scouting_ = false, scout_ended_ = false, adding_ = false;
     std::vector<NeeCountLearner> slots_;
     std::vector<int> next_;  // per slot: the tile add() expects next
     std::vector<NeeCountLearner::Summary> summaries_;
