@@ -193,6 +193,14 @@ Options parse_command_line(int argc, char** argv) {
                   throw UsageError("--count-cost: expected lookups or model, got '" + std::string(v) + "'", true);
               o.lookup_costs = v == "lookups";
           });
+    value("--scout", "S",
+          "learned rows: a scout of 2 samples in one pixel of 16 raises the pilot's counts to those it predicts "
+          "best at or above --pilot-count (on, default), or none (off)",
+          [&](std::string_view v) {
+              if (v != "on" && v != "off")
+                  throw UsageError("--scout: expected on or off, got '" + std::string(v) + "'", true);
+              o.scout = v == "on";
+          });
     value("--runs", "K", "render each row K times (seeds seed..seed+K-1), report medians",
           [&](std::string_view v) { o.runs = parse_number<int>("--runs", v, 1, 1000); });
     value("--reference-spp", "N", "effective variance against an N-spp reference (chromatic, fog, plume)",

@@ -22,6 +22,7 @@ struct Options {
     float pilot_count = 0.25f;  ///< --pilot-count: the learned rows' pilot NEE and segment count
     bool weigh_pilot = true;  ///< --pilot-weight variance (true) or equal
     bool lookup_costs = true; ///< --count-cost lookups (true) or model
+    bool scout = true;        ///< --scout on (true) or off
     std::optional<int> reference_spp;  ///< --reference-spp: effective (error-based) variance
     nsp::EstimatorOptions estimator;   ///< max depth, equiangular and emission-segment settings
     std::string out = "out";

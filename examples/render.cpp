@@ -66,6 +66,7 @@ std::vector<Job> plan_jobs(const std::vector<TablePlan>& tables, const Options& 
         rq.pilot_count = o.pilot_count;
         rq.weigh_pilot = o.weigh_pilot;
         rq.lookup_costs = o.lookup_costs;
+        rq.scout = o.scout;
         rq.majorant = o.majorant;
         return rq;
     };

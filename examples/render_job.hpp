@@ -69,6 +69,10 @@ struct RenderRequest {
     /// DDA steps or technique runs; --count-cost lookups), or nsp's default model (false;
     /// --count-cost model).
     bool lookup_costs = true;
+    /// Before the pilot, a scout (nsp::TileCounts::add_scout: 2 samples of one pixel in 16, not
+    /// in the image) raises the pilot's counts from pilot_count to those it predicts best at or
+    /// above it (--scout on), or the pilot runs at pilot_count (false; --scout off).
+    bool scout = true;
 };
 
 /// What one render measured. The estimates of each sample are taken as linear RGB (mono: the value
@@ -91,7 +95,7 @@ struct RenderStats {
     /// With RenderRequest::learn_nee_counts: the NEE count chosen for each tile (row-major tiles),
     /// and on an emissive medium the emission segment count (empty otherwise).
     std::vector<float> nee_counts, segment_counts;
-    float pilot_count = 1.f;  ///< the pilot's NEE (and segment) count
+    float pilot_count = 1.f;  ///< the pilot's NEE count (after the scout, where one ran)
 
     /// The mean over the 3 channels of channel_variance.
     double variance_per_channel() const {

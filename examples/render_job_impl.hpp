@@ -278,7 +278,8 @@ RenderStats render(const typename C::Scene& scene, const RenderRequest& rq, std:
     };
 
     std::atomic<int> next_row{0}, rows_done{0};
-    std::vector<ThreadTotals> totals(std::size_t(rq.threads)), pilot_totals(std::size_t(rq.threads));
+    std::vector<ThreadTotals> totals(std::size_t(rq.threads)), pilot_totals(std::size_t(rq.threads)),
+        scout_totals(std::size_t(rq.threads));
     InPlaceProgress progress(rq.label, isatty(STDERR_FILENO) != 0);
     RenderStats st;
     const auto t0 = std::chrono::steady_clock::now();
@@ -290,31 +291,70 @@ RenderStats render(const typename C::Scene& scene, const RenderRequest& rq, std:
 
     if constexpr (C::learns_nee_count) {
         if (rq.learn_nee_counts) {
-            // Pass 1: the pilot, tile by tile, at rq.pilot_count (NEE and segment).
-            nsp::TechniqueCounts pilot_counts;
-            pilot_counts.nee = rq.pilot_count;
-            pilot_counts.emission_segment = C::MediumKind::emissive ? rq.pilot_count : 1.f;
-            nsp::EstimatorOptions pilot_options = rq.estimator;
-            pilot_options.nee_count = pilot_counts.nee;
-            pilot_options.emission_segment_count = pilot_counts.emission_segment;
-            const Estimator pilot_estimator{pilot_options};
             // The protocol of docs/integration.md (nsp::TileCounts): slot j learns tiles j, j +
             // kSlots, ... in order (threads take whole slots), so the counts do not depend on the
             // thread count; a tile keeps its own counts where its pilot shows they pay, else it
             // takes the image's where its pilot predicts them no worse than counts 1.
+            nsp::TechniqueCounts floor_counts;
+            floor_counts.nee = rq.pilot_count;
+            floor_counts.emission_segment = C::MediumKind::emissive ? rq.pilot_count : 1.f;
             nsp::CostModel costs;
             if (rq.lookup_costs) {
                 costs.per_sample = 1.0 / 64.0;
                 costs.per_dda_step = costs.per_shadow_walk = costs.per_segment_walk = costs.per_light_walk = 0.0;
             }
-            nsp::TileCounts plan(w, h, rq.tile_size, costs, pilot_counts);
+            nsp::TileCounts plan(w, h, rq.tile_size, costs, floor_counts);
             const int pilot = RenderRequest::pilot_spp(rq.spp);
             std::vector<PixelState> px(std::size_t(w) * std::size_t(h));
             for (std::size_t p = 0; p < px.size(); ++p) px[p].rng = nsp::Pcg32(rq.seed, p);
             constexpr bool kEmissive = C::MediumKind::emissive;
             const int n_tiles = plan.tile_count();
+            // Pass 0, the scout: 2 samples of one pixel in 16 at rq.pilot_count, on streams of their
+            // own and not in the image (only their work is counted), raise the pilot's counts.
+            if (rq.scout) {
+                nsp::EstimatorOptions scout_options = rq.estimator;
+                scout_options.nee_count = floor_counts.nee;
+                scout_options.emission_segment_count = floor_counts.emission_segment;
+                const Estimator scout_estimator{scout_options};
+                const int scout_spp = nsp::TileCounts::scout_spp(rq.spp);
+                std::atomic<int> next_scout_slot{0};
+                auto scout_work = [&](ThreadTotals& out) {
+                    ThreadTotals t, discarded;
+                    const double cpu0 = thread_cpu_seconds();
+                    for (int j; (j = next_scout_slot.fetch_add(1)) < nsp::TileCounts::kSlots;)
+                        for (const int tile : plan.slot_tiles(j)) {
+                            nsp::NeeCountLearner learner = plan.scout_learner();
+                            const nsp::TileCounts::Rect r = plan.tile_rect(tile);
+                            for (int y = r.y0; y < r.y1; ++y)
+                                for (int x = r.x0; x < r.x1; ++x) {
+                                    if (!nsp::TileCounts::is_scout(x, y)) continue;
+                                    const std::size_t p = std::size_t(y) * std::size_t(w) + std::size_t(x);
+                                    PixelState state{nsp::Pcg32(rq.seed, px.size() + p)};
+                                    for (int k = 0; k < scout_spp; ++k)
+                                        learner.end_sample(sample(scout_estimator, learner, state, x, y, discarded));
+                                    learner.end_pixel();
+                                }
+                            t.counter.n += learner.count();
+                            t.counter.steps += learner.steps();
+                            plan.add_scout(tile, learner);
+                        }
+                    t.aborted = discarded.aborted;  // a scout's failed path is reported like any other
+                    t.nonfinite = discarded.nonfinite;
+                    t.rejected = discarded.rejected;
+                    t.cpu_seconds = thread_cpu_seconds() - cpu0;
+                    out = t;
+                };
+                run_pool(scout_work, scout_totals);
+                plan.end_scout();
+            }
+            // Pass 1: the pilot, tile by tile, at the counts the scout raised rq.pilot_count to.
+            const nsp::TechniqueCounts pilot_counts = plan.pilot_counts();
+            nsp::EstimatorOptions pilot_options = rq.estimator;
+            pilot_options.nee_count = pilot_counts.nee;
+            pilot_options.emission_segment_count = pilot_counts.emission_segment;
+            const Estimator pilot_estimator{pilot_options};
             st.nee_counts.assign(std::size_t(n_tiles), 1.f);
-            st.pilot_count = rq.pilot_count;
+            st.pilot_count = pilot_counts.nee;
             if (kEmissive) st.segment_counts.assign(st.nee_counts.size(), 1.f);
             std::atomic<int> next_slot{0};
             auto pilot_work = [&](ThreadTotals& out) {
@@ -417,7 +457,7 @@ RenderStats render(const typename C::Scene& scene, const RenderRequest& rq, std:
     st.pixels = std::size_t(w) * std::size_t(h);
     double var_mean = 0.0;
     std::array<double, 3> var_channel{}, mean{};
-    for (const auto* list : {&totals, &pilot_totals})
+    for (const auto* list : {&totals, &pilot_totals, &scout_totals})
         for (const ThreadTotals& t : *list) {
             st.lookups += t.counter.count();
             st.steps += t.counter.steps;
