@@ -142,7 +142,7 @@ public:
             for (int jn = fn; jn >= 0; --jn)
                 for (int js = segment_axis ? fs : 0; js >= 0; --js) {
                     const double e = scout.predicted_variance(jn, js) * scout.predicted_cost(jn, js);
-                    if (scout.allowed(jn, js) && e > 0.0 && e <= best) bn = jn, bs = js, best = e;
+                    if (scout.allowed(jn, js) && e > 0.0 && std::isfinite(e) && e <= best) bn = jn, bs = js, best = e;
                 }
             pilot_.nee = NeeCountLearner::candidate(bn);
             if (segment_axis) pilot_.emission_segment = NeeCountLearner::candidate(bs);
