@@ -85,8 +85,9 @@ Check check_integration(const char* name, double v) {
         return {v > 0.0, "a finite value > 0"};
     }
     if (std::strcmp(name, "tile_counts") == 0) {
-        // The per-tile counts protocol (nsp::TileCounts, a pilot at NEE count 1/4 learned in
-        // halves, each pixel's pilot weighted by pilot_weight) over the white furnace: every pixel's
+        // The per-tile counts protocol (nsp::TileCounts: a scout, a pilot at NEE count 1/4 or
+        // above learned in halves, each pixel's pilot weighted by pilot_weight) over the white
+        // furnace: every pixel's
         // radiance is exactly 1, and so is the image's mean, whatever counts the tiles chose, if the
         // pilot's weights and the rest's counts keep every pixel unbiased. Over seeds 1-12 the
         // image mean's standard deviation is 0.0006, so 0.003 is 5 SE (seed 1: fixed).
