@@ -1233,6 +1233,55 @@ TEST_CASE("TileCounts: a pilot learned in halves weighs each pixel by the other 
                          InvalidArgument);
 }
 
+TEST_CASE("TileCounts: a tile's own count below 1 that one of its halves predicts worse than 1 is disputed: counts 1") {
+    // Synthetic pilots (a light tracking finds as well as NEE, NEE's walk most of a sample's
+    // work): tile 0's even half (64 samples) shows NEE wasted, its odd half (8 samples) has one
+    // contribution only NEE finds. Merged, the tile's own choice is a low count, significant; the
+    // odd half alone predicts that count worse than counts 1, so the tile keeps 1 (Disputed).
+    // Tile 1 gets the even half's pilot on both sides: its own low count stands.
+    auto pilot = [](NeeCountLearner& l, bool only_nee_once, int reps) {
+        for (int r = 0; r < reps; ++r)
+            for (int i = 0; i < 8; ++i) {
+                const bool only_nee = only_nee_once && i == 3;
+                const float u = 0.5f + 0.25f * float((i * 7 + 1 + r) % 5);
+                for (int k = 0; k < 21; ++k) l.lookup();
+                if (!only_nee) l.record_light(u, 1.f, 1.f, 0.f, 1.f, LightTechnique::Hit);
+                l.record_light(u, only_nee ? 0.f : 1.f, 1.f, 0.f, 1.f, LightTechnique::Nee);
+                l.record_shadow_walk(20.0, true);
+                l.end_sample(double(u));
+                if (i % 2 == 1) l.end_pixel();
+            }
+    };
+    TileCounts tc(32, 16, 16);
+    NeeCountLearner even = tc.learner(), odd = tc.learner();
+    pilot(even, false, 8);
+    pilot(odd, true, 1);
+    NeeCountLearner both = even;
+    both.merge(odd);
+    const NeeCountLearner::Summary merged = both.summary();
+    REQUIRE(!merged.open);
+    REQUIRE(merged.own.nee < 1.f);  // the tile alone would take a low count
+    const int j = NeeCountLearner::candidate_index(merged.own.nee);
+    const double odd_ratio = odd.predicted_variance(j) * odd.predicted_cost(j) /
+                             (odd.predicted_variance(0) * odd.predicted_cost(0));
+    const double even_ratio = even.predicted_variance(j) * even.predicted_cost(j) /
+                              (even.predicted_variance(0) * even.predicted_cost(0));
+    MESSAGE("disputed tile: merged choice " << merged.own.nee << "; predicted efficiency there over counts 1: odd half "
+                                            << odd_ratio << ", even half " << even_ratio);
+    REQUIRE(odd_ratio > 1.0);
+    REQUIRE(even_ratio < 1.0);
+    tc.add(0, even, odd);
+    NeeCountLearner even1 = tc.learner(), odd1 = tc.learner();
+    pilot(even1, false, 8);
+    pilot(odd1, false, 8);
+    tc.add(1, even1, odd1);
+    tc.choose();
+    CHECK(tc.counts(0) == TechniqueCounts{});
+    CHECK(tc.source(0) == TileCounts::Source::Disputed);
+    CHECK(tc.counts(1).nee < 1.f);
+    CHECK(tc.source(1) == TileCounts::Source::Own);
+}
+
 TEST_CASE("TileCounts: pixels weighted by pilot_weight after a pilot at count 1/4 give the furnace's 1") {
     // The white furnace (albedo 1, unit sky: L = 1 along every ray) through a 32 x 32 image of
     // parallel rays, the protocol of docs/integration.md with a pilot at NEE count 1/4 learned in

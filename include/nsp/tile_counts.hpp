@@ -46,7 +46,10 @@ public:
     enum class Source {
         Own,       ///< its pilot showed a significant gain (or had nothing to learn from)
         Image,     ///< the image's counts, which its pilot predicts no worse than counts 1
-        CountsOne  ///< counts 1: no significant gain of its own, and the image's predicted worse
+        CountsOne,  ///< counts 1: no significant gain of its own, and the image's predicted worse
+        /// counts 1: its own choice, significant over the whole tile, is predicted worse than
+        /// counts 1 by one of its halves (add(t, even, odd)) alone: a tail one half did not see
+        Disputed
     };
 
     /// Tiles of tile_size^2 pixels over a width x height image; the learners take `costs` and a
@@ -174,9 +177,14 @@ public:
     }
     /// Tile t's pilot is done, learned in two halves of its pixels: `even` from the pixels with
     /// x + y even, `odd` from the others. The tile's counts are chosen from both merged, as by
-    /// add(t, learner); each half's predicted variances at the pilot's counts and at its own
-    /// choice are kept so that a pixel's pilot samples can be weighted by the other half's
-    /// (pilot_weight). Throws as add(t, learner).
+    /// add(t, learner), with one cross-check: its own choice below counts 1 stands only where
+    /// each half alone predicts it no worse than counts 1, else the tile keeps counts 1
+    /// (Source::Disputed; on the chromatic cloud's set-up C2, one tile of four chose NEE 1/2 in
+    /// 3 renders of 15, significant over the tile, and the image's variance rose 1.55-2.15x; with
+    /// the cross-check every tile keeps 1 in those 15, while D's and C3's tiles keep their low
+    /// counts). Each half's predicted variances at the
+    /// pilot's counts and at its own choice are kept so that a pixel's pilot samples can be
+    /// weighted by the other half's (pilot_weight). Throws as add(t, learner).
     void add(int t, const NeeCountLearner& even, const NeeCountLearner& odd) {
         check_pilot_add(t);
         NeeCountLearner both = even;
@@ -186,6 +194,17 @@ public:
         next_[std::size_t(t % kSlots)] = t + kSlots;
         Halves& h = halves_[std::size_t(t)];
         h.learned = true;
+        // The cross-check: the tile's own choice below counts 1 stands only where each half alone
+        // predicts it no worse than counts 1.
+        const NeeCountLearner::Summary& s = summaries_[std::size_t(t)];
+        const int on = candidate_of(s.own.nee),
+                  os = candidate_of(s.light_subpath ? s.own.light_subpath : s.own.emission_segment);
+        if (!s.open && on >= 0 && os >= 0 && (on != 0 || os != 0))
+            for (const NeeCountLearner* l : {&even, &odd}) {
+                const double e = l->predicted_variance(on, os) * l->predicted_cost(on, os),
+                             e1 = l->predicted_variance(0, 0) * l->predicted_cost(0, 0);
+                if (!(e <= e1)) h.disputed = true;
+            }
         for (int half = 0; half < 2; ++half) {
             const NeeCountLearner& l = half == 0 ? even : odd;
             const NeeCountLearner::Summary own = l.summary();  // its choose_counts() and axis
@@ -240,6 +259,11 @@ public:
         image_counts_ = image_.choose_counts();
         for (int t = 0; t < tile_count(); ++t) {
             const NeeCountLearner::Summary& s = summaries_[std::size_t(t)];
+            if (halves_[std::size_t(t)].disputed) {
+                counts_[std::size_t(t)] = TechniqueCounts{};
+                sources_[std::size_t(t)] = Source::Disputed;
+                continue;
+            }
             const TechniqueCounts c = NeeCountLearner::choose_counts(s, image_counts_);
             counts_[std::size_t(t)] = c;
             sources_[std::size_t(t)] = !s.open                  ? Source::Own
@@ -299,7 +323,7 @@ private:
     /// Per tile added in halves: each half's predicted variance at the pilot's counts and at
     /// the counts it chooses alone (0: no weight from it).
     struct Halves {
-        bool learned = false;
+        bool learned = false, disputed = false;
         std::array<float, 2> pilot_variance{}, chosen_variance{};
     };
     std::vector<Halves> halves_;
