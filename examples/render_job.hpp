@@ -46,7 +46,7 @@ struct RenderRequest {
     std::string label;  ///< for the line shown in place while it renders (on a terminal)
     bool pixel_stats = false;  ///< also return every pixel's mean and sample variance (RenderStats)
     /// Learn the NEE count per tile (combinations with learns_nee_count only): the first
-    /// pilot_spp(spp) samples of every pixel at pilot_count with an nsp::NeeCountLearner per
+    /// pilot_spp(spp) samples of every pixel at pilot_count (or above: scout) with an nsp::NeeCountLearner per
     /// half of each tile_size^2 tile, the rest at the tile's chosen count (its own where its pilot shows it
     /// pays, else the image's where its pilot predicts that no worse than count 1). Every sample,
     /// the pilot's too, is in the image and the stats (weighed as weigh_pilot says).

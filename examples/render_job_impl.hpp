@@ -190,8 +190,9 @@ struct PixelState {
 /// Renders `scene` with combination C's estimator: per pixel, `spp` jittered camera rays (and in
 /// Hero mode a wavelength draw per path); one Pcg32 stream per pixel (so images do not depend on
 /// the thread count); rows handed out to threads through an atomic counter. Writes the mean
-/// linear RGB into `rgb`. With rq.learn_nee_counts (C::learns_nee_count), a first pass renders
-/// each tile's pilot samples at rq.pilot_count with an nsp::NeeCountLearner per half of the tile
+/// linear RGB into `rgb`. With rq.learn_nee_counts (C::learns_nee_count), a scout (rq.scout: 2
+/// samples of one pixel in 16, not in the image) raises the pilot's counts from rq.pilot_count,
+/// then a first pass renders each tile's pilot samples with an nsp::NeeCountLearner per half of the tile
 /// as their counter, tiles handed out to threads in fixed slots (the chosen counts do not depend
 /// on the thread count); a tile keeps its own counts where its pilot shows they pay, else takes
 /// the image's (every tile's pilot merged) where its pilot predicts them no worse than counts 1;

@@ -48,7 +48,7 @@ public:
         Image,     ///< the image's counts, which its pilot predicts no worse than counts 1
         CountsOne,  ///< counts 1: no significant gain of its own, and the image's predicted worse
         /// counts 1: its own choice, significant over the whole tile, is predicted worse than
-        /// counts 1 by one of its halves (add(t, even, odd)) alone: a tail one half did not see
+        /// counts 1 by one of its halves (add(t, even, odd)) alone: a tail that half saw
         Disputed
     };
 
@@ -110,7 +110,7 @@ public:
         return x % kScoutStride == kScoutStride / 2 && y % kScoutStride == kScoutStride / 2;
     }
     /// The scout's samples per scout pixel: 2 (at most spp). Over a 128 x 128 image, 2048
-    /// samples at 1/16 of a 2-spp pass: 1/512 of a 256-spp render's samples.
+    /// samples: 1/2048 of a 256-spp render's samples.
     static constexpr int scout_spp(int spp) noexcept { return std::min(spp, 2); }
     /// A fresh learner for one tile's scout pixels, at the constructed pilot counts.
     NeeCountLearner scout_learner() const { return NeeCountLearner(costs_, floor_); }
@@ -182,9 +182,9 @@ public:
     /// (Source::Disputed; on the chromatic cloud's set-up C2, one tile of four chose NEE 1/2 in
     /// 3 renders of 15, significant over the tile, and the image's variance rose 1.55-2.15x; with
     /// the cross-check every tile keeps 1 in those 15, while D's and C3's tiles keep their low
-    /// counts). Each half's predicted variances at the
-    /// pilot's counts and at its own choice are kept so that a pixel's pilot samples can be
-    /// weighted by the other half's (pilot_weight). Throws as add(t, learner).
+    /// counts). Each half's predicted variances at the pilot's counts and at its own choice are
+    /// kept so that a pixel's pilot samples can be weighted by the other half's (pilot_weight).
+    /// Throws as add(t, learner).
     void add(int t, const NeeCountLearner& even, const NeeCountLearner& odd) {
         check_pilot_add(t);
         NeeCountLearner both = even;
