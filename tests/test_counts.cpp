@@ -41,6 +41,17 @@ void for_each_nee_strategy(float c, const EstimatorOptions& o, F check) {
     check(PathEstimator<strategy::EquiangularMis, mis::Balance, A>(oc), "uni-nee-eq-mis balance");
 }
 
+/// One synthetic pilot sample: a light contribution u that tracking finds as well as NEE (p_hit =
+/// p_nee), or (`only_nee`) that only NEE finds (a small light); NEE's walk costs 20 of the
+/// sample's 21 lookups.
+void synthetic_sample(NeeCountLearner& l, float u, bool only_nee) {
+    for (int k = 0; k < 21; ++k) l.lookup();
+    if (!only_nee) l.record_light(u, 1.f, 1.f, 0.f, 1.f, LightTechnique::Hit);
+    l.record_light(u, only_nee ? 0.f : 1.f, 1.f, 0.f, 1.f, LightTechnique::Nee);
+    l.record_shadow_walk(20.0, true);
+    l.end_sample(double(u));
+}
+
 }  // namespace
 
 TEST_CASE("NEE counts: the two weights of one path sum to 1 and weigh NEE by nee_count x its pdf") {
@@ -964,12 +975,7 @@ TEST_CASE("NeeCountLearner: bookkeeping") {
         // count falls, the segment count, which changes nothing, stays 1.
         NeeCountLearner l;
         for (int i = 0; i < 100; ++i) {
-            const float u = i % 2 ? 3.f : 1.f;
-            for (int k = 0; k < 21; ++k) l.lookup();
-            l.record_light(u, 1.f, 1.f, 0.f, 1.f, LightTechnique::Hit);
-            l.record_light(u, 1.f, 1.f, 0.f, 1.f, LightTechnique::Nee);
-            l.record_shadow_walk(20.0, true);
-            l.end_sample(double(u));
+            synthetic_sample(l, i % 2 ? 3.f : 1.f, false);
             if (i % 10 == 9) l.end_pixel();
         }
         const TechniqueCounts n = l.choose_counts();
@@ -990,11 +996,7 @@ TEST_CASE("NeeCountLearner: bookkeeping") {
         auto pilot = [](NeeCountLearner& l, std::initializer_list<Sample> samples) {
             int i = 0;
             for (const Sample& smp : samples) {
-                for (int k = 0; k < 21; ++k) l.lookup();
-                if (!smp.only_nee) l.record_light(smp.u, 1.f, 1.f, 0.f, 1.f, LightTechnique::Hit);
-                l.record_light(smp.u, smp.only_nee ? 0.f : 1.f, 1.f, 0.f, 1.f, LightTechnique::Nee);
-                l.record_shadow_walk(20.0, true);
-                l.end_sample(double(smp.u));
+                synthetic_sample(l, smp.u, smp.only_nee);
                 if (++i % 2 == 0) l.end_pixel();
             }
         };
@@ -1108,13 +1110,7 @@ TEST_CASE("TileCounts: the host protocol gives every tile the counts of the manu
     // image predictions to the bit.
     auto pilot = [](NeeCountLearner& l, int t) {
         for (int i = 0; i < 8; ++i) {
-            const bool only_nee = t % 3 == 0 && i == 3;
-            const float u = 0.5f + 0.25f * float((i * 7 + t) % 5);
-            for (int k = 0; k < 21; ++k) l.lookup();
-            if (!only_nee) l.record_light(u, 1.f, 1.f, 0.f, 1.f, LightTechnique::Hit);
-            l.record_light(u, only_nee ? 0.f : 1.f, 1.f, 0.f, 1.f, LightTechnique::Nee);
-            l.record_shadow_walk(20.0, true);
-            l.end_sample(double(u));
+            synthetic_sample(l, 0.5f + 0.25f * float((i * 7 + t) % 5), t % 3 == 0 && i == 3);
             if (i % 2 == 1) l.end_pixel();
         }
     };
@@ -1242,13 +1238,7 @@ TEST_CASE("TileCounts: a tile's own count below 1 that one of its halves predict
     auto pilot = [](NeeCountLearner& l, bool only_nee_once, int reps) {
         for (int r = 0; r < reps; ++r)
             for (int i = 0; i < 8; ++i) {
-                const bool only_nee = only_nee_once && i == 3;
-                const float u = 0.5f + 0.25f * float((i * 7 + 1 + r) % 5);
-                for (int k = 0; k < 21; ++k) l.lookup();
-                if (!only_nee) l.record_light(u, 1.f, 1.f, 0.f, 1.f, LightTechnique::Hit);
-                l.record_light(u, only_nee ? 0.f : 1.f, 1.f, 0.f, 1.f, LightTechnique::Nee);
-                l.record_shadow_walk(20.0, true);
-                l.end_sample(double(u));
+                synthetic_sample(l, 0.5f + 0.25f * float((i * 7 + 1 + r) % 5), only_nee_once && i == 3);
                 if (i % 2 == 1) l.end_pixel();
             }
     };
