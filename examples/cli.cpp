@@ -215,6 +215,12 @@ Options parse_command_line(int argc, char** argv) {
           [&](std::string_view v) { o.estimator.max_depth = parse_number<int>("--max-depth", v, 0, 1 << 20); });
     flag("--equiangular-every-segment", "uni-nee-eq-mis: an equiangular vertex on every segment",
          [&] { o.estimator.adaptive_equiangular = false; });
+    value("--equiangular-count", "C",
+          "draw the equiangular vertex on a fraction C in [0, 1] of the pieces (0: uni-nee-eq-mis is uni-nee-mis; "
+          "equiangular-nee refuses 0)",
+          [&](std::string_view v) {
+              o.estimator.equiangular_count = parse_number<float>("--equiangular-count", v, 0.f, 1.f);
+          });
     flag("--no-emission-segments", "leave out the emission segment technique (plume)",
          [&] { o.estimator.emission_along_segments = false; });
     value("--emission-segment-count", "C", "run the emission segment technique on a fraction C in (0, 1] of segments",

@@ -1444,6 +1444,33 @@ TEST_CASE("NEE counts: a count outside [0, 1] is rejected by name, by BDPT too; 
                          doctest::Contains("nee_count = 0 is not allowed with strategy ratio-nee"), InvalidArgument);
 }
 
+TEST_CASE("equiangular counts: a count outside [0, 1] is rejected by name; 0 where equiangular vertices are the only way") {
+    auto eq_count = [](float c) {
+        EstimatorOptions o;
+        o.equiangular_count = c;
+        return o;
+    };
+    for (const float bad : {-0.5f, 1.5f, std::nanf("")}) {
+        CAPTURE(bad);
+        CHECK_THROWS_WITH_AS((PathEstimator<strategy::EquiangularMis, mis::Balance>(eq_count(bad))),
+                             doctest::Contains("equiangular_count"), InvalidArgument);
+        CHECK_THROWS_WITH_AS((SpectralPathEstimator<channels::SpectralMis, strategy::EquiangularMis, mis::Balance>(
+                                 eq_count(bad))),
+                             doctest::Contains("equiangular_count"), InvalidArgument);
+    }
+    CHECK_THROWS_WITH_AS((PathEstimator<strategy::EquiangularMis, mis::Balance>(eq_count(2.f))),
+                         doctest::Contains("equiangular_count = 2 is not allowed: an expected sample count must lie in [0, 1]"),
+                         InvalidArgument);
+    CHECK_NOTHROW((PathEstimator<strategy::EquiangularMis, mis::Balance>(eq_count(0.f))));
+    CHECK_NOTHROW((PathEstimator<strategy::EquiangularNextEvent>(eq_count(0.5f))));
+    CHECK_THROWS_WITH_AS((PathEstimator<strategy::EquiangularNextEvent>(eq_count(0.f))),
+                         doctest::Contains("equiangular_count = 0 is not allowed with strategy equiangular-nee"),
+                         InvalidArgument);
+    CHECK_THROWS_WITH_AS((SpectralPathEstimator<channels::Independent, strategy::EquiangularNextEvent>(eq_count(0.f))),
+                         doctest::Contains("equiangular_count = 0 is not allowed with strategy equiangular-nee"),
+                         InvalidArgument);
+}
+
 TEST_CASE("emission segment counts: a count outside [0, 1] is rejected by name, by every estimator") {
     for (const float bad : {-0.5f, 1.5f, std::nanf("")}) {
         CAPTURE(bad);

@@ -6,8 +6,8 @@
 // runs its estimate divides by n, and every MIS weight takes n p in place of its pdf p. That keeps
 // the estimator unbiased for any n in (0, 1] and lets a technique that does not pay for itself be
 // drawn rarely; n = 0 removes the technique from every weight, unbiased where the others cover
-// what it samples (EstimatorOptions says where nsp allows it). The adaptive equiangular
-// probability (EstimatorOptions::adaptive_equiangular),
+// what it samples (EstimatorOptions says where nsp allows it). The equiangular vertex's count
+// (EstimatorOptions::equiangular_count, times the adaptive probability of adaptive_equiangular),
 // BDPT's light_subpath_probability, the NEE count (EstimatorOptions::nee_count) and the emission
 // segment technique's count (EstimatorOptions::emission_segment_count) are such counts.
 //

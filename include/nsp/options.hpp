@@ -80,6 +80,17 @@ struct EstimatorOptions {
     /// strategy::EquiangularMis: draw the equiangular vertex of a segment with the probability of
     /// equiangular_probability (below) instead of on every segment. Off: on every segment.
     bool adaptive_equiangular = true;
+    /// The expected count of the equiangular vertex on each piece of a segment, in [0, 1] (THEORY
+    /// 5.9, counts.hpp), for the strategies with equiangular sampling: the piece draws it with
+    /// probability equiangular_count (x equiangular_probability where adaptive_equiangular applies),
+    /// its estimate divided by that, and every weight takes the product x its density. 1: as
+    /// without counts. 0: strategy::EquiangularMis never draws it and it is absent from every
+    /// weight, so the estimator is exactly uni + NEE MIS (tracking and NEE from tracked vertices
+    /// reach every light it reaches); strategy::EquiangularNextEvent reaches the lights from its
+    /// equiangular vertices alone and refuses 0 at construction. nsp::PathEstimator and
+    /// nsp::SpectralPathEstimator; nsp::BdptEstimator's equiangular strategy is on or off
+    /// (bdpt_equiangular).
+    float equiangular_count = 1.f;
     /// The combining strategies on an emissive medium: on every segment also draw one point in
     /// proportion to the emitted power along the segment (the segment technique of THEORY 5.7,
     /// the nulls before it ratio-tracked), combined with the collision estimator and NEE toward
@@ -194,6 +205,7 @@ inline void validate(const EstimatorOptions& opts) {
                      " is not allowed: it must lie in (0, 1]");
     validate_count("EstimatorOptions nee_count", opts.nee_count, true);
     validate_count("EstimatorOptions emission_segment_count", opts.emission_segment_count, true);
+    validate_count("EstimatorOptions equiangular_count", opts.equiangular_count, true);
 }
 
 }  // namespace nsp

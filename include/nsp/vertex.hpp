@@ -219,12 +219,17 @@ public:
     using Absorption = A;
 
     /// Throws InvalidArgument on invalid roulette settings or counts (see EstimatorOptions), and
-    /// on nee_count 0 with a strategy that reaches the lights by NEE alone.
+    /// on nee_count 0 with a strategy that reaches the lights by NEE alone and equiangular_count 0
+    /// with one whose only NEE is from equiangular vertices.
     explicit VertexKernels(EstimatorOptions opts = {}, H heuristic = H{}) : opts_(opts), heuristic_(heuristic) {
         validate(opts);
         if (St::samples_lights && !St::hits_lights && opts.nee_count == 0.f)
             detail::fail("EstimatorOptions nee_count = 0 is not allowed with strategy ", St::name,
                          ": NEE is its only way to the lights (a count of 0 needs a strategy that also hits them)");
+        if (St::equiangular && !St::combines && opts.equiangular_count == 0.f)
+            detail::fail("EstimatorOptions equiangular_count = 0 is not allowed with strategy ", St::name,
+                         ": its equiangular vertices are its only way to light scattered in the media (a count of 0 "
+                         "needs strategy uni-nee-eq-mis)");
     }
 
     const EstimatorOptions& options() const noexcept { return opts_; }

@@ -75,17 +75,19 @@ public:
         return ds;
     }
 
-    /// The probability with which the piece draws an equiangular vertex: 1, or with
-    /// EstimatorOptions::adaptive_equiangular (combining strategies) the largest over the targets
-    /// of equiangular_probability; a function of the piece alone, as every technique needs it.
+    /// The probability with which the piece draws an equiangular vertex: the expected count
+    /// EstimatorOptions::equiangular_count, with EstimatorOptions::adaptive_equiangular (combining
+    /// strategies) times the largest over the targets of equiangular_probability; a function of
+    /// the piece alone, as every technique needs it. 0 at count 0: the technique is absent.
     template <PathStrategy St, Medium M, MajorantPolicy<M> Maj>
     float selection(const EstimatorOptions& opts, const Maj& majorant,
                     const typename M::Spectral::Wavelengths& lambda) const noexcept {
-        if (!St::combines || !opts.adaptive_equiangular) return 1.f;
+        const float count = opts.equiangular_count;
+        if (!St::combines || !opts.adaptive_equiangular || !(count > 0.f)) return count;
         float p = 0.f;
         for (int k = 0; k < sc_->lights.equiangular_count(); ++k)
             p = std::max(p, equiangular_probability<M>(majorant, ray_, sampler(k), lambda));
-        return p;
+        return count * p;
     }
 
 private:

@@ -100,7 +100,8 @@ RadianceSample<typename Sc::Spectral> trace_path(const K& k, const Sc& sc, const
                 eq = PieceEquiangular<Sc>(sc, ray, in.t0, in.t1);
                 if (eq.valid()) {
                     eq_select = eq.template selection<St, typename Sc::MediumType>(opts, m.majorant, lambda);
-                    if (depth < opts.max_depth && draw_technique(eq_select, rng)) {
+                    // At count 0 no number is drawn: the loop is uni + NEE MIS's, draw for draw.
+                    if (depth < opts.max_depth && eq_select > 0.f && draw_technique(eq_select, rng)) {
                         const Status es =
                             equiangular_nee(st, sc, medium, ray, eq, eq_select, depth + 1, lambda, rng, counter, L);
                         if (es == Status::NonFinite) return {Spectrum::Zero(), es};  // an overflowed flight
@@ -132,7 +133,7 @@ RadianceSample<typename Sc::Spectral> trace_path(const K& k, const Sc& sc, const
                 in_medium = true;
                 t_medium = t;
                 if constexpr (St::equiangular) {
-                    eq_covers = eq.valid();
+                    eq_covers = eq.valid() && eq_select > 0.f;  // at count 0 tracking's alone
                     // inf (grey) where the tracking pdf underflowed: equiangular then takes the weight
                     if (eq_covers) eq_x = st.vertex_eq(eq_select * eq.density(t));
                 }
