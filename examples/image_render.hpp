@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <ctime>
 #include <functional>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -19,6 +20,7 @@
 
 #include "image_row.hpp"
 #include "png_writer.hpp"
+#include "tile_learning.hpp"
 
 namespace nsp_examples {
 
@@ -41,64 +43,41 @@ auto count_ladder(Make make) {
     return ladder;
 }
 
-/// The pilot of render_pixels and render_splatting on `plan` (nsp::TileCounts, the protocol of
-/// docs/integration.md): threads take whole slots (`run_pool(work)` runs work(Out&) on each
-/// thread's totals), a slot's tiles in order, so the counts do not depend on the thread count;
-/// `pilot_pixel(out, learner, x, y)` runs pixel (x, y)'s pilot samples with the tile's learner as
-/// their counter (and end_sample after each). Each tile's lookups, steps and the thread CPU time
-/// go to the thread's totals. Ends with plan.choose().
-template <class Out, class Pool, class PilotPixel>
-void learn_tiles(nsp::TileCounts& plan, Pool&& run_pool, PilotPixel&& pilot_pixel) {
-    std::atomic<int> next_slot{0};
-    auto learn = [&](Out& out) {
-        const double cpu0 = thread_cpu_seconds();
-        for (int j; (j = next_slot.fetch_add(1)) < nsp::TileCounts::kSlots;)
-            for (const int t : plan.slot_tiles(j)) {
-                nsp::NeeCountLearner learner = plan.learner();
-                const nsp::TileCounts::Rect r = plan.tile_rect(t);
-                for (int y = r.y0; y < r.y1; ++y)
-                    for (int x = r.x0; x < r.x1; ++x) {
-                        pilot_pixel(out, learner, x, y);
-                        learner.end_pixel();
-                    }
-                plan.add(t, learner);
-                out.lookups += learner.count();
-                out.steps += learner.steps();
-            }
-        out.cpu += thread_cpu_seconds() - cpu0;
-    };
-    run_pool(learn);
-    plan.choose();
-}
-
 /// The core of render_image and render_image_learned: `ladder` holds the estimator at every
 /// candidate pair of counts (NEE x emission segment technique, NeeCountLearner's order), or one
-/// estimator; with `pilot` > 0 the first `pilot` samples of each pixel run ladder[0] (counts 1)
-/// with an nsp::NeeCountLearner per 16x16 tile as their counter (tiles handed to threads in fixed
-/// slots, so the counts do not depend on the thread count), the rest the tile's chosen pair
-/// (written to `chosen`, a tile per entry, row-major): its own where its pilot shows it pays,
-/// else the image's (all tiles' pilots merged) where its pilot predicts that no worse than counts
-/// 1; every sample is in the statistics. Per-tile counts are
-/// sound here: every strategy of radiance() adds to its own sample's pixel alone.
+/// estimator; with `pilot` > 0 the counts are learned per 16x16 tile by nsp::TileCounts's protocol
+/// (docs/integration.md, tile_learning.hpp; as nsp_render's learned rows, with nsp's default cost
+/// model): a scout of 2 samples of one pixel in 16 (streams of their own, not in the image) raises
+/// the pilot's counts from `pilot_count` (the segment's too where the medium emits) to those it
+/// predicts best; the first `pilot` samples of each pixel run at those counts, in two halves per
+/// tile; the rest at the tile's chosen pair (written to `chosen`, a tile per entry, row-major);
+/// each pixel's pilot mean weighs as TileCounts::pilot_weight says, and every sample is in the
+/// statistics. Per-tile counts are sound here: every strategy of radiance() adds to its own
+/// sample's pixel alone.
 template <class Sc, class E, class Camera>
 Row render_pixels(const Sc& scene, const std::vector<E>& ladder, const std::string& name, int res, int spp, int threads,
-                  std::uint64_t seed, const Camera& camera, int pilot, std::vector<nsp::TechniqueCounts>* chosen) {
+                  std::uint64_t seed, const Camera& camera, int pilot, float pilot_count,
+                  std::vector<nsp::TechniqueCounts>* chosen) {
     constexpr int kChannels = Sc::Spectral::channels;
     constexpr int kC = nsp::NeeCountLearner::kCandidates, kTile = 16;
+    constexpr bool kEmissive = nsp::EmissiveMedium<typename Sc::MediumType>;
     const std::size_t n_pix = std::size_t(res) * std::size_t(res);
     Row row;
     row.name = name;
     row.image.width = row.image.height = res;
     row.image.rgb.assign(n_pix * 3u, 0.f);
-    struct Pixel {
-        nsp::Pcg32 rng;
+    struct Stats {  // the channel mean's running mean and squared deviations, each channel's sum
         int k = 0;
         double mean = 0.0, m2 = 0.0;
         std::array<double, 3> rgb{};
     };
+    struct Pixel {
+        nsp::Pcg32 rng;
+        Stats rest, first;  // the samples after the pilot (all of them without one); the pilot's
+    };
     std::vector<Pixel> pixels;
     pixels.reserve(n_pix);
-    for (std::size_t p = 0; p < n_pix; ++p) pixels.push_back(Pixel{nsp::Pcg32(seed, p)});
+    for (std::size_t p = 0; p < n_pix; ++p) pixels.push_back(Pixel{nsp::Pcg32(seed, p), {}, {}});
     struct Totals {
         std::uint64_t lookups = 0, steps = 0, failed = 0;
         double cpu = 0.0;
@@ -107,19 +86,31 @@ Row render_pixels(const Sc& scene, const std::vector<E>& ladder, const std::stri
     const int tiles_x = (res + kTile - 1) / kTile, n_tiles = tiles_x * tiles_x;
     std::vector<std::size_t> tile_pair(std::size_t(n_tiles), 0);  // index into ladder
     if (chosen) chosen->assign(std::size_t(n_tiles), nsp::TechniqueCounts{});
-    // Samples of pixel (x, y) up to the k1-th with `estimator` and `counter`, each one's value to `each`.
-    auto run_samples = [&](Totals& out, const E& estimator, auto& counter, int x, int y, int k1, auto&& each) {
+    auto pair_of = [&](const nsp::TechniqueCounts& c) {
+        if (ladder.size() != std::size_t(kC * kC)) return std::size_t(0);
+        return std::size_t(nsp::NeeCountLearner::candidate_index(c.nee) * kC +
+                           nsp::NeeCountLearner::candidate_index(c.emission_segment));
+    };
+    // One sample of pixel (x, y) from `rng` with `estimator` and `counter`: its value.
+    auto one_sample = [&](Totals& out, const E& estimator, auto& counter, nsp::Pcg32& rng, int x, int y) {
+        const float u = (float(x) + rng.uniform()) / float(res);
+        const float v = 1.f - (float(y) + rng.uniform()) / float(res);
+        const auto r = estimator.radiance(scene, camera(u, v), {}, rng, counter);
+        if (r.status != nsp::Status::Ok) ++out.failed;
+        return r.value;
+    };
+    // n more samples of pixel (x, y) into its statistics `to`, each one's channel mean to `each`.
+    auto run_samples = [&](Totals& out, const E& estimator, auto& counter, int x, int y, int n, Stats Pixel::*to,
+                           auto&& each) {
         Pixel& px = pixels[std::size_t(y) * std::size_t(res) + std::size_t(x)];
-        while (px.k < k1) {
-            const float u = (float(x) + px.rng.uniform()) / float(res);
-            const float v = 1.f - (float(y) + px.rng.uniform()) / float(res);
-            const auto r = estimator.radiance(scene, camera(u, v), {}, px.rng, counter);
-            if (r.status != nsp::Status::Ok) ++out.failed;
-            for (int c = 0; c < 3; ++c) px.rgb[std::size_t(c)] += r.value[kChannels == 3 ? c : 0];
-            const double L = double(r.value.mean()), d = L - px.mean;
-            ++px.k;
-            px.mean += d / px.k;
-            px.m2 += d * (L - px.mean);
+        Stats& s = px.*to;
+        for (int i = 0; i < n; ++i) {
+            const auto value = one_sample(out, estimator, counter, px.rng, x, y);
+            for (int c = 0; c < 3; ++c) s.rgb[std::size_t(c)] += value[kChannels == 3 ? c : 0];
+            const double L = double(value.mean()), d = L - s.mean;
+            ++s.k;
+            s.mean += d / s.k;
+            s.m2 += d * (L - s.mean);
             each(L);
         }
     };
@@ -128,21 +119,48 @@ Row render_pixels(const Sc& scene, const std::vector<E>& ladder, const std::stri
         for (int t = 0; t < threads; ++t) pool.emplace_back(work, std::ref(totals[std::size_t(t)]));
         for (auto& t : pool) t.join();
     };
+    auto timed_pool = [&](auto& work) {  // run_pool with each thread's CPU time
+        auto timed = [&work](Totals& out) {
+            const double cpu0 = thread_cpu_seconds();
+            work(out);
+            out.cpu += thread_cpu_seconds() - cpu0;
+        };
+        run_pool(timed);
+    };
+    auto add_work = [](Totals& out, const nsp::NeeCountLearner& l) {
+        out.lookups += l.count();
+        out.steps += l.steps();
+    };
     const auto start = std::chrono::steady_clock::now();
     const int first = std::min(pilot, spp);
+    std::optional<nsp::TileCounts> plan;
     if (first > 0) {
-        // Each tile keeps its own counts where its pilot shows they pay, else takes the image's
-        // where its pilot predicts them no worse than counts 1 (nsp::TileCounts).
-        nsp::TileCounts plan(res, res, kTile);
-        learn_tiles<Totals>(plan, run_pool, [&](Totals& out, nsp::NeeCountLearner& learner, int x, int y) {
-            run_samples(out, ladder[0], learner, x, y, first, [&](double v) { learner.end_sample(v); });
-        });
+        nsp::TechniqueCounts floor;
+        floor.nee = pilot_count;
+        floor.emission_segment = kEmissive ? pilot_count : 1.f;
+        plan.emplace(res, res, kTile, nsp::CostModel{}, floor);
+        const E& scout_estimator = ladder[pair_of(floor)];
+        const int scout_spp = nsp::TileCounts::scout_spp(spp);
+        scout_tiles<Totals>(
+            *plan, timed_pool,
+            [&](Totals& out, nsp::NeeCountLearner& learner, int x, int y) {
+                nsp::Pcg32 rng(seed, n_pix + std::size_t(y) * std::size_t(res) + std::size_t(x));
+                for (int k = 0; k < scout_spp; ++k)
+                    learner.end_sample(double(one_sample(out, scout_estimator, learner, rng, x, y).mean()));
+            },
+            add_work);
+        const E& pilot_estimator = ladder[pair_of(plan->pilot_counts())];
+        pilot_tiles<Totals>(
+            *plan, true, timed_pool,
+            [&](Totals& out, nsp::NeeCountLearner& learner, int x, int y) {
+                run_samples(out, pilot_estimator, learner, x, y, first, &Pixel::first,
+                            [&](double v) { learner.end_sample(v); });
+            },
+            add_work);
         for (int t = 0; t < n_tiles; ++t) {
-            const nsp::TechniqueCounts& c = plan.counts(t);
+            const nsp::TechniqueCounts& c = plan->counts(t);
             if (chosen) (*chosen)[std::size_t(t)] = c;
-            if (ladder.size() == std::size_t(kC * kC))
-                tile_pair[std::size_t(t)] = std::size_t(nsp::NeeCountLearner::candidate_index(c.nee) * kC +
-                                                        nsp::NeeCountLearner::candidate_index(c.emission_segment));
+            tile_pair[std::size_t(t)] = pair_of(c);
         }
     }
     std::atomic<int> next{0};
@@ -152,7 +170,7 @@ Row render_pixels(const Sc& scene, const std::vector<E>& ladder, const std::stri
         for (int y; (y = next.fetch_add(1)) < res;)
             for (int x = 0; x < res; ++x) {
                 const std::size_t t = std::size_t((y / kTile) * tiles_x + x / kTile);
-                run_samples(out, ladder[tile_pair[t]], counter, x, y, spp, [](double) {});
+                run_samples(out, ladder[tile_pair[t]], counter, x, y, spp - first, &Pixel::rest, [](double) {});
             }
         out.lookups += counter.count();
         out.steps += counter.steps;
@@ -170,10 +188,25 @@ Row render_pixels(const Sc& scene, const std::vector<E>& ladder, const std::stri
     const double n_pixels = double(n_pix), samples = n_pixels * spp;
     double sum_var = 0.0, sum_mean = 0.0;
     for (std::size_t p = 0; p < n_pix; ++p) {
-        const Pixel& px = pixels[p];
-        for (int c = 0; c < 3; ++c) row.image.rgb[3 * p + std::size_t(c)] = float(px.rgb[std::size_t(c)] / spp);
-        sum_var += px.m2 / (spp - 1);
-        sum_mean += px.mean;
+        const Stats &f = pixels[p].first, &r = pixels[p].rest;
+        const int x = int(p % std::size_t(res)), y = int(p / std::size_t(res));
+        if (f.k >= 2 && r.k >= 2) {  // the pilot's mean weighs a, the rest's 1 - a (TileCounts::pilot_weight)
+            const double a = plan->pilot_weight(x, y, f.k, spp);
+            for (int c = 0; c < 3; ++c)
+                row.image.rgb[3 * p + std::size_t(c)] =
+                    float(a * f.rgb[std::size_t(c)] / f.k + (1.0 - a) * r.rgb[std::size_t(c)] / r.k);
+            // The weighted mean's variance, per sample (times spp), each side's from its own samples.
+            sum_var += (a * a * f.m2 / (f.k - 1) / f.k + (1.0 - a) * (1.0 - a) * r.m2 / (r.k - 1) / r.k) * spp;
+            sum_mean += a * f.mean + (1.0 - a) * r.mean;
+        } else {  // every sample weighs the same: the two sides' Welford sums merged
+            const int n = f.k + r.k;
+            const double d = r.mean - f.mean, mean = f.mean + d * r.k / n;
+            const double m2 = f.m2 + r.m2 + d * d * double(f.k) * double(r.k) / n;
+            for (int c = 0; c < 3; ++c)
+                row.image.rgb[3 * p + std::size_t(c)] = float((f.rgb[std::size_t(c)] + r.rgb[std::size_t(c)]) / spp);
+            sum_var += m2 / (spp - 1);
+            sum_mean += mean;
+        }
     }
     row.lookups = lookups / samples;
     row.steps = steps / samples;
@@ -191,17 +224,20 @@ Row render_pixels(const Sc& scene, const std::vector<E>& ladder, const std::stri
 template <class Sc, class E, class Camera>
 Row render_image(const Sc& scene, const E& estimator, const std::string& name, int res, int spp, int threads,
                  std::uint64_t seed, const Camera& camera) {
-    return detail::render_pixels(scene, std::vector<E>{estimator}, name, res, spp, threads, seed, camera, 0, nullptr);
+    return detail::render_pixels(scene, std::vector<E>{estimator}, name, res, spp, threads, seed, camera, 0, 1.f,
+                                 nullptr);
 }
 
 /// render_image with the NEE count and the emission segment count learned per 16x16 tile (THEORY
-/// 5.9, nsp::NeeCountLearner; see detail::render_pixels): a pilot of `pilot` samples per pixel at
-/// counts 1, the rest at the tile's pair, the tiles' pairs to `chosen`;
-/// `make(nee_count, emission_segment_count)` builds the estimator at a pair.
+/// 5.9, nsp::TileCounts; see detail::render_pixels): a scout, a pilot of `pilot` samples per pixel
+/// at `pilot_count` or the counts the scout raised it to, the rest at the tile's pair, the tiles'
+/// pairs to `chosen`; `make(nee_count, emission_segment_count)` builds the estimator at a pair.
 template <class Sc, class Make, class Camera>
 Row render_image_learned(const Sc& scene, Make make, const std::string& name, int res, int spp, int threads,
-                         std::uint64_t seed, const Camera& camera, int pilot, std::vector<nsp::TechniqueCounts>* chosen) {
-    return detail::render_pixels(scene, detail::count_ladder(make), name, res, spp, threads, seed, camera, pilot, chosen);
+                         std::uint64_t seed, const Camera& camera, int pilot, float pilot_count,
+                         std::vector<nsp::TechniqueCounts>* chosen) {
+    return detail::render_pixels(scene, detail::count_ladder(make), name, res, spp, threads, seed, camera, pilot,
+                                 pilot_count, chosen);
 }
 
 namespace detail {
@@ -209,8 +245,8 @@ namespace detail {
 /// The core of render_image_splatting and render_image_splatting_learned: `ladder` holds the
 /// estimator at every candidate pair of counts (NEE x light subpath, NeeCountLearner's order), or
 /// one estimator; with `pilot` > 0 the first `pilot` samples of each pixel run ladder[0] (counts
-/// 1) with an nsp::NeeCountLearner as their counter, one per 16x16 tile, merged by learn_tiles
-/// (so the counts do not depend on the thread count), and the rest of every pixel's samples the
+/// 1) with an nsp::NeeCountLearner as their counter, one per 16x16 tile, merged in slot order
+/// (pilot_tiles: the counts do not depend on the thread count), and the rest of every pixel's samples the
 /// image's chosen pair (written to `chosen`). One pair for
 /// the image, not one per tile: a splat's MIS weight takes the counts of the sample that drew its
 /// light subpath, and they must be those of the pixel it lands in. The pilot's samples and their
@@ -275,10 +311,25 @@ Row render_splatting(const Sc& scene, const std::vector<E>& ladder, const Cam& c
     };
     const int first = std::min(pilot, spp);
     if (first > 0) {
+        // A BDPT pilot runs at counts 1 (one pair for the image: no scout, the halves merged).
         nsp::TileCounts plan(res, res, kTile);
-        learn_tiles<Buffers>(plan, run_pool, [&](Buffers& out, nsp::NeeCountLearner& learner, int x, int y) {
-            run_samples(out, ladder[0], learner, x, y, 0, first, [&](double v) { learner.end_sample(v); });
-        });
+        auto timed_pool = [&](auto& work) {  // run_pool with each thread's CPU time
+            auto timed = [&work](Buffers& out) {
+                const double cpu0 = thread_cpu_seconds();
+                work(out);
+                out.cpu += thread_cpu_seconds() - cpu0;
+            };
+            run_pool(timed);
+        };
+        pilot_tiles<Buffers>(
+            plan, false, timed_pool,
+            [&](Buffers& out, nsp::NeeCountLearner& learner, int x, int y) {
+                run_samples(out, ladder[0], learner, x, y, 0, first, [&](double v) { learner.end_sample(v); });
+            },
+            [](Buffers& out, const nsp::NeeCountLearner& l) {
+                out.lookups += l.count();
+                out.steps += l.steps();
+            });
         const nsp::TechniqueCounts c = plan.image_counts();
         if (chosen) *chosen = c;
         if (ladder.size() == std::size_t(kC * kC))

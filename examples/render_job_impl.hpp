@@ -26,6 +26,7 @@
 #include "combinations.hpp"
 #include "default_scene.hpp"
 #include "render_job.hpp"
+#include "tile_learning.hpp"
 #include "type_list.hpp"
 
 namespace nsp_examples {
@@ -310,6 +311,23 @@ RenderStats render(const typename C::Scene& scene, const RenderRequest& rq, std:
             for (std::size_t p = 0; p < px.size(); ++p) px[p].rng = nsp::Pcg32(rq.seed, p);
             constexpr bool kEmissive = C::MediumKind::emissive;
             const int n_tiles = plan.tile_count();
+            // Each pass's per-thread totals, timed (thread CPU time) into `list`.
+            auto pool_into = [&](std::vector<ThreadTotals>& list) {
+                return [&run_pool, &list](auto& work) {
+                    auto timed = [&work](ThreadTotals& out) {
+                        ThreadTotals t;  // local: the counters of different threads must not share a cache line
+                        const double cpu0 = thread_cpu_seconds();
+                        work(t);
+                        t.cpu_seconds = thread_cpu_seconds() - cpu0;
+                        out = t;
+                    };
+                    run_pool(timed, list);
+                };
+            };
+            auto add_work = [](ThreadTotals& t, const nsp::NeeCountLearner& l) {
+                t.counter.n += l.count();
+                t.counter.steps += l.steps();
+            };
             // Pass 0, the scout: 2 samples of one pixel in 16 at rq.pilot_count, on streams of their
             // own and not in the image (only their work is counted), raise the pilot's counts.
             if (rq.scout) {
@@ -318,35 +336,19 @@ RenderStats render(const typename C::Scene& scene, const RenderRequest& rq, std:
                 scout_options.emission_segment_count = floor_counts.emission_segment;
                 const Estimator scout_estimator{scout_options};
                 const int scout_spp = nsp::TileCounts::scout_spp(rq.spp);
-                std::atomic<int> next_scout_slot{0};
-                auto scout_work = [&](ThreadTotals& out) {
-                    ThreadTotals t, discarded;
-                    const double cpu0 = thread_cpu_seconds();
-                    for (int j; (j = next_scout_slot.fetch_add(1)) < nsp::TileCounts::kSlots;)
-                        for (const int tile : plan.slot_tiles(j)) {
-                            nsp::NeeCountLearner learner = plan.scout_learner();
-                            const nsp::TileCounts::Rect r = plan.tile_rect(tile);
-                            for (int y = r.y0; y < r.y1; ++y)
-                                for (int x = r.x0; x < r.x1; ++x) {
-                                    if (!nsp::TileCounts::is_scout(x, y)) continue;
-                                    const std::size_t p = std::size_t(y) * std::size_t(w) + std::size_t(x);
-                                    PixelState state{nsp::Pcg32(rq.seed, px.size() + p)};
-                                    for (int k = 0; k < scout_spp; ++k)
-                                        learner.end_sample(sample(scout_estimator, learner, state, x, y, discarded));
-                                    learner.end_pixel();
-                                }
-                            t.counter.n += learner.count();
-                            t.counter.steps += learner.steps();
-                            plan.add_scout(tile, learner);
-                        }
-                    t.aborted = discarded.aborted;  // a scout's failed path is reported like any other
-                    t.nonfinite = discarded.nonfinite;
-                    t.rejected = discarded.rejected;
-                    t.cpu_seconds = thread_cpu_seconds() - cpu0;
-                    out = t;
-                };
-                run_pool(scout_work, scout_totals);
-                plan.end_scout();
+                scout_tiles<ThreadTotals>(
+                    plan, pool_into(scout_totals),
+                    [&](ThreadTotals& t, nsp::NeeCountLearner& learner, int x, int y) {
+                        const std::size_t p = std::size_t(y) * std::size_t(w) + std::size_t(x);
+                        PixelState state{nsp::Pcg32(rq.seed, px.size() + p)};
+                        ThreadTotals discarded;
+                        for (int k = 0; k < scout_spp; ++k)
+                            learner.end_sample(sample(scout_estimator, learner, state, x, y, discarded));
+                        t.aborted += discarded.aborted;  // a scout's failed path is reported like any other
+                        t.nonfinite += discarded.nonfinite;
+                        t.rejected += discarded.rejected;
+                    },
+                    add_work);
             }
             // Pass 1: the pilot, tile by tile, at the counts the scout raised rq.pilot_count to.
             const nsp::TechniqueCounts pilot_counts = plan.pilot_counts();
@@ -357,41 +359,16 @@ RenderStats render(const typename C::Scene& scene, const RenderRequest& rq, std:
             st.nee_counts.assign(std::size_t(n_tiles), 1.f);
             st.pilot_count = pilot_counts.nee;
             if (kEmissive) st.segment_counts.assign(st.nee_counts.size(), 1.f);
-            std::atomic<int> next_slot{0};
-            auto pilot_work = [&](ThreadTotals& out) {
-                ThreadTotals t;
-                const double cpu0 = thread_cpu_seconds();
-                for (int j; (j = next_slot.fetch_add(1)) < nsp::TileCounts::kSlots;)
-                    for (const int tile : plan.slot_tiles(j)) {
-                        // Two halves of the tile's pixels (x + y even, odd): each half's pilot is
-                        // weighted by the other's predictions (TileCounts::pilot_weight).
-                        std::array<nsp::NeeCountLearner, 2> half{plan.learner(), plan.learner()};
-                        const nsp::TileCounts::Rect r = plan.tile_rect(tile);
-                        for (int y = r.y0; y < r.y1; ++y)
-                            for (int x = r.x0; x < r.x1; ++x) {
-                                PixelState& state = px[std::size_t(y) * std::size_t(w) + std::size_t(x)];
-                                nsp::NeeCountLearner& learner = half[std::size_t((x + y) & 1)];
-                                for (int k = 0; k < pilot; ++k)
-                                    learner.end_sample(sample(pilot_estimator, learner, state, x, y, t));
-                                learner.end_pixel();
-                                state.end_pilot();
-                            }
-                        for (const nsp::NeeCountLearner& l : half) {
-                            t.counter.n += l.count();
-                            t.counter.steps += l.steps();
-                        }
-                        if (rq.weigh_pilot) {
-                            plan.add(tile, half[0], half[1]);
-                        } else {
-                            half[0].merge(half[1]);
-                            plan.add(tile, half[0]);
-                        }
-                    }
-                t.cpu_seconds = thread_cpu_seconds() - cpu0;
-                out = t;
-            };
-            run_pool(pilot_work, pilot_totals);
-            plan.choose();
+            // In two halves of each tile's pixels (x + y even, odd): each half's pilot is weighted
+            // by the other's predictions (TileCounts::pilot_weight).
+            pilot_tiles<ThreadTotals>(
+                plan, rq.weigh_pilot, pool_into(pilot_totals),
+                [&](ThreadTotals& t, nsp::NeeCountLearner& learner, int x, int y) {
+                    PixelState& state = px[std::size_t(y) * std::size_t(w) + std::size_t(x)];
+                    for (int k = 0; k < pilot; ++k) learner.end_sample(sample(pilot_estimator, learner, state, x, y, t));
+                    state.end_pilot();
+                },
+                add_work);
             for (int tile = 0; tile < n_tiles; ++tile) {
                 const nsp::TechniqueCounts& n = plan.counts(tile);
                 st.nee_counts[std::size_t(tile)] = n.nee;

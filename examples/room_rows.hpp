@@ -113,16 +113,18 @@ public:
             };
             const int pilot = RenderRequest::pilot_spp(spp);
             std::vector<nsp::TechniqueCounts> chosen;
+            const float pilot_count = RenderRequest{}.pilot_count;
             Row row = render_image_learned(*scene, make, name, res, spp, threads, s,
-                                           [](float u, float v) { return room_camera_ray(u, v, 1.f); }, pilot, &chosen);
+                                           [](float u, float v) { return room_camera_ray(u, v, 1.f); }, pilot,
+                                           pilot_count, &chosen);
             std::array<int, nsp::NeeCountLearner::kCandidates> nee{}, segment{};
             for (const nsp::TechniqueCounts& c : chosen) {
                 ++nee[std::size_t(nsp::NeeCountLearner::candidate_index(c.nee))];
                 ++segment[std::size_t(nsp::NeeCountLearner::candidate_index(c.emission_segment))];
             }
             std::ostringstream note;  // not "(" + std::to_string(..): GCC 12 warns (-Wrestrict, bug 105329)
-            note << "learned counts (" << name << ", a " << pilot
-                 << "-spp pilot at counts 1 per 16x16 tile), tiles at 1, 1/2, .., 1/64, 0: NEE";
+            note << "learned counts (" << name << ", a scout, a " << pilot << "-spp pilot at counts " << pilot_count
+                 << " or above per 16x16 tile), tiles at 1, 1/2, .., 1/64, 0: NEE";
             for (const int n : nee) note << ' ' << n;
             note << "; emission segment";
             for (const int n : segment) note << ' ' << n;
