@@ -43,6 +43,20 @@ auto count_ladder(Make make) {
     return ladder;
 }
 
+/// `run_pool(work)` (work(Out&) on every thread) as a pool that also adds each thread's CPU time
+/// to its totals' `cpu`.
+template <class Out, class Pool>
+auto timed(Pool& run_pool) {
+    return [&run_pool](auto& work) {
+        auto with_time = [&work](Out& out) {
+            const double cpu0 = thread_cpu_seconds();
+            work(out);
+            out.cpu += thread_cpu_seconds() - cpu0;
+        };
+        run_pool(with_time);
+    };
+}
+
 /// The core of render_image and render_image_learned: `ladder` holds the estimator at every
 /// candidate pair of counts (NEE x emission segment technique, NeeCountLearner's order), or one
 /// estimator; with `pilot` > 0 the counts are learned per 16x16 tile by nsp::TileCounts's protocol
@@ -119,14 +133,7 @@ Row render_pixels(const Sc& scene, const std::vector<E>& ladder, const std::stri
         for (int t = 0; t < threads; ++t) pool.emplace_back(work, std::ref(totals[std::size_t(t)]));
         for (auto& t : pool) t.join();
     };
-    auto timed_pool = [&](auto& work) {  // run_pool with each thread's CPU time
-        auto timed = [&work](Totals& out) {
-            const double cpu0 = thread_cpu_seconds();
-            work(out);
-            out.cpu += thread_cpu_seconds() - cpu0;
-        };
-        run_pool(timed);
-    };
+    auto timed_pool = timed<Totals>(run_pool);
     auto add_work = [](Totals& out, const nsp::NeeCountLearner& l) {
         out.lookups += l.count();
         out.steps += l.steps();
@@ -313,16 +320,8 @@ Row render_splatting(const Sc& scene, const std::vector<E>& ladder, const Cam& c
     if (first > 0) {
         // A BDPT pilot runs at counts 1 (one pair for the image: no scout, the halves merged).
         nsp::TileCounts plan(res, res, kTile);
-        auto timed_pool = [&](auto& work) {  // run_pool with each thread's CPU time
-            auto timed = [&work](Buffers& out) {
-                const double cpu0 = thread_cpu_seconds();
-                work(out);
-                out.cpu += thread_cpu_seconds() - cpu0;
-            };
-            run_pool(timed);
-        };
         pilot_tiles<Buffers>(
-            plan, false, timed_pool,
+            plan, false, timed<Buffers>(run_pool),
             [&](Buffers& out, nsp::NeeCountLearner& learner, int x, int y) {
                 run_samples(out, ladder[0], learner, x, y, 0, first, [&](double v) { learner.end_sample(v); });
             },
