@@ -221,6 +221,14 @@ Options parse_command_line(int argc, char** argv) {
           [&](std::string_view v) {
               o.estimator.equiangular_count = parse_number<float>("--equiangular-count", v, 0.f, 1.f);
           });
+    value("--shadow", "ratio|marching",
+          "shadow rays' transmittance: ratio tracking (default) or unbiased ray marching; marching renders only the rows "
+          "that take it (grey ratio-nee, directional-mis, equiangular-nee), named _marched",
+          [&](std::string_view v) {
+              if (v == "ratio") o.estimator.shadow_estimator = nsp::ShadowEstimator::RatioTracking;
+              else if (v == "marching") o.estimator.shadow_estimator = nsp::ShadowEstimator::RayMarching;
+              else throw UsageError("--shadow: '" + std::string(v) + "' is not ratio or marching", true);
+          });
     flag("--no-emission-segments", "leave out the emission segment technique (plume)",
          [&] { o.estimator.emission_along_segments = false; });
     value("--emission-segment-count", "C", "run the emission segment technique on a fraction C in (0, 1] of segments",

@@ -139,8 +139,19 @@ std::vector<TablePlan> plan(const Options& o) {
                 TablePlan t{setup.choice, mode, o.width.value_or(d.width), o.height.value_or(d.height),
                             o.spp.value_or(setup.spp > 0 ? setup.spp : d.spp), {}, std::nullopt};
                 std::vector<bool> token_used(tokens.size(), false);
-                for (const Candidate& c : candidates(mode, o.selections)) {
+                const bool marching = o.estimator.shadow_estimator == nsp::ShadowEstimator::RayMarching;
+                for (Candidate c : candidates(mode, o.selections)) {
                     if (c.emissive != d.emissive) continue;
+                    // --shadow marching: only the rows whose shadow rays need no path pdf (the
+                    // library refuses the others), each named as such.
+                    if (marching) {
+                        if (c.channels != "grey" || c.learned ||
+                            (c.strategy != "ratio-nee" && c.strategy != "directional-mis" &&
+                             c.strategy != "equiangular-nee"))
+                            continue;
+                        c.name += "_marched";
+                        c.key += "_marched";
+                    }
                     const auto maj = std::find(majorants.begin(), majorants.end(), c.majorant);
                     if (maj == majorants.end()) continue;
                     if (!o.majorants.empty()) majorant_used[std::size_t(maj - majorants.begin())] = true;

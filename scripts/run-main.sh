@@ -23,6 +23,8 @@
 #     every majorant (global, grid 16^3 and 64^3, tree on the VDB nodes, adaptive tree), their
 #     tables and out/plume_vdb/volume.png, out/cloud_vdb/volume.png; then the plume glowing by its
 #     temperature grid (blackbody emission, Rgb) with every strategy, out/plume_fire/volume.png;
+#  1d. nsp_transmittance: ratio tracking, residual ratio tracking and unbiased ray marching on 1-D
+#     extinction profiles and on shadow rays through the example media (two tables, about 6 s);
 # With --with-references it then also runs (about 90 s more, which would take the default run past
 # five minutes on 2 cores with the renderer's build; README's heavy-tail tables come from it):
 #  2. the heavy-tail comparison: the grey-majorant baseline against spectral MIS + NEE (per-channel
@@ -49,7 +51,7 @@ cd "$(dirname "$0")/.."
 # renders take about 24% longer at -O1 (set-ups A and B at 48x48, 64 spp, one thread: 11.4 s
 # against 9.2 s), every row alike, so the tables' ratios stand. The benchmarks (bench/run.sh)
 # build their own -O3 tree.
-NSP_CMAKE_ARGS="-DNSP_OPTIMIZE=-O1 ${NSP_CMAKE_ARGS:-}" scripts/setup.sh nsp_room nsp_volume nsp_render
+NSP_CMAKE_ARGS="-DNSP_OPTIMIZE=-O1 ${NSP_CMAKE_ARGS:-}" scripts/setup.sh nsp_room nsp_volume nsp_render nsp_transmittance
 
 references=0
 if [ "${1:-}" = --with-references ]; then
@@ -79,6 +81,8 @@ build/examples/nsp_volume out/cloud.vdb --compare-majorants --res 96 --spp 64 --
 # The plume's temperature grid: blackbody emission in Rgb, every strategy (about 5 s).
 build/examples/nsp_volume out/plume.vdb --temperature temperature --normalize-blackbody --emission-scale 60 \
     --density-scale 100 --majorant tree --res 96 --spp 64 --out out/plume_fire
+# The transmittance estimators: 1-D profiles and the example media (about 6 s).
+build/examples/nsp_transmittance
 if [ "$references" = 0 ]; then
     echo
     echo "main job: $((SECONDS - start)) s of rendering (scripts/run-main.sh --with-references adds the"

@@ -93,6 +93,12 @@ Check check_integration(const char* name, double v) {
         // image mean's standard deviation is 0.0006, so 0.003 is 5 SE (seed 1: fixed).
         return {std::abs(v - 1.0) < 0.003, "1 within 0.003 (5 standard errors)"};
     }
+    if (std::strcmp(name, "transmittance_query") == 0) {
+        // Residual ratio tracking and ray marching through a constant density (optical depth 4):
+        // the control takes all of it (the residual majorant is rounding's, about 1e-4 of it) and
+        // every comb returns the optical depth exactly, so each gives exp(-4) to float rounding.
+        return {std::abs(v - 2.0 * std::exp(-4.0)) < 1e-5, "2 exp(-4) = 0.036631 within 1e-5"};
+    }
     return {true, "a finite value"};
 }
 

@@ -20,6 +20,7 @@
 #include "majorants/grid.hpp"
 #include "majorants/tree.hpp"
 #include "majorants/choose.hpp"
+#include "majorants/control.hpp"
 #include "majorants/crossing.hpp"
 #include "media/blackbody.hpp"
 #include "media/emissive.hpp"
@@ -39,4 +40,5 @@
 #include "surface_scene.hpp"
 #include "tile_counts.hpp"
 #include "tracking.hpp"
+#include "transmittance.hpp"
 #include "vertex.hpp"

@@ -71,6 +71,43 @@ concept PathStrategy = requires {
     { T::equiangular } -> std::convertible_to<bool>;
 };
 
+/// Settings of unbiased ray marching (transmittance_ray_marching, nsp/transmittance.hpp).
+struct RayMarchingOptions {
+    /// Lookups of one comb per unit of the majorant's optical depth along the ray (the comb has
+    /// ceil(this x tau_bar) lookups, at least min_lookups and at most max_lookups).
+    float lookups_per_depth = 1.f;
+    int min_lookups = 2;
+    int max_lookups = 1 << 16;
+    /// The roulette that ends the series: after the k-th term (weighted by the inverse of the
+    /// probabilities so far), the next is taken with probability min(1, |term| / term_scale)
+    /// (largest channel); a term of 0 ends it.
+    float term_scale = 0.01f;
+    /// The highest order: the roulette practically never gets there (a term's size falls as 1/k!),
+    /// and the estimate ends with Status::Aborted (value 0) if it does.
+    int max_order = 64;
+};
+
+/// Throws InvalidArgument on RayMarchingOptions outside their ranges: lookups_per_depth finite and
+/// > 0, 1 <= min_lookups <= max_lookups <= 2^24, term_scale finite and > 0, max_order in [1, 1024].
+inline void validate(const RayMarchingOptions& o) {
+    if (!(o.lookups_per_depth > 0.f) || !(o.lookups_per_depth <= 3.4e38f))
+        detail::fail("RayMarchingOptions lookups_per_depth = ", o.lookups_per_depth,
+                     " is not allowed: it must be finite and > 0");
+    if (o.min_lookups < 1 || o.max_lookups < o.min_lookups || o.max_lookups > (1 << 24))
+        detail::fail("RayMarchingOptions min_lookups = ", o.min_lookups, ", max_lookups = ", o.max_lookups,
+                     " is not allowed: they must satisfy 1 <= min_lookups <= max_lookups <= 2^24");
+    if (!(o.term_scale > 0.f) || !(o.term_scale <= 3.4e38f))
+        detail::fail("RayMarchingOptions term_scale = ", o.term_scale, " is not allowed: it must be finite and > 0");
+    if (o.max_order < 1 || o.max_order > 1024)
+        detail::fail("RayMarchingOptions max_order = ", o.max_order, " is not allowed: it must lie in [1, 1024]");
+}
+
+/// How a path estimator estimates a shadow ray's transmittance (EstimatorOptions::shadow_estimator).
+enum class ShadowEstimator : std::uint8_t {
+    RatioTracking,  ///< ratio tracking under the scene's majorant: every strategy (its null pdfs are what null-scattering MIS weighs)
+    RayMarching,    ///< unbiased ray marching under the scene's grey majorant (THEORY 5.10): strategies without null-scattering pdfs
+};
+
 /// Run-time settings of a path estimator.
 struct EstimatorOptions {
     int max_depth = 1000;          ///< most real scattering vertices on a path (>= 0)
@@ -133,6 +170,15 @@ struct EstimatorOptions {
     /// distance pdfs to weigh it by and leaves it out. The path estimators choose equiangular
     /// sampling by their strategy instead.
     bool bdpt_equiangular = true;
+    /// How shadow rays (NEE, and the nulls before an equiangular vertex) estimate their
+    /// transmittance. RayMarching: unbiased ray marching (nsp/transmittance.hpp, THEORY 5.10;
+    /// fewer lookups x variance than ratio tracking on every example medium, worse where a
+    /// medium's detail is finer than its comb) with `ray_marching`'s settings; it has no path pdf,
+    /// so only nsp::PathEstimator with strategy::NextEvent, DirectionalMis or EquiangularNextEvent
+    /// takes it (and VertexKernels::shadow for a host's own loop with them); the others refuse it
+    /// at construction. Its estimate is unbiased but may leave [0, 1].
+    ShadowEstimator shadow_estimator = ShadowEstimator::RatioTracking;
+    RayMarchingOptions ray_marching{};
 };
 
 /// A radiance estimate and its status.
@@ -206,6 +252,7 @@ inline void validate(const EstimatorOptions& opts) {
     validate_count("EstimatorOptions nee_count", opts.nee_count, true);
     validate_count("EstimatorOptions emission_segment_count", opts.emission_segment_count, true);
     validate_count("EstimatorOptions equiangular_count", opts.equiangular_count, true);
+    validate(opts.ray_marching);
 }
 
 }  // namespace nsp

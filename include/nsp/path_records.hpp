@@ -80,6 +80,15 @@ ShadowPiece<float, typename Med::Spectral> grey_shadow_piece(const K& k, const M
         out.f = Med::Spectral::Spectrum::Zero();
         return out;
     }
+    if constexpr (!K::Strategy::null_pdfs && !is_per_channel_majorant_v<Maj, Med>) {
+        if (k.options().shadow_estimator == ShadowEstimator::RayMarching) {  // no pdf needed (THEORY 5.10)
+            const auto m = transmittance_ray_marching(medium, majorant, r, t_max, lambda, rng, counter,
+                                                      k.options().ray_marching);
+            out.status = m.status;
+            out.f = m.status == Status::Ok ? m.value : Med::Spectral::Spectrum::Zero();
+            return out;
+        }
+    }
     const auto tr = track_ratio<typename K::Absorption, K::Strategy::null_pdfs>(medium, majorant, r, t_max, lambda,
                                                                                rng, counter);
     out.status = flight_status(tr.end);

@@ -45,6 +45,7 @@
 #include "options.hpp"
 #include "recorder.hpp"
 #include "tracking.hpp"
+#include "transmittance.hpp"
 
 namespace nsp {
 
@@ -226,6 +227,11 @@ public:
         if (St::samples_lights && !St::hits_lights && opts.nee_count == 0.f)
             detail::fail("EstimatorOptions nee_count = 0 is not allowed with strategy ", St::name,
                          ": NEE is its only way to the lights (a count of 0 needs a strategy that also hits them)");
+        if (opts.shadow_estimator == ShadowEstimator::RayMarching && (St::null_pdfs || !St::samples_lights))
+            detail::fail("EstimatorOptions shadow_estimator = RayMarching is not allowed with strategy ", St::name,
+                         St::null_pdfs ? ": its weights need the shadow rays' null-scattering pdfs, which ray marching "
+                                         "has not (ratio-nee, directional-mis and equiangular-nee take it)"
+                                       : ": it casts no shadow rays");
         if (St::equiangular && !St::combines && opts.equiangular_count == 0.f)
             detail::fail("EstimatorOptions equiangular_count = 0 is not allowed with strategy ", St::name,
                          ": its equiangular vertices are its only way to light scattered in the media (a count of 0 "
@@ -261,15 +267,26 @@ public:
         return track_delta_visiting<A>(medium, majorant, ray, t_max, lambda, rng, counter, std::move(visit));
     }
 
-    /// The transmittance of a shadow ray through `medium` up to `distance` (ratio tracking), and
-    /// the product of the null probabilities delta tracking with policy A would have had at its
-    /// nulls (only where St weighs by null-scattering pdfs; 1 otherwise). Never throws; bad input
-    /// as for track() gives transmittance 0 and Status::InvalidInput.
+    /// The transmittance of a shadow ray through `medium` up to `distance` (ratio tracking; with
+    /// EstimatorOptions::shadow_estimator RayMarching and a grey majorant, unbiased ray marching),
+    /// and the product of the null probabilities delta tracking with policy A would have had at
+    /// its nulls (only where St weighs by null-scattering pdfs; 1 otherwise). Never throws; bad
+    /// input as for track() gives transmittance 0 and Status::InvalidInput.
     template <Medium M, MajorantPolicy<M> Maj, UniformRng R, LookupCounter C>
     ShadowTransmittance<typename M::Spectral> shadow(const M& medium, const Maj& majorant, const Ray& ray,
                                                      float distance, const typename M::Spectral::Wavelengths& lambda,
                                                      R& rng, C& counter) const {
         if (!valid_ray(ray, distance)) return {M::Spectral::Spectrum::Zero(), 1.f, Status::InvalidInput};
+        if constexpr (!St::null_pdfs && !is_per_channel_majorant_v<Maj, M>) {
+            if (opts_.shadow_estimator == ShadowEstimator::RayMarching) {
+                const auto m = transmittance_ray_marching(medium, majorant, ray, distance, lambda, rng, counter,
+                                                          opts_.ray_marching);
+                ShadowTransmittance<typename M::Spectral> s;
+                s.status = m.status;
+                if (m.status == Status::Ok) s.transmittance = m.value;
+                return s;
+            }
+        }
         const auto tr = track_ratio<A, St::null_pdfs>(medium, majorant, ray, distance, lambda, rng, counter);
         ShadowTransmittance<typename M::Spectral> s;
         if (const Status fs = flight_status(tr.end); fs != Status::Ok) {

@@ -196,6 +196,10 @@ private:
 
     static EstimatorOptions checked(EstimatorOptions o) {
         validate(o);
+        if (o.shadow_estimator != ShadowEstimator::RatioTracking)
+            detail::fail("EstimatorOptions shadow_estimator = RayMarching is not allowed with nsp::BdptEstimator: "
+                         "its connections are weighed by their null-scattering pdfs (nsp::PathEstimator with "
+                         "ratio-nee, directional-mis or equiangular-nee takes it)");
         if (o.max_depth > MaxDepth)
             detail::fail("BdptEstimator max_depth = ", o.max_depth, " is not allowed: it must be <= ", MaxDepth,
                          " (the estimator's MaxDepth template argument, the size of its vertex arrays)");

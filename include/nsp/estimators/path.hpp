@@ -323,8 +323,9 @@ public:
     using HeuristicType = H;
     using Absorption = A;
 
-    /// Throws InvalidArgument on the option values PathEstimator rejects.
-    explicit SpectralPathEstimator(EstimatorOptions opts = {}) : kernels_(opts) {}
+    /// Throws InvalidArgument on the option values PathEstimator rejects, and on
+    /// shadow_estimator = RayMarching (its shadow rays track every channel's pdfs).
+    explicit SpectralPathEstimator(EstimatorOptions opts = {}) : kernels_(refuse_marching(opts)) {}
 
     const EstimatorOptions& options() const noexcept { return kernels_.options(); }
 
@@ -355,6 +356,14 @@ public:
     }
 
 private:
+    static EstimatorOptions refuse_marching(const EstimatorOptions& o) {
+        if (o.shadow_estimator != ShadowEstimator::RatioTracking)
+            detail::fail("EstimatorOptions shadow_estimator = RayMarching is not allowed with "
+                         "nsp::SpectralPathEstimator: its shadow rays track every channel's pdfs (nsp::PathEstimator "
+                         "with ratio-nee, directional-mis or equiangular-nee takes it)");
+        return o;
+    }
+
     VertexKernels<St, H, A> kernels_;
 };
 

@@ -293,13 +293,7 @@ public:
         for (int z = 0; z < res[2]; ++z)
             for (int y = 0; y < res[1]; ++y)
                 for (int x = 0; x < res[0]; ++x, ++i) {
-                    const int c[3] = {x, y, z};
-                    Box region;
-                    for (int a = 0; a < 3; ++a) {
-                        region.lo[a] = box_.lo[a] + float(c[a]) * cell_[a];
-                        region.hi[a] = c[a] + 1 == res[a] ? box_.hi[a] : box_.lo[a] + float(c[a] + 1) * cell_[a];
-                    }
-                    const float d = bounds.density(region);
+                    const float d = bounds.density(region(x, y, z));
                     if (!std::isfinite(d) || d < 0.f)
                         fail(what, " cell (", x, ", ", y, ", ", z, "): the medium's density bound = ", d,
                              " is not allowed: it must be finite and >= 0");
@@ -318,6 +312,18 @@ public:
 
     GridWalk walk(const Ray& r, float tmin, float tmax) const noexcept {
         return {box_, res_, cell_, r, box_.clip(r, tmin, tmax)};
+    }
+
+    /// The region of cell (x, y, z): its faces at lo + k cell, the last one on each axis ending
+    /// at the box's face (so that the cells cover the box exactly).
+    Box region(int x, int y, int z) const noexcept {
+        const int c[3] = {x, y, z};
+        Box r;
+        for (int a = 0; a < 3; ++a) {
+            r.lo[a] = box_.lo[a] + float(c[a]) * cell_[a];
+            r.hi[a] = c[a] + 1 == res_[a] ? box_.hi[a] : box_.lo[a] + float(c[a] + 1) * cell_[a];
+        }
+        return r;
     }
 
     /// The value of the cell holding point p (faces rounded to the cell above, clamped to the

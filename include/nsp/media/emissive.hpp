@@ -254,6 +254,11 @@ public:
     {
         return medium_.density_bound(region);
     }
+    float density_lower_bound(const Box& region) const noexcept
+        requires RegionBoundedMedium<M> && requires(const M& m, const Box& b) { m.density_lower_bound(b); }
+    {
+        return medium_.density_lower_bound(region);
+    }
     Coefficient extinction_per_density() const
         requires RegionBoundedMedium<M>
     {

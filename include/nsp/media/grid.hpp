@@ -6,6 +6,7 @@
 #include <array>
 #include <cmath>
 #include <cstddef>
+#include <limits>
 #include <utility>
 #include <vector>
 
@@ -53,27 +54,54 @@ inline float trilinear_lookup(const float* v, const std::array<int, 3>& res, con
     return lerp(lerp(c00, c10, f[1]), lerp(c01, c11, f[1]), f[2]);
 }
 
-/// The largest value trilinear_lookup (same grid) can return at any p in `region` (0 if it
-/// misses the box): the largest voxel among those the lookups there read. The region is widened
-/// by 1/1000 of a voxel so that a point that rounds just outside it is still covered.
-inline float voxel_bound(const float* v, const std::array<int, 3>& res, const Box& box,
-                         const Vec3& inv_extent, const Box& region) noexcept {
-    int lo[3], hi[3];
+/// The voxels [lo, hi] (inclusive, per axis) that trilinear_lookup (same grid) reads at any p in
+/// `region`, the region widened by 1/1000 of a voxel so that a point that rounds just outside it
+/// is still covered; false if the region misses the box.
+inline bool voxels_read(const std::array<int, 3>& res, const Box& box, const Vec3& inv_extent, const Box& region,
+                        int lo[3], int hi[3]) noexcept {
     for (int a = 0; a < 3; ++a) {
         const float r0 = std::max(region.lo[a], box.lo[a]), r1 = std::min(region.hi[a], box.hi[a]);
-        if (r0 > r1) return 0.f;
+        if (r0 > r1) return false;
         const float x0 = (r0 - box.lo[a]) * inv_extent[a] * float(res[a]) - 0.5f - 1e-3f;
         const float x1 = (r1 - box.lo[a]) * inv_extent[a] * float(res[a]) - 0.5f + 1e-3f;
         lo[a] = std::clamp(int(std::floor(x0)), 0, res[a] - 1);
         hi[a] = std::clamp(int(std::floor(x1)) + 1, 0, res[a] - 1);
     }
-    float m = 0.f;
+    return true;
+}
+
+/// `combine` (max or min) over the voxels voxels_read() lists, from `init`; `none` if the region
+/// misses the box.
+template <class Combine>
+float fold_voxels(const float* v, const std::array<int, 3>& res, const Box& box, const Vec3& inv_extent,
+                  const Box& region, float init, float none, Combine combine) noexcept {
+    int lo[3], hi[3];
+    if (!voxels_read(res, box, inv_extent, region, lo, hi)) return none;
+    float m = init;
     for (int z = lo[2]; z <= hi[2]; ++z)
         for (int y = lo[1]; y <= hi[1]; ++y) {
             const float* row = &v[std::size_t(res[0]) * (std::size_t(y) + std::size_t(res[1]) * std::size_t(z))];
-            for (int x = lo[0]; x <= hi[0]; ++x) m = std::max(m, row[x]);
+            for (int x = lo[0]; x <= hi[0]; ++x) m = combine(m, row[x]);
         }
     return m;
+}
+
+/// The largest value trilinear_lookup (same grid) can return at any p in `region` (0 if it
+/// misses the box): the largest voxel among those the lookups there read.
+inline float voxel_bound(const float* v, const std::array<int, 3>& res, const Box& box,
+                         const Vec3& inv_extent, const Box& region) noexcept {
+    return fold_voxels(v, res, box, inv_extent, region, 0.f, 0.f, [](float a, float b) { return std::max(a, b); });
+}
+
+/// The smallest value trilinear_lookup (same grid) can return at any p in `region` inside the
+/// box: the smallest voxel among those the lookups there read (a trilinear value is a convex
+/// combination of them), less 2^-20 of it for the lookup's rounding; 0 where the region misses
+/// the box (a lookup outside it returns 0).
+inline float voxel_lower_bound(const float* v, const std::array<int, 3>& res, const Box& box,
+                               const Vec3& inv_extent, const Box& region) noexcept {
+    const float m = fold_voxels(v, res, box, inv_extent, region, std::numeric_limits<float>::infinity(), 0.f,
+                                [](float a, float b) { return std::min(a, b); });
+    return m * (1.f - 1.f / 1048576.f);
 }
 
 }  // namespace detail
@@ -152,6 +180,13 @@ public:
     /// of a voxel so that a point that rounds just outside it is still covered.
     float density_bound(const Box& region) const noexcept {
         return detail::voxel_bound(density_.data(), res_, bounds_, inv_extent_, region);
+    }
+
+    /// The smallest density a lookup can return at any p in `region` inside the box (a minorant,
+    /// the control of THEORY 5.10): the smallest voxel the lookups there read, less rounding; 0
+    /// where the region misses the box.
+    float density_lower_bound(const Box& region) const noexcept {
+        return detail::voxel_lower_bound(density_.data(), res_, bounds_, inv_extent_, region);
     }
 
 private:

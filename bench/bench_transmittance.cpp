@@ -1,0 +1,81 @@
+// bench/bench_transmittance.cpp: one microbenchmark per transmittance estimator (THEORY 5.10,
+// nsp/transmittance.hpp) on the same random rays through the default cloud (Mono): ratio
+// tracking under the global and a 16^3 grid majorant, residual ratio tracking under a 16^3 grid
+// control, unbiased ray marching under the global and the grid majorant. Each iteration is one
+// estimate; the counters give lookups per estimate and the estimates' variance, so
+// time x variance per estimator comes from one run (bench/run.sh repeats it for medians). The
+// machine-independent comparison (lookups x variance) is nsp_transmittance's
+// (docs/transmittance.md).
+#include <cmath>
+
+#include <benchmark/benchmark.h>
+
+#include "fixtures.hpp"
+
+namespace {
+
+using namespace nsp_bench;
+using M = nsp::DenseGridMedium<nsp::Mono>;
+
+const M& cloud() { return default_scene<nsp::Mono>(LightSetup::A).medium(); }
+
+/// One estimate per iteration along tracking_rays() in turn, by `estimate(ray, rng, counter)`.
+template <class F>
+void run(benchmark::State& state, F&& estimate) {
+    const auto& rays = tracking_rays();
+    nsp::Pcg32 rng(3, 33);
+    nsp::LookupCount counter;
+    double sum = 0.0, sum2 = 0.0;
+    std::size_t i = 0, failed = 0;
+    for (auto _ : state) {
+        const auto t = estimate(rays[i++ & kSetMask], rng, counter);
+        failed += t.status != nsp::Status::Ok;
+        const double v = double(t.value[0]);
+        sum += v;
+        sum2 += v * v;
+    }
+    const double n = double(state.iterations());
+    report_lookups(state, counter, "lookups/estimate");
+    state.counters["mean"] = sum / n;
+    state.counters["variance"] = n > 1.0 ? (sum2 - sum * sum / n) / (n - 1.0) : 0.0;
+    if (failed > 0) state.SkipWithError("an estimate failed");
+}
+
+void BM_Ratio_Global(benchmark::State& state) {
+    const nsp::GlobalMajorant<M> maj(cloud());
+    run(state, [&](const nsp::Ray& r, nsp::Pcg32& rng, nsp::LookupCount& c) {
+        return nsp::transmittance_ratio(cloud(), maj, r, kTmax, {}, rng, c);
+    });
+}
+void BM_Ratio_Grid16(benchmark::State& state) {
+    const nsp::GridMajorant<M> maj(cloud(), 16);
+    run(state, [&](const nsp::Ray& r, nsp::Pcg32& rng, nsp::LookupCount& c) {
+        return nsp::transmittance_ratio(cloud(), maj, r, kTmax, {}, rng, c);
+    });
+}
+void BM_ResidualRatio_GridControl16(benchmark::State& state) {
+    const nsp::GridControl<M> control(cloud(), 16);
+    run(state, [&](const nsp::Ray& r, nsp::Pcg32& rng, nsp::LookupCount& c) {
+        return nsp::transmittance_residual_ratio(cloud(), control, r, kTmax, {}, rng, c);
+    });
+}
+void BM_RayMarching_Global(benchmark::State& state) {
+    const nsp::GlobalMajorant<M> maj(cloud());
+    run(state, [&](const nsp::Ray& r, nsp::Pcg32& rng, nsp::LookupCount& c) {
+        return nsp::transmittance_ray_marching(cloud(), maj, r, kTmax, {}, rng, c);
+    });
+}
+void BM_RayMarching_Grid16(benchmark::State& state) {
+    const nsp::GridMajorant<M> maj(cloud(), 16);
+    run(state, [&](const nsp::Ray& r, nsp::Pcg32& rng, nsp::LookupCount& c) {
+        return nsp::transmittance_ray_marching(cloud(), maj, r, kTmax, {}, rng, c);
+    });
+}
+
+BENCHMARK(BM_Ratio_Global)->MinTime(kMinTime);
+BENCHMARK(BM_Ratio_Grid16)->MinTime(kMinTime);
+BENCHMARK(BM_ResidualRatio_GridControl16)->MinTime(kMinTime);
+BENCHMARK(BM_RayMarching_Global)->MinTime(kMinTime);
+BENCHMARK(BM_RayMarching_Grid16)->MinTime(kMinTime);
+
+}  // namespace

@@ -1,0 +1,214 @@
+// nsp/majorants/control.hpp: controls (minorants) beside majorants, for the estimators that pay
+// lookups only for the residual extinction above a known part (THEORY 5.10).
+//
+// A control policy walks a ray as a majorant policy does and yields ControlSegments: on [t0, t1)
+// the control mu_c (per channel, known without a lookup) and the residual majorant mu_bar_r with
+// 0 <= mu_t,c(x) - mu_c,c <= mu_bar_r for every channel c and x on the stretch. Residual ratio
+// tracking (transmittance.hpp) draws tentative collisions at rate mu_bar_r and takes exp(-mu_c
+// len) in closed form: where the control is the whole extinction (a homogeneous stretch) it pays
+// no lookup at all; with a control of 0 it is ratio tracking, draw for draw.
+//
+// GridControl stores per cell the density's lower bound beside its upper bound (two floats per
+// cell; a medium without a lower-bound query, LowerBoundedMedium, gets a control of 0 and pays
+// for none). GlobalControl is one constant control and majorant over the medium's box.
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <concepts>
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include "../core/error.hpp"
+#include "../majorant.hpp"
+#include "../media/validate.hpp"
+#include "../medium.hpp"
+#include "grid.hpp"
+
+namespace nsp {
+
+/// A RegionBoundedMedium that also bounds its density from below over any axis-aligned region
+/// inside its box (`density_lower_bound(region)`, rounding included): the control of THEORY 5.10.
+template <class M>
+concept LowerBoundedMedium = RegionBoundedMedium<M> && requires(const M& m, const Box& b) {
+    { m.density_lower_bound(b) } -> std::same_as<float>;
+};
+
+/// A stretch [t0, t1) of a ray with its control and residual majorant (see the header): the
+/// control per channel (`Spectrum`), the residual majorant and the full majorant grey.
+template <class Spectrum>
+struct ControlSegment {
+    float t0 = 0.f;
+    float t1 = 0.f;
+    Spectrum sigma_ctl{};   ///< mu_c per channel, finite and >= 0
+    float sigma_res = 0.f;  ///< mu_bar_r: mu_t,c - mu_c,c lies in [0, mu_bar_r] on the stretch
+    float sigma_maj = 0.f;  ///< the full majorant, max_c mu_c,c + mu_bar_r or looser (what ratio tracking would use)
+};
+
+namespace detail {
+template <class T>
+struct is_control_segment : std::false_type {};
+template <class S>
+struct is_control_segment<ControlSegment<S>> : std::true_type {};
+}  // namespace detail
+
+/// A control policy for medium M: `iterate_control(ray, tmin, tmax, lambda)` yields
+/// ControlSegments in increasing t (std::nullopt at the end) over the part of [tmin, tmax] where
+/// the medium may be non-zero; `steps()` on the iterator counts its DDA steps where it has them.
+template <class P, class M>
+concept ControlPolicy = Medium<M> &&
+    requires(const P& p, const Ray& r, float t, const typename M::Spectral::Wavelengths& l) {
+        { p.iterate_control(r, t, t, l).next().has_value() } -> std::same_as<bool>;
+        requires detail::is_control_segment<std::remove_cvref_t<decltype(*p.iterate_control(r, t, t, l).next())>>::value;
+    };
+
+/// One control and one majorant over the medium's box: the control a caller gives (per channel),
+/// the majorant the medium's extinction bound. Residual ratio tracking under it is unbiased for
+/// any control up to that bound while the residual majorant (bound - the smallest channel's
+/// control) is > 0, a control above the extinction in places included (THEORY 5.10); at a control
+/// equal to the bound nothing is looked up, and the control must be the extinction itself.
+template <Medium M>
+class GlobalControl {
+public:
+    using Spectral = typename M::Spectral;
+    using Spectrum = typename Spectral::Spectrum;
+    using Coefficient = typename Spectral::Coefficient;
+
+    /// Throws InvalidArgument unless every channel of `control` is finite, >= 0 and at most the
+    /// medium's extinction bound (max_extinction()) in that channel.
+    GlobalControl(const M& medium, const Coefficient& control)
+        : bounds_(medium.bounds()), control_(control), majorant_(medium.max_extinction()) {
+        detail::require_coefficient(control_, "GlobalControl control");
+        detail::require_finite_nonnegative(majorant_, "GlobalControl: the medium's extinction bound");
+        const float top = max_value(control_);
+        if (top > majorant_)
+            detail::fail("GlobalControl control = ", top, " (its largest channel) exceeds the medium's extinction bound ",
+                         majorant_, ": a control must lie below the extinction everywhere");
+    }
+
+    /// The whole [tmin, tmax] clipped to the box: the control, residual majorant max_extinction -
+    /// the smallest channel's control (so the residual bounds every channel), majorant max_extinction.
+    class Iterator {
+    public:
+        Iterator(Interval in, const Spectrum& ctl, float res, float maj) noexcept
+            : seg_{in.t0, in.t1, ctl, res, maj}, done_(in.empty()) {}
+        std::optional<ControlSegment<Spectrum>> next() noexcept {
+            if (done_) return std::nullopt;
+            done_ = true;
+            return seg_;
+        }
+        std::uint32_t steps() const noexcept { return 0; }
+
+    private:
+        ControlSegment<Spectrum> seg_;
+        bool done_;
+    };
+
+    Iterator iterate_control(const Ray& r, float tmin, float tmax, const typename Spectral::Wavelengths& l) const noexcept {
+        const Spectrum ctl = Spectral::sample(control_, l);
+        const float res = std::max(0.f, majorant_ - ctl.minCoeff());
+        return {bounds_.clip(r, tmin, tmax), ctl, res, majorant_};
+    }
+
+private:
+    Box bounds_;
+    Coefficient control_;
+    float majorant_;
+};
+
+/// A grid of controls and majorants over the medium's box (THEORY 5.10): per cell the medium's
+/// density bounds from below (LowerBoundedMedium; 0 for a medium without one) and from above,
+/// d_min <= d <= d_max; on a cell's stretch the control is d_min times each channel's extinction
+/// per density u_c, the residual majorant (d_max - d_min) max_c u_c, and the majorant d_max max_c
+/// u_c (GridMajorant's). Walked by the same DDA as GridMajorant. Two floats per cell.
+template <RegionBoundedMedium M>
+class GridControl {
+public:
+    using Spectral = typename M::Spectral;
+    using Spectrum = typename Spectral::Spectrum;
+
+    /// Throws InvalidArgument as GridMajorant does (resolution, box, bounds), and on a lower bound
+    /// that is not finite, is negative or exceeds the cell's upper bound.
+    GridControl(const M& medium, std::array<int, 3> resolution)
+        : upper_(medium, resolution, 1.f, "GridControl"), unit_(medium.extinction_per_density()),
+          unit_max_(max_value(unit_)) {
+        const std::array<int, 3> res = upper_.resolution();
+        lower_.assign(std::size_t(res[0]) * std::size_t(res[1]) * std::size_t(res[2]), 0.f);
+        if constexpr (LowerBoundedMedium<M>) {
+            std::size_t i = 0;
+            for (int z = 0; z < res[2]; ++z)
+                for (int y = 0; y < res[1]; ++y)
+                    for (int x = 0; x < res[0]; ++x, ++i) {
+                        const float d = medium.density_lower_bound(upper_.region(x, y, z));
+                        if (!std::isfinite(d) || d < 0.f)
+                            detail::fail("GridControl cell (", x, ", ", y, ", ", z, "): the medium's density lower bound = ",
+                                         d, " is not allowed: it must be finite and >= 0");
+                        if (d > upper_.at(x, y, z))
+                            detail::fail("GridControl cell (", x, ", ", y, ", ", z, "): the medium's density lower bound = ",
+                                         d, " exceeds its upper bound ", upper_.at(x, y, z));
+                        lower_[i] = d;
+                    }
+        }
+    }
+    GridControl(const M& medium, int resolution) : GridControl(medium, {resolution, resolution, resolution}) {}
+
+    class Iterator {
+    public:
+        Iterator(const GridControl& g, detail::GridWalk walk, const Spectrum& unit) noexcept
+            : g_(&g), walk_(walk), unit_(unit) {}
+        std::optional<ControlSegment<Spectrum>> next() noexcept {
+            std::size_t i;
+            float t0, t1;
+            while (walk_.next(i, t0, t1)) {
+                const float hi = g_->upper_.data()[i];
+                if (!(hi > 0.f) || !(t1 > t0)) continue;
+                const float lo = g_->lower_[i];
+                return ControlSegment<Spectrum>{t0, t1, unit_ * lo, (hi - lo) * g_->unit_max_, hi * g_->unit_max_};
+            }
+            return std::nullopt;
+        }
+        std::uint32_t steps() const noexcept { return walk_.steps(); }
+
+    private:
+        const GridControl* g_;
+        detail::GridWalk walk_;
+        Spectrum unit_;
+    };
+
+    Iterator iterate_control(const Ray& r, float tmin, float tmax, const typename Spectral::Wavelengths& l) const noexcept {
+        return {*this, upper_.walk(r, tmin, tmax), Spectral::sample(unit_, l)};
+    }
+
+    /// The control's share of the majorant, sum d_min / sum d_max over the cells (0 for an empty
+    /// medium): what residual ratio tracking saves in lookups where rays cross cells evenly.
+    double controlled_fraction() const noexcept {
+        double lo = 0.0, hi = 0.0;
+        const float* up = upper_.data();
+        for (std::size_t i = 0; i < lower_.size(); ++i) {
+            lo += lower_[i];
+            hi += up[i];
+        }
+        return hi > 0.0 ? lo / hi : 0.0;
+    }
+
+    /// The density bounds of cell (x, y, z): {lower, upper}.
+    std::array<float, 2> cell_density(int x, int y, int z) const noexcept {
+        const std::array<int, 3> res = upper_.resolution();
+        return {lower_[std::size_t(x) + std::size_t(res[0]) * (std::size_t(y) + std::size_t(res[1]) * std::size_t(z))],
+                upper_.at(x, y, z)};
+    }
+    std::array<int, 3> resolution() const noexcept { return upper_.resolution(); }
+    /// Bytes of cell storage (two floats per cell).
+    std::size_t memory_bytes() const noexcept { return upper_.memory_bytes() + lower_.size() * sizeof(float); }
+
+private:
+    detail::MajorantGrid<M> upper_;
+    std::vector<float> lower_;
+    typename Spectral::Coefficient unit_;
+    float unit_max_;
+};
+
+}  // namespace nsp
