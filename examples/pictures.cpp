@@ -45,6 +45,9 @@ PictureJob picture_job(SceneKind kind, const Options& o) {
     job.rq.threads = o.threads;
     job.rq.seed = o.seed;
     job.rq.estimator = o.estimator;
+    // The picture's estimator ratio-tracks its shadow rays whatever --shadow says (it may be one
+    // that needs their path pdfs).
+    job.rq.estimator.shadow_estimator = nsp::ShadowEstimator::RatioTracking;
     job.rq.majorant = o.majorant;
     return job;
 }

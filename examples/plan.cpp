@@ -165,7 +165,8 @@ std::vector<TablePlan> plan(const Options& o) {
                 }
                 // A scene's default row that this mode does not compile (e.g. the equiangular
                 // strategies outside mono) is left out with a note rather than silently.
-                for (std::size_t k = 0; k < tokens.size() && o.estimators.empty(); ++k)
+                // (Not under --shadow marching, which leaves out every row that needs path pdfs.)
+                for (std::size_t k = 0; k < tokens.size() && o.estimators.empty() && !marching; ++k)
                     if (!token_used[k] && !t.rows.empty())
                         std::fprintf(stderr, "nsp_render: note: set-up %s, %.*s: no row '%s' (not compiled in this "
                                      "mode, see --list)\n", setup.name.c_str(), int(mode.size()), mode.data(),

@@ -75,6 +75,9 @@ std::vector<Job> plan_jobs(const std::vector<TablePlan>& tables, const Options& 
         if (t.reference) {
             Job& j = jobs.emplace_back(Job{t.mode, t.reference->index, request(t, o.seed + kReferenceSeedOffset, SelectionRule::Uniform)});
             j.rq.spp = *o.reference_spp;
+            // The reference ratio-tracks its shadow rays whatever --shadow says: one reference
+            // for every run, and its estimator may need their path pdfs.
+            j.rq.estimator.shadow_estimator = nsp::ShadowEstimator::RatioTracking;
             j.rq.pixel_stats = true;
         }
         for (const Candidate& c : t.rows)

@@ -16,7 +16,7 @@
 //   homogeneous medium under its own majorant); its estimate may leave [0, 1] (it is unbiased, not
 //   bounded).
 //
-// Every kernel: noexcept, no allocation, status InvalidInput (value 0) for a ray that is not
+// Every kernel: never throws, allocates nothing, status InvalidInput (value 0) for a ray that is not
 // usable_ray or a NaN tmax, Aborted where a limit was reached, NonFinite where the estimate left
 // float's range (value 0).
 #pragma once
