@@ -357,7 +357,7 @@ TEST_CASE("GridControl: per-cell minorants bound the density from below") {
         }
     }
     CHECK(checked > 1000);
-    MESSAGE("controlled fraction of the cloud at 6^3: " << control.controlled_fraction());
+    MESSAGE("controlled fraction of the noise-grid medium at 6^3: " << control.controlled_fraction());
     CHECK(control.controlled_fraction() > 0.0);
     CHECK(control.controlled_fraction() < 1.0);
     CHECK(control.memory_bytes() == 2 * 216 * sizeof(float));

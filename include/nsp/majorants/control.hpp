@@ -194,12 +194,6 @@ public:
         return hi > 0.0 ? lo / hi : 0.0;
     }
 
-    /// The density bounds of cell (x, y, z): {lower, upper}.
-    std::array<float, 2> cell_density(int x, int y, int z) const noexcept {
-        const std::array<int, 3> res = upper_.resolution();
-        return {lower_[std::size_t(x) + std::size_t(res[0]) * (std::size_t(y) + std::size_t(res[1]) * std::size_t(z))],
-                upper_.at(x, y, z)};
-    }
     std::array<int, 3> resolution() const noexcept { return upper_.resolution(); }
     /// Bytes of cell storage (two floats per cell).
     std::size_t memory_bytes() const noexcept { return upper_.memory_bytes() + lower_.size() * sizeof(float); }
