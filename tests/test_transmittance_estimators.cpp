@@ -334,7 +334,7 @@ TEST_CASE("ray-marched shadow rays: the host's shadow kernel, and the estimators
 }
 
 TEST_CASE("GridControl: per-cell minorants bound the density from below") {
-    // Every lookup inside a cell lies in [control, control + residual majorant] in every channel.
+    // Every lookup inside a cell lies in [control, control + residual majorant] and below the majorant in every channel.
     const Box box{Vec3(-1.f), Vec3(1.f)};
     using M = DenseGridMedium<Rgb>;
     const auto medium = make_medium<M>(box, 1.f, spec<Rgb>(0.2f, 0.1f, 0.4f), spec<Rgb>(0.6f, 0.3f, 1.2f));
@@ -344,7 +344,7 @@ TEST_CASE("GridControl: per-cell minorants bound the density from below") {
     for (int i = 0; i < 200; ++i) {
         const Vec3 o(-3.f, 2.f * rng.uniform() - 1.f, 2.f * rng.uniform() - 1.f);
         const Ray ray{o, glm::normalize(Vec3(1.f, 0.4f * rng.uniform() - 0.2f, 0.4f * rng.uniform() - 0.2f))};
-        auto it = control.iterate_control(ray, 0.f, kInf, {});
+        auto it = control.iterate(ray, 0.f, kInf, {});
         while (auto seg = it.next()) {
             for (int k = 0; k < 4; ++k) {
                 const float t = seg->t0 + (seg->t1 - seg->t0) * rng.uniform();
@@ -352,6 +352,7 @@ TEST_CASE("GridControl: per-cell minorants bound the density from below") {
                 const auto res = (mu - seg->sigma_ctl).eval();
                 REQUIRE((res >= -1e-6f * mu).all());
                 REQUIRE((res <= seg->sigma_res * (1.f + 1e-5f)).all());
+                REQUIRE((mu <= seg->sigma_maj * (1.f + 1e-5f)).all());
                 ++checked;
             }
         }

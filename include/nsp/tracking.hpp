@@ -159,6 +159,9 @@ struct FlightEnd {
     float t = 0.f;          ///< the stopping distance
     V tau_tail{};           ///< majorant optical depth from the last collision to tmax if passed
     bool invalid = false;   ///< the ray was not usable_ray or tmin / tmax NaN: nothing was tracked (`aborted` is set too)
+    /// The control's optical depth over the flight (up to `t` where it stopped), where the
+    /// callback took a control (ControlUse::ClosedForm or Collide); 0 otherwise.
+    double tau_ctl = 0.0;
 };
 
 /// The default limit on tentative collisions in one flight. It only matters where a majorant is
@@ -174,7 +177,70 @@ concept CollisionCallback = requires(F& f, float t, const Coefficients<S>& c, co
     { f(t, c, v, v) } -> std::same_as<bool>;
 };
 
+/// How a collision callback takes the control of a majorant policy whose segments carry one
+/// (ControlSegment, majorants/control.hpp; THEORY 5.10), stated as its
+/// `static constexpr ControlUse control_use` (Ignore where it states nothing). Under ClosedForm and
+/// Collide the loop splits the extinction into the grey control mu_c (the segment's smallest
+/// channel's) and the residual mu_t - mu_c, and hands the callback residual tentative collisions
+/// at rate mu_bar - mu_c with the coefficients scaled to the residual extinction mu_t,c - mu_c in
+/// every channel (albedo kept; negative where a control exceeds the extinction, all absorption
+/// where mu_t,c = 0), their `mu_bar` the residual majorant.
+enum class ControlUse : std::uint8_t {
+    Ignore,      ///< track under the full majorant, as without a control
+    ClosedForm,  ///< ratio tracking: only the residual is tracked; exp(-FlightEnd::tau_ctl) is the control's transmittance
+    /// Decomposition tracking: control collisions at rate mu_c beside the residual's tentative ones,
+    /// the first of them real. One lookup there (for the albedo); the callback sees coefficients
+    /// scaled to extinction mu_c and `mu_bar` = mu_c, so that its null probability is 0.
+    Collide,
+};
+
 namespace detail {
+/// What callback F states (ControlUse::Ignore where it states nothing).
+template <class F>
+constexpr ControlUse control_use_of() noexcept {
+    using G = std::remove_cvref_t<F>;
+    if constexpr (requires { { G::control_use } -> std::convertible_to<ControlUse>; }) return G::control_use;
+    else return ControlUse::Ignore;
+}
+
+/// True for a majorant segment that carries a control (ControlSegment).
+template <class Seg>
+inline constexpr bool has_control_v = requires(const Seg& s) { s.sigma_ctl; };
+
+/// A segment's grey control: its smallest channel's, kept within [0, mu_bar].
+template <class Spec>
+float grey_control(const Spec& ctl, float mu_bar) noexcept {
+    return std::min(std::max(ctl.minCoeff(), 0.f), mu_bar);
+}
+
+/// Scales coefficients `k` (after the bound policy) to extinction mu_t,c - `ctl` in every channel,
+/// albedo kept (ControlUse): where mu_t,c = 0 the residual -ctl is all absorption. mu_s is scaled
+/// and mu_a is the rest, so that the residual extinction is the difference to within one rounding;
+/// where that rounding put it above `rate` = mu_bar - ctl (which mu_t <= mu_bar excludes), mu_a
+/// gives the excess back (as clamp_to_majorant).
+template <SpectralMode S>
+void to_residual(Coefficients<S>& k, float ctl, float rate) noexcept {
+    using Spec = typename S::Spectrum;
+    if (!(ctl > 0.f)) return;  // no control here: the lookup as it is (a control of 0 is today's tracker, bit for bit)
+    const Spec t = k.sigma_t();
+    const Spec r = t - ctl;
+    k.sigma_s = (t > 0.f).select(k.sigma_s * (r / t), 0.f);
+    k.sigma_a = r - k.sigma_s;
+    const Spec over = k.sigma_t() - rate;
+    if ((over > 0.f).any()) [[unlikely]]
+        k.sigma_a = (over > 0.f).select(k.sigma_a - over, k.sigma_a);
+}
+
+/// Scales coefficients `k` to extinction `ctl` in every channel, albedo kept (a control collision,
+/// ControlUse::Collide): where mu_t,c = 0 it is all absorption.
+template <SpectralMode S>
+void to_control(Coefficients<S>& k, float ctl) noexcept {
+    using Spec = typename S::Spectrum;
+    const Spec t = k.sigma_t();
+    k.sigma_s = (t > 0.f).select(k.sigma_s * (ctl / t), 0.f).min(ctl);
+    k.sigma_a = ctl - k.sigma_s;
+}
+
 /// bound::Clamp: scales a lookup's coefficients, albedo kept, so that mu_t <= mu_bar in every
 /// channel (mu_bar grey or per channel).
 template <SpectralMode S, class V>
@@ -233,6 +299,12 @@ FlightEnd<MajorantValue<Maj, M>> free_flight(const M& medium, const Maj& majoran
     using V = MajorantValue<Maj, M>;
     using B = bound_policy_t<Maj>;
     constexpr bool grey = std::is_same_v<V, float>;
+    // A control (THEORY 5.10): the segments carry one and the callback takes it (ControlUse).
+    using Seg = std::remove_cvref_t<decltype(*majorant.iterate(ray, tmin, tmax, lambda).next())>;
+    constexpr ControlUse use = detail::has_control_v<Seg> ? detail::control_use_of<F>() : ControlUse::Ignore;
+    constexpr bool residual = use != ControlUse::Ignore;
+    constexpr bool collide = use == ControlUse::Collide;
+    static_assert(!residual || grey, "a control's segments carry a grey majorant");
     if (!usable_ray(ray) || tmin != tmin || tmax != tmax) [[unlikely]] {  // NaN != NaN
         FlightEnd<V> bad{false, true, false, 0.f, V{}, true};
         if constexpr (!grey) bad.tau_tail.setZero();
@@ -253,9 +325,33 @@ FlightEnd<MajorantValue<Maj, M>> free_flight(const M& medium, const Maj& majoran
     // drawing again: the same exponential distribution, one log and one random number less per
     // grid cell crossed.
     float e = -1.f;
+    [[maybe_unused]] double tau_ctl = 0.0;  // the control's optical depth so far (ControlUse)
+    [[maybe_unused]] float e_ctl = -1.f;    // the control depth left to the next control collision (Collide)
+    // The lookup at t with the bound policy applied: false where bound::Reject ends the flight.
+    auto look_up = [&](float t, const auto& maj, Coefficients<typename M::Spectral>& coeff) {
+        counter.lookup();
+        coeff = medium.coefficients(ray.at(t), lambda);
+        NSP_DEBUG_ASSERT((coeff.sigma_a >= 0.f).all() && (coeff.sigma_s >= 0.f).all() &&
+                             all_finite(coeff.sigma_a) && all_finite(coeff.sigma_s),
+                         "the medium returned a negative or non-finite coefficient");
+        if constexpr (std::is_same_v<B, bound::Clamp>) {
+            detail::clamp_to_majorant(coeff, maj);
+        } else if constexpr (std::is_same_v<B, bound::Reject>) {
+            if (detail::exceeds_majorant(coeff, maj)) return false;
+        }
+        return true;
+    };
     while (auto seg = segments.next()) {
-        const float mu_bar = channel_of(seg->sigma_maj, channel);
-        if (!(mu_bar > 0.f)) {  // nothing to collide with on this segment
+        float mu_bar = channel_of(seg->sigma_maj, channel);
+        [[maybe_unused]] float ctl = 0.f;
+        if constexpr (residual) {
+            ctl = detail::grey_control(seg->sigma_ctl, mu_bar);
+            mu_bar -= ctl;  // the residual majorant
+            if constexpr (!collide) tau_ctl += double(ctl) * double(seg->t1 - seg->t0);
+        }
+        if constexpr (collide) {
+            if (!(mu_bar > 0.f) && !(ctl > 0.f)) continue;
+        } else if (!(mu_bar > 0.f)) {  // nothing to collide with on this segment
             if constexpr (!grey) add_depth(seg->sigma_maj, seg->t1 - seg->t0);
             continue;
         }
@@ -264,35 +360,79 @@ FlightEnd<MajorantValue<Maj, M>> free_flight(const M& medium, const Maj& majoran
             // Exponential step: E = -ln(1 - u) majorant optical depths. logf, not log1pf: 1 - u is
             // exact for u on Pcg32's 2^-24 grid, so E agrees with -log1pf(-u) within 1 ulp (within
             // 2^-24 for finer u), and glibc's log1pf took 30% of this loop (bench/RESULTS.md).
-            if (!(e > 0.f)) e = -std::log(1.f - rng.uniform());
-            const float dt = e / mu_bar;
+            float dt;
+            [[maybe_unused]] bool control_first = false;
+            if constexpr (collide) {
+                dt = kInf;
+                if (mu_bar > 0.f) {
+                    if (!(e > 0.f)) e = -std::log(1.f - rng.uniform());
+                    dt = e / mu_bar;
+                }
+                if (ctl > 0.f) {
+                    if (!(e_ctl > 0.f)) e_ctl = -std::log(1.f - rng.uniform());
+                    if (const float dc = e_ctl / ctl; dc < dt) {
+                        dt = dc;
+                        control_first = true;
+                    }
+                }
+            } else {
+                if (!(e > 0.f)) e = -std::log(1.f - rng.uniform());
+                dt = e / mu_bar;
+            }
             if (!(dt < seg->t1 - t)) {  // the step leaves the segment (also catches inf)
-                add_depth(seg->sigma_maj, seg->t1 - t);
-                e -= mu_bar * (seg->t1 - t);  // <= 0 after rounding at the boundary: draw anew
+                const float len = seg->t1 - t;
+                if constexpr (collide) {
+                    if (mu_bar > 0.f) e -= mu_bar * len;  // <= 0 after rounding at the boundary: draw anew
+                    if (ctl > 0.f) e_ctl -= ctl * len;
+                    tau += (mu_bar + ctl) * len;
+                    tau_ctl += double(ctl) * double(len);
+                } else {
+                    if constexpr (grey) tau += mu_bar * len;  // the residual's, under a control
+                    else add_depth(seg->sigma_maj, len);
+                    e -= mu_bar * len;  // <= 0 after rounding at the boundary: draw anew
+                }
                 break;
             }
             t += dt;
-            if constexpr (grey) tau += e;
-            else add_depth(seg->sigma_maj, dt);
-            e = -1.f;
             if (++collisions > max_collisions) return {false, true, false, t, V{}};
-            counter.lookup();
-            auto coeff = medium.coefficients(ray.at(t), lambda);
-            NSP_DEBUG_ASSERT((coeff.sigma_a >= 0.f).all() && (coeff.sigma_s >= 0.f).all() &&
-                                 all_finite(coeff.sigma_a) && all_finite(coeff.sigma_s),
-                             "the medium returned a negative or non-finite coefficient");
-            if constexpr (std::is_same_v<B, bound::Clamp>) {
-                detail::clamp_to_majorant(coeff, seg->sigma_maj);
-            } else if constexpr (std::is_same_v<B, bound::Reject>) {
-                if (detail::exceeds_majorant(coeff, seg->sigma_maj)) return {false, true, true, t, V{}};
+            Coefficients<typename M::Spectral> coeff;
+            if (!look_up(t, seg->sigma_maj, coeff)) return {false, true, true, t, V{}};
+            float rate = mu_bar;  // the callback's majorant
+            if constexpr (collide) {
+                tau += (mu_bar + ctl) * dt;
+                tau_ctl += double(ctl) * double(dt);
+                if (control_first) {  // a control collision: real (THEORY 5.10)
+                    if (mu_bar > 0.f && e > 0.f) e -= mu_bar * dt;
+                    e_ctl = -1.f;
+                    detail::to_control(coeff, ctl);
+                    rate = ctl;
+                } else {
+                    if (ctl > 0.f && e_ctl > 0.f) e_ctl -= ctl * dt;
+                    e = -1.f;
+                    detail::to_residual(coeff, ctl, mu_bar);
+                }
+            } else {
+                if constexpr (grey) tau += e;
+                else add_depth(seg->sigma_maj, dt);
+                e = -1.f;
+                if constexpr (residual) detail::to_residual(coeff, ctl, mu_bar);
             }
             const V tau_step = tau;
             if constexpr (grey) tau = 0.f;
             else tau.setZero();
-            if (!on_collision(t, coeff, seg->sigma_maj, tau_step)) return {true, false, false, t, V{}};
+            bool go_on;
+            if constexpr (residual) go_on = on_collision(t, coeff, rate, tau_step);
+            else go_on = on_collision(t, coeff, seg->sigma_maj, tau_step);
+            if (!go_on) {
+                FlightEnd<V> end{true, false, false, t, V{}};
+                end.tau_ctl = tau_ctl;
+                return end;
+            }
         }
     }
-    return {false, false, false, tmax, tau};
+    FlightEnd<V> end{false, false, false, tmax, tau};
+    end.tau_ctl = tau_ctl;
+    return end;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -335,10 +475,12 @@ struct DeltaTrack {
     SegmentEnd end = SegmentEnd::Passed;
     float t = 0.f;                     ///< distance of the real collision, or tmax
     typename S::Spectrum weight;       ///< product of per-vertex f/p factors (1 on grey media with a bounding majorant)
-    float null_pdf_product = 1.f;      ///< prod_j P_n(n_j): the ratio p_track / p_ratio of the nulls (THEORY 5.1)
+    float null_pdf_product = 1.f;      ///< prod_j P_n(n_j): the ratio p_track / p_ratio of the nulls (THEORY 5.1); under a control, times exp(-tau_c) (5.10)
     /// mu_bar(t) P_event(t) at a real collision: its pdf over Tbar (THEORY 5.4). It is 0 where the
     /// product lies below float's range (an event of subnormal probability under a majorant below
-    /// 1/2, fuzzer finding 15); `equiangular_over_tracking` then gives inf, as it should.
+    /// 1/2, fuzzer finding 15); `equiangular_over_tracking` then gives inf, as it should. Under a
+    /// control it is the density of the route that drew the vertex (control or residual), not the
+    /// vertex's: equiangular MIS does not run on a control.
     float event_density = 0.f;
 };
 
@@ -354,6 +496,9 @@ struct NoVisit {
 /// product of the nulls before it (the collision estimator of emission, THEORY 5.7, uses it).
 template <AbsorptionPolicy A, SpectralMode S, UniformRng R, class Rec, class Visit = NoVisit>
 struct DeltaCollision {
+    /// Under a control, decomposition tracking (THEORY 5.10; track_delta_visiting refuses a control
+    /// with a visitor).
+    static constexpr ControlUse control_use = ControlUse::Collide;
     R& rng;
     Rec& rec;
     Visit visit{};
@@ -428,6 +573,8 @@ struct RatioTrack {
 /// would have used at the same nulls, the factor that makes null-scattering MIS work (THEORY 5.1).
 template <AbsorptionPolicy A, bool kNullRatio, SpectralMode S, class Rec>
 struct RatioCollision {
+    /// Under a control, residual ratio tracking (THEORY 5.10).
+    static constexpr ControlUse control_use = ControlUse::ClosedForm;
     Rec& rec;
     SegmentEnd end = SegmentEnd::Passed;
     // The products accumulate in double (see detail::kFloatNulls; for one to a few channels
@@ -464,6 +611,10 @@ DeltaTrack<typename M::Spectral> track_delta_visiting(const M& medium, const Maj
                                                       float tmax, const typename M::Spectral::Wavelengths& lambda,
                                                       R& rng, C& counter, Visit visit, Rec&& rec = Rec{}) {
     using S = typename M::Spectral;
+    static_assert(!Visit::enabled || !detail::has_control_v<std::remove_cvref_t<decltype(*majorant.iterate(
+                                         ray, 0.f, tmax, lambda).next())>>,
+                  "a visitor (the collision estimator of emission) sees the full majorant's tentative collisions, "
+                  "which decomposition tracking under a control does not draw: track under a majorant without one");
     DeltaCollision<A, S, R, std::remove_reference_t<Rec>, Visit> cb{rng, rec, std::move(visit)};
     const auto f = free_flight(medium, majorant, ray, 0.f, tmax, lambda, rng, counter, cb);
     if (f.aborted) return {aborted_end(f), f.t, S::Spectrum::Zero(), 1.f};
@@ -472,6 +623,9 @@ DeltaTrack<typename M::Spectral> track_delta_visiting(const M& medium, const Maj
         cb.out.t = tmax;
         if constexpr (std::remove_reference_t<Rec>::enabled) rec.log_pdf -= f.tau_tail;
     }
+    // Under a control, no control collision before the end: exp(-tau_c) joins the null product
+    // (THEORY 5.10: p_uni / p_nee = (p_w / p_l) exp(-tau_c) prod P_n,r).
+    if (f.tau_ctl > 0.0) cb.null_pdf_product *= std::exp(-f.tau_ctl);
     return cb.finish();
 }
 
@@ -498,6 +652,13 @@ RatioTrack<typename M::Spectral> track_ratio(const M& medium, const Maj& majoran
     if (f.aborted) return {aborted_end(f), S::Spectrum::Zero(), 1.f};
     if constexpr (std::remove_reference_t<Rec>::enabled)
         if (!f.stopped) rec.log_pdf -= f.tau_tail;
+    // Under a control (residual ratio tracking, THEORY 5.10): the control's transmittance in closed
+    // form, and decomposition tracking's probability of no control collision in the null product.
+    if (f.tau_ctl > 0.0 && cb.end == SegmentEnd::Passed) {
+        const double t_ctl = std::exp(-f.tau_ctl);
+        cb.transmittance *= t_ctl;
+        cb.null_pdf_product *= t_ctl;
+    }
     return cb.finish();
 }
 

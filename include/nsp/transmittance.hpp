@@ -40,8 +40,12 @@
 namespace nsp {
 
 /// Residual ratio tracking of the transmittance along `ray` over [0, tmax] (see the header): per
-/// channel exp(-sum mu_c len) times prod_i (1 - (mu_t(x_i) - mu_c) / mu_bar_r) over tentative
-/// collisions x_i at rate mu_bar_r. At most `max_collisions` tentative collisions (then Aborted).
+/// channel exp(-sum mu_c,c len) times prod_i (1 - (mu_t,c(x_i) - mu_c,c) / mu_bar_r) over
+/// tentative collisions x_i at rate mu_bar_r, each channel with its own control (the free-flight
+/// loop's residual ratio tracking, track_ratio under a control, takes one grey control for every
+/// channel so that its null probabilities pair with decomposition tracking's; per channel, a
+/// chromatic medium's residual is smaller). At most `max_collisions` tentative collisions (then
+/// Aborted).
 template <Medium M, ControlPolicy<M> Ctl, UniformRng R, LookupCounter C>
 TransmittanceSample<typename M::Spectral> transmittance_residual_ratio(
     const M& medium, const Ctl& control, const Ray& ray, float tmax, const typename M::Spectral::Wavelengths& lambda,
@@ -50,7 +54,7 @@ TransmittanceSample<typename M::Spectral> transmittance_residual_ratio(
     const Spec zero = Spec::Zero();
     if (!usable_ray(ray) || tmax != tmax) [[unlikely]]
         return {zero, Status::InvalidInput};
-    auto segments = control.iterate_control(ray, 0.f, tmax, lambda);
+    auto segments = control.iterate(ray, 0.f, tmax, lambda);
     const detail::StepReport<decltype(segments), C> report{segments, counter};
     Spec tau_c = zero;
     // The product in double and its end below float's smallest normal, as ratio tracking's

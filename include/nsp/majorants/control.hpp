@@ -1,12 +1,16 @@
 // nsp/majorants/control.hpp: controls (minorants) beside majorants, for the estimators that pay
 // lookups only for the residual extinction above a known part (THEORY 5.10).
 //
-// A control policy walks a ray as a majorant policy does and yields ControlSegments: on [t0, t1)
-// the control mu_c (per channel, known without a lookup) and the residual majorant mu_bar_r with
-// 0 <= mu_t,c(x) - mu_c,c <= mu_bar_r for every channel c and x on the stretch. Residual ratio
-// tracking (transmittance.hpp) draws tentative collisions at rate mu_bar_r and takes exp(-mu_c
-// len) in closed form: where the control is the whole extinction (a homogeneous stretch) it pays
-// no lookup at all; with a control of 0 it is ratio tracking, draw for draw.
+// A control policy is a majorant policy whose segments are ControlSegments: on [t0, t1) the
+// majorant mu_bar and the control mu_c (per channel, known without a lookup) with
+// mu_c,c <= mu_t,c(x) <= mu_bar for every channel c and x on the stretch. The free-flight loop
+// (tracking.hpp) tracks the residual mu_t - mu_c under the residual majorant mu_bar - mu_c, with
+// the grey control mu_c = min_c mu_c,c: ratio tracking takes exp(-mu_c len) in closed form
+// (residual ratio tracking), delta tracking draws control collisions at rate mu_c beside the
+// residual's tentative ones (decomposition tracking). Where the control is the whole extinction
+// (a homogeneous stretch) neither pays a lookup for its nulls; with a control of 0 both are
+// today's trackers, draw for draw. Code that walks the segments without knowing of the control
+// (the per-channel trackers, pdf evaluation) sees an ordinary majorant.
 //
 // GridControl stores per cell the density's lower bound beside its upper bound (two floats per
 // cell; a medium without a lower-bound query, LowerBoundedMedium, gets a control of 0 and pays
@@ -37,39 +41,47 @@ concept LowerBoundedMedium = RegionBoundedMedium<M> && requires(const M& m, cons
     { m.density_lower_bound(b) } -> std::same_as<float>;
 };
 
-/// A stretch [t0, t1) of a ray with its control and residual majorant (see the header): the
-/// control per channel (`Spectrum`), the residual majorant and the full majorant grey.
+/// A stretch [t0, t1) of a ray with its grey majorant and its control per channel (see the header).
 template <class Spectrum>
 struct ControlSegment {
     float t0 = 0.f;
     float t1 = 0.f;
-    Spectrum sigma_ctl{};   ///< mu_c per channel, finite and >= 0
-    float sigma_res = 0.f;  ///< mu_bar_r: mu_t,c - mu_c,c lies in [0, mu_bar_r] on the stretch
-    float sigma_maj = 0.f;  ///< the full majorant, max_c mu_c,c + mu_bar_r or looser (what ratio tracking would use)
+    float sigma_maj = 0.f;  ///< mu_bar: the majorant, >= mu_t,c in every channel on the stretch
+    Spectrum sigma_ctl{};   ///< mu_c per channel, finite, >= 0 and <= mu_bar (below mu_t,c unless the caller chose otherwise)
+    /// The residual majorant of a per-channel control: mu_t,c - mu_c,c <= sigma_res in every channel
+    /// (transmittance_residual_ratio); at most mu_bar - min_c mu_c,c, which the loop's grey control uses.
+    float sigma_res = 0.f;
 };
 
 namespace detail {
+template <class S>
+struct is_majorant_segment<ControlSegment<S>> : std::true_type {};  // a majorant segment with a control
 template <class T>
 struct is_control_segment : std::false_type {};
 template <class S>
 struct is_control_segment<ControlSegment<S>> : std::true_type {};
 }  // namespace detail
 
-/// A control policy for medium M: `iterate_control(ray, tmin, tmax, lambda)` yields
-/// ControlSegments in increasing t (std::nullopt at the end) over the part of [tmin, tmax] where
-/// the medium may be non-zero; `steps()` on the iterator counts its DDA steps where it has them.
+/// A control policy for medium M: a majorant policy whose `iterate(ray, tmin, tmax, lambda)`
+/// yields ControlSegments (see the header); `steps()` on the iterator counts its DDA steps where
+/// it has them.
 template <class P, class M>
-concept ControlPolicy = Medium<M> &&
-    requires(const P& p, const Ray& r, float t, const typename M::Spectral::Wavelengths& l) {
-        { p.iterate_control(r, t, t, l).next().has_value() } -> std::same_as<bool>;
-        requires detail::is_control_segment<std::remove_cvref_t<decltype(*p.iterate_control(r, t, t, l).next())>>::value;
-    };
+concept ControlPolicy = MajorantPolicy<P, M> &&
+    detail::is_control_segment<std::remove_cvref_t<decltype(*std::declval<const P&>()
+                                                               .iterate(std::declval<const Ray&>(), 0.f, 0.f,
+                                                                        std::declval<const typename M::Spectral::Wavelengths&>())
+                                                               .next())>>::value;
+
+/// True when majorant policy Maj carries a control (ControlPolicy).
+template <class Maj, class M>
+inline constexpr bool is_control_v = ControlPolicy<Maj, M>;
 
 /// One control and one majorant over the medium's box: the control a caller gives (per channel),
-/// the majorant the medium's extinction bound. Residual ratio tracking under it is unbiased for
-/// any control up to that bound while the residual majorant (bound - the smallest channel's
-/// control) is > 0, a control above the extinction in places included (THEORY 5.10); at a control
-/// equal to the bound nothing is looked up, and the control must be the extinction itself.
+/// the majorant the medium's extinction bound. Tracking under it is unbiased for any control up to
+/// that bound while the residual majorant (bound - the smallest channel's control) is > 0, a
+/// control above the extinction in places included: the residual is negative there and the
+/// trackers weigh its nulls by sign (THEORY 5.10); at a control equal to the bound nothing is
+/// looked up, and the control must be the extinction itself.
 template <Medium M>
 class GlobalControl {
 public:
@@ -89,12 +101,11 @@ public:
                          majorant_, ": a control must lie below the extinction everywhere");
     }
 
-    /// The whole [tmin, tmax] clipped to the box: the control, residual majorant max_extinction -
-    /// the smallest channel's control (so the residual bounds every channel), majorant max_extinction.
+    /// The whole [tmin, tmax] clipped to the box: majorant max_extinction and the control.
     class Iterator {
     public:
-        Iterator(Interval in, const Spectrum& ctl, float res, float maj) noexcept
-            : seg_{in.t0, in.t1, ctl, res, maj}, done_(in.empty()) {}
+        Iterator(Interval in, float maj, const Spectrum& ctl) noexcept
+            : seg_{in.t0, in.t1, maj, ctl, std::max(0.f, maj - ctl.minCoeff())}, done_(in.empty()) {}
         std::optional<ControlSegment<Spectrum>> next() noexcept {
             if (done_) return std::nullopt;
             done_ = true;
@@ -107,10 +118,8 @@ public:
         bool done_;
     };
 
-    Iterator iterate_control(const Ray& r, float tmin, float tmax, const typename Spectral::Wavelengths& l) const noexcept {
-        const Spectrum ctl = Spectral::sample(control_, l);
-        const float res = std::max(0.f, majorant_ - ctl.minCoeff());
-        return {bounds_.clip(r, tmin, tmax), ctl, res, majorant_};
+    Iterator iterate(const Ray& r, float tmin, float tmax, const typename Spectral::Wavelengths& l) const noexcept {
+        return {bounds_.clip(r, tmin, tmax), majorant_, Spectral::sample(control_, l)};
     }
 
 private:
@@ -122,8 +131,8 @@ private:
 /// A grid of controls and majorants over the medium's box (THEORY 5.10): per cell the medium's
 /// density bounds from below (LowerBoundedMedium; 0 for a medium without one) and from above,
 /// d_min <= d <= d_max; on a cell's stretch the control is d_min times each channel's extinction
-/// per density u_c, the residual majorant (d_max - d_min) max_c u_c, and the majorant d_max max_c
-/// u_c (GridMajorant's). Walked by the same DDA as GridMajorant. Two floats per cell.
+/// per density u_c and the majorant d_max max_c u_c (GridMajorant's), so the residual majorant is
+/// d_max max_c u_c - d_min min_c u_c ((d_max - d_min) u on a grey medium). Walked by the same DDA as GridMajorant. Two floats per cell.
 template <RegionBoundedMedium M>
 class GridControl {
 public:
@@ -166,7 +175,7 @@ public:
                 const float hi = g_->upper_.data()[i];
                 if (!(hi > 0.f) || !(t1 > t0)) continue;
                 const float lo = g_->lower_[i];
-                return ControlSegment<Spectrum>{t0, t1, unit_ * lo, (hi - lo) * g_->unit_max_, hi * g_->unit_max_};
+                return ControlSegment<Spectrum>{t0, t1, hi * g_->unit_max_, unit_ * lo, (hi - lo) * g_->unit_max_};
             }
             return std::nullopt;
         }
@@ -178,7 +187,7 @@ public:
         Spectrum unit_;
     };
 
-    Iterator iterate_control(const Ray& r, float tmin, float tmax, const typename Spectral::Wavelengths& l) const noexcept {
+    Iterator iterate(const Ray& r, float tmin, float tmax, const typename Spectral::Wavelengths& l) const noexcept {
         return {*this, upper_.walk(r, tmin, tmax), Spectral::sample(unit_, l)};
     }
 
