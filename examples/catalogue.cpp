@@ -78,7 +78,8 @@ std::vector<SceneEntry> make_catalogue() {
                  {"unidirectional_grey_absorb-weight", "ratio-nee_grey_absorb-weight",
                   "directional-mis_grey_balance_absorb-weight", "uni-nee-mis_grey_balance_absorb-weight",
                   "uni-nee-mis_grey_balance_absorb-weight_learned"},
-                 {"global", "grid"}, "", false,
+                 // grid-control: decomposition tracking under the grid's per-cell minorants
+                 {"global", "grid", "grid-control"}, "", false,
                  "SA", nsp::Mono::name, "uni-nee-mis_grid_balance_absorb-weight", 64,
                  "uni-nee-mis_balance_absorb-weight", {"unidirectional_absorb-weight", "ratio-nee_absorb-weight"}});
 
@@ -94,7 +95,8 @@ std::vector<SceneEntry> make_catalogue() {
                    {"ratio-nee_grey_absorb-weight", "uni-nee-mis_grey_balance_absorb-weight",
                     "equiangular-nee_grey_absorb-weight", "uni-nee-eq-mis_grey_absorb-weight",
                     "uni-nee-eq-mis_grey_balance_absorb-weight_learned"},
-                   {"global", "grid"},
+                   // grid-control (decomposition tracking) takes the strategies without equiangular sampling
+                   {"global", "grid", "grid-control"},
                    // its NEE from tracked vertices near the lamp is weighted down by the equiangular pdf
                    // there: no 1/r^2 tail, unlike tracking + NEE
                    "uni-nee-eq-mis_balance_absorb-event", false,

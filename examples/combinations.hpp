@@ -122,6 +122,20 @@ struct ChannelGridMajorantPolicy {
     static type<M> make(const M& medium, const MajorantSettings& s) { return type<M>(medium, s.grid_res); }
 };
 
+/// A grey voxel-grid majorant with a control beside it (nsp::GridControl, THEORY 5.10): per cell the
+/// medium's density bounds from above and below. PathEstimator tracks its segments by decomposition
+/// tracking and its shadow rays by residual ratio tracking, paying lookups only for the residual
+/// above each cell's minorant.
+struct GridControlPolicy {
+    static constexpr const char* name = "grid-control";
+    static constexpr bool per_channel = false;
+    static constexpr bool bounding = true;
+    template <nsp::Medium M>
+    using type = nsp::GridControl<M>;
+    template <nsp::Medium M>
+    static type<M> make(const M& medium, const MajorantSettings& s) { return type<M>(medium, s.grid_res); }
+};
+
 /// The channel policy of nsp::PathEstimator: one pdf driven by the channel means, grey majorant.
 struct Grey {
     static constexpr const char* name = "grey";
@@ -132,7 +146,8 @@ using ChannelPolicies = tl::list<Grey, nsp::channels::Independent, nsp::channels
                                  nsp::channels::SpectralTrackingAverage, nsp::channels::SpectralMis>;
 using Majorants = tl::list<GlobalMajorantPolicy<>, ChannelMajorantPolicy, GridMajorantPolicy<>, ChannelGridMajorantPolicy,
                            GlobalMajorantPolicy<nsp::bound::Signed>, GlobalMajorantPolicy<nsp::bound::Clamp>,
-                           GridMajorantPolicy<nsp::bound::Signed>, GridMajorantPolicy<nsp::bound::Clamp>>;
+                           GridMajorantPolicy<nsp::bound::Signed>, GridMajorantPolicy<nsp::bound::Clamp>,
+                           GridControlPolicy>;
 using Strategies = tl::list<nsp::strategy::Unidirectional, nsp::strategy::NextEvent,
                             nsp::strategy::DirectionalMis, nsp::strategy::NullScatteringMis,
                             nsp::strategy::EquiangularNextEvent, nsp::strategy::EquiangularMis>;
@@ -174,6 +189,9 @@ using MediumKinds = tl::list<DenseGridCloud, EmissivePlume>;
 ///   without equiangular sampling (the plume has no point or sphere light for it to aim at). The
 ///   smoke is grey, so SpectralPathEstimator's emission rows would repeat PathEstimator's at about
 ///   twice the cost per sample; the tests cover them.
+/// - the grid control (GridControlPolicy) with PathEstimator in Mono and Rgb, absorb-weight, on the
+///   media without emission and the strategies without equiangular sampling: what PathEstimator
+///   takes under a control (its static_assert), without the Hero<4> points the grey axis does not need.
 template <class Tuple>
 struct is_valid;
 template <class S, class CP, class Maj, class St, class H, class A, class Med>
@@ -194,7 +212,9 @@ struct is_valid<tl::list<S, CP, Maj, St, H, A, Med>> {
     }();
     static constexpr bool estimator_fits = grey || (S::channels > 1 && (St::null_pdfs || !St::combines));
     static constexpr bool build_fits = [] {
-        if constexpr (Med::emissive)
+        if constexpr (std::is_same_v<Maj, GridControlPolicy>)
+            return grey && weight && !St::equiangular && !Med::emissive && S::channels <= 3 && !nsp::is_hero_v<S>;
+        else if constexpr (Med::emissive)
             return grey && std::is_same_v<S, nsp::Rgb> && Maj::bounding && weight && !St::equiangular;
         else if constexpr (St::equiangular) return grey && std::is_same_v<S, nsp::Mono>;
         else return true;
@@ -277,9 +297,9 @@ using CombinationsOf = tl::transform<
 // tracking max and average global, spectral MIS per-channel and global), and 5 pairs with the grid
 // majorants x absorb-weight (independent channel-grid, spectral tracking max and average grid,
 // spectral MIS grid and channel-grid). The emissive medium, in Rgb: the 6 grey rows with global and
-// grid, absorb-weight.
-static_assert(tl::size<CombinationsOf<nsp::Mono>> == 9 * 2 + (9 + 3) + 9 * 4);
-static_assert(tl::size<CombinationsOf<nsp::Rgb>> == 6 * 2 + 6 + 5 * 3 * 2 + 5 * 3 + 6 * 2);
+// grid, absorb-weight. The grid control, in Mono and Rgb: the 6 grey rows, absorb-weight.
+static_assert(tl::size<CombinationsOf<nsp::Mono>> == 9 * 2 + (9 + 3) + 9 * 4 + 6);
+static_assert(tl::size<CombinationsOf<nsp::Rgb>> == 6 * 2 + 6 + 5 * 3 * 2 + 5 * 3 + 6 * 2 + 6);
 static_assert(tl::size<CombinationsOf<Hero4>> == 6 * 2 + 6 + 5 * 3 * 2 + 5 * 3);
 
 /// What the driver knows of one combination at run time: its names and traits as plain data, so

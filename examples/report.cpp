@@ -65,6 +65,10 @@ void print_majorant_notes(const Options& o, const std::vector<Row>& rows) {
                     "steps (cells crossed, empty ones included) per sample; lookups/spl counts density lookups "
                     "only.\n", n, n, n, n * n * n * 4 / 1024);
     }
+    if (any([](const Row& r) { return r.c.majorant == "grid-control"; }))
+        std::printf("grid-control (nsp::GridControl): the grid majorant with each cell's density lower bound beside "
+                    "it (two floats per cell); segments by decomposition tracking, shadow rays by residual ratio "
+                    "tracking: lookups only for the density above each cell's minorant.\n");
     if (any([](const Row& r) { return !r.c.bounding; }))
         std::printf("non-bounding majorants (*-signed, *-clamp): %g x the bound (--majorant-scale), below the "
                     "extinction where the medium is dense. signed (bound::Signed): negative null weights, "

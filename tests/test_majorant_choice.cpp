@@ -143,3 +143,48 @@ TEST_CASE("the cost model rejects a bad step cost or resolution, naming it") {
                          Contains("step_cost = nan"), InvalidArgument);
     CHECK_THROWS_WITH_AS(grid_majorant_cost(medium, {4, 0, 4}), Contains("resolution[1] = 0"), InvalidArgument);
 }
+
+TEST_CASE("the control's cost model: the residual optical depth of random lines, and its choice") {
+    // Lookups: the residual majorant's optical depth (majorant less the grey control) over random
+    // lines, within 5 SE of 20000 lines, as decomposition and residual ratio tracking draw their
+    // tentative collisions at that rate; steps: the grid's.
+    const Box box{Vec3(0.f, 0.f, 0.f), Vec3(2.f, 1.f, 1.5f)};
+    std::vector<float> d(16 * 16 * 16);
+    Pcg32 fill(3, 3);
+    for (float& v : d) v = 0.5f + fill.uniform();  // everywhere between 0.5 and 1.5: a large minorant
+    const M medium(box, {16, 16, 16}, std::move(d), grey<Mono>(2.f), grey<Mono>(8.f));
+    for (const std::array<int, 3> res : {std::array<int, 3>{4, 4, 4}, std::array<int, 3>{8, 3, 5}}) {
+        CAPTURE(res[0]); CAPTURE(res[1]); CAPTURE(res[2]);
+        const MajorantCost model = grid_control_cost(medium, res);
+        const MajorantCost plain = grid_majorant_cost(medium, res);
+        const GridControl<M> control(medium, res);
+        Pcg32 rng(13, 5);
+        Stat steps, depth;
+        for (int i = 0; i < 20000; ++i) {
+            const Ray ray = random_line(rng, box);
+            auto it = control.iterate(ray, 0.f, kInf, {});
+            double tau = 0.0;
+            while (auto s = it.next()) tau += double(s->t1 - s->t0) * (double(s->sigma_maj) - double(s->sigma_ctl[0]));
+            steps.add(double(it.steps()));
+            depth.add(tau);
+        }
+        CAPTURE(model.steps); CAPTURE(steps.mean); CAPTURE(model.lookups); CAPTURE(depth.mean);
+        CHECK(model.control);
+        CHECK(std::abs(steps.mean - model.steps) <= 5.0 * steps.se());
+        CHECK(std::abs(depth.mean - model.lookups) <= 5.0 * depth.se());
+        CHECK(model.steps == doctest::Approx(plain.steps).epsilon(1e-12));
+        // The density's minimum is at least 1/3 of its maximum in every cell: the control removes at
+        // least a third of the lookups.
+        CHECK(model.lookups < (2.0 / 3.0) * plain.lookups);
+    }
+    // The choice: with the control's steps at the grid's cost, a control (it never costs more
+    // lookups than the same grid); with dear control steps, no control.
+    const MajorantCost cheap = choose_majorant(medium, 64, kDefaultStepCost, kDefaultStepCost);
+    CHECK(cheap.control);
+    CHECK(cheap.cost < choose_grid_resolution(medium).cost);
+    const MajorantCost dear = choose_majorant(medium, 64, kDefaultStepCost, 1e6f);
+    CHECK(!dear.control);
+    CHECK(dear.cost == choose_grid_resolution(medium).cost);
+    CHECK_THROWS_WITH_AS(choose_majorant(medium, 64, kDefaultStepCost, -1.f), Contains("step_cost = -1"),
+                         InvalidArgument);
+}

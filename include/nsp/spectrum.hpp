@@ -224,6 +224,18 @@ float max_value(const K& k) noexcept {
     else return k.maxCoeff();
 }
 
+/// The smallest value of a coefficient over all channels or wavelengths.
+template <class K>
+float min_value(const K& k) noexcept {
+    if constexpr (std::is_same_v<K, TabulatedSpectrum>) {
+        float m = k[0];
+        for (int i = 1; i < TabulatedSpectrum::kSize; ++i) m = std::min(m, k[i]);
+        return m;
+    } else {
+        return k.minCoeff();
+    }
+}
+
 /// A coefficient scaled by k.
 template <class K>
 K scale(const K& c, float k) {

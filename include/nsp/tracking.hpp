@@ -62,6 +62,18 @@ namespace detail {
 /// mu_bar - (a + s) everywhere, so event_probabilities and null_probability agree on whether it is
 /// 0 (where they differed, a null was chosen with P_n > 0 in float and weighed with P_n = 0: NaN;
 /// found by the fuzzer).
+/// The coefficient that drives a real event's probability: the channel mean of |mu_x,c|. A
+/// medium's mu_a and mu_s are >= 0 and this is their mean; a residual under a control above the
+/// density is negative (THEORY 5.10), and its real events are then drawn by |mu_x| and weighed
+/// mu_x / (mu_bar P_x), negative, as bound::Signed weighs negative nulls: drawn with probability
+/// 0 they were lost (decomposition tracking's control collisions would have carried the whole
+/// control). The mean of |.|, not |mean|: channels of both signs must not cancel.
+template <class Spec>
+float event_coefficient(const Spec& sigma) noexcept {
+    if constexpr (Spec::SizeAtCompileTime == 1) return std::abs(sigma[0]);
+    else return sampling_scalar(Spec(sigma.abs()));
+}
+
 template <SpectralMode S>
 float null_coefficient(const Coefficients<S>& c, float mu_bar) noexcept {
     if constexpr (S::channels == 1) return std::abs(mu_bar - (c.sigma_a[0] + c.sigma_s[0]));
@@ -78,8 +90,8 @@ float null_coefficient(const Coefficients<S>& c, float mu_bar) noexcept {
 /// unbiased (THEORY 1, 4.3). Clamping P_n at 0 there would drop the negative null term.
 template <AbsorptionPolicy A, SpectralMode S>
 EventProbabilities event_probabilities(const Coefficients<S>& c, float mu_bar) noexcept {
-    const float a = std::max(0.f, sampling_scalar(c.sigma_a));
-    const float s = std::max(0.f, sampling_scalar(c.sigma_s));
+    const float a = detail::event_coefficient(c.sigma_a);
+    const float s = detail::event_coefficient(c.sigma_s);
     const float n = detail::null_coefficient(c, mu_bar);
     // In double: where a + s + n is below 2^-126 (a denormal majorant, met at a zero-length step
     // from u = 0) the float 1 / (a + s + n) overflowed and the probabilities were inf or NaN
@@ -117,8 +129,8 @@ DoubleSpectrum<typename S::Spectrum> null_ratio(const Coefficients<S>& c, float 
 /// The null probability P_n of event_probabilities<A> (the same formula), in double.
 template <AbsorptionPolicy A, SpectralMode S>
 double null_probability(const Coefficients<S>& c, float mu_bar) noexcept {
-    const float a = std::max(0.f, sampling_scalar(c.sigma_a));
-    const float s = std::max(0.f, sampling_scalar(c.sigma_s));
+    const float a = event_coefficient(c.sigma_a);
+    const float s = event_coefficient(c.sigma_s);
     const double t = a + s;  // in float, as event_probabilities forms it
     const double n = null_coefficient(c, mu_bar);
     return n / (t + n);
@@ -347,7 +359,11 @@ FlightEnd<MajorantValue<Maj, M>> free_flight(const M& medium, const Maj& majoran
         if constexpr (residual) {
             ctl = detail::grey_control(seg->sigma_ctl, mu_bar);
             mu_bar -= ctl;  // the residual majorant
-            if constexpr (!collide) tau_ctl += double(ctl) * double(seg->t1 - seg->t0);
+            if constexpr (!collide) {
+                tau_ctl += double(ctl) * double(seg->t1 - seg->t0);
+                if constexpr (requires { on_collision.control_depth(tau_ctl); })
+                    if (tau_ctl > 20.0) on_collision.control_depth(tau_ctl);
+            }
         }
         if constexpr (collide) {
             if (!(mu_bar > 0.f) && !(ctl > 0.f)) continue;
@@ -424,15 +440,23 @@ FlightEnd<MajorantValue<Maj, M>> free_flight(const M& medium, const Maj& majoran
             if constexpr (residual) go_on = on_collision(t, coeff, rate, tau_step);
             else go_on = on_collision(t, coeff, seg->sigma_maj, tau_step);
             if (!go_on) {
-                FlightEnd<V> end{true, false, false, t, V{}};
-                end.tau_ctl = tau_ctl;
-                return end;
+                if constexpr (residual) {
+                    FlightEnd<V> end{true, false, false, t, 0.f};
+                    end.tau_ctl = tau_ctl;
+                    return end;
+                } else {
+                    return {true, false, false, t, V{}};
+                }
             }
         }
     }
-    FlightEnd<V> end{false, false, false, tmax, tau};
-    end.tau_ctl = tau_ctl;
-    return end;
+    if constexpr (residual) {
+        FlightEnd<V> end{false, false, false, tmax, tau};
+        end.tau_ctl = tau_ctl;
+        return end;
+    } else {
+        return {false, false, false, tmax, tau};
+    }
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -581,6 +605,15 @@ struct RatioCollision {
     // double costs no more than float); `finish` rounds them.
     detail::DoubleSpectrum<typename S::Spectrum> transmittance = decltype(transmittance)::Ones();
     double null_pdf_product = 1.0;
+    /// The product below which the estimate is lost: the smallest normal float, over the control's
+    /// transmittance where a control's closed form will multiply it (control_depth).
+    double floor = double(std::numeric_limits<float>::min());
+
+    /// Under a control, the loop's report of the control's optical depth up to the end of the
+    /// current segment (past 20 only: below, the floor would stay under 1e-29): the estimate will
+    /// be multiplied by exp(-tau), so the stop below must see it, or a shadow ray through a thick
+    /// controlled medium walks to its end for an estimate that rounds to 0.
+    void control_depth(double tau) noexcept { floor = double(std::numeric_limits<float>::min()) * std::exp(tau); }
 
     bool operator()(float t, const Coefficients<S>& c, float mu_bar, float tau) {
         transmittance *= detail::null_ratio(c, mu_bar);
@@ -589,7 +622,7 @@ struct RatioCollision {
         // Stop once every channel is below the smallest normal float, what the float result can
         // hold: a float product of factors above 1/2 stalls at the smallest denormal and never
         // reaches 0, which made thick media cost a lookup per majorant optical depth.
-        if ((transmittance.abs() < double(std::numeric_limits<float>::min())).all()) {
+        if ((transmittance.abs() < floor).all()) {
             transmittance.setZero();
             end = SegmentEnd::Terminated;
             return false;

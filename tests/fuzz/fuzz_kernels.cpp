@@ -18,7 +18,9 @@
 // - last (its bytes are read after everything else, so the corpus keeps its meaning): a ray
 //   that is not usable_ray (a direction of length 0.5, 1.01 or 2, a zero, NaN or infinite
 //   direction, a NaN or infinite origin) or a NaN distance, at every public tracking entry and at
-//   both path estimators: each must answer InvalidInput and no estimate (0), never a number.
+//   both path estimators: each must answer InvalidInput and no estimate (0), never a number;
+// - after it, reading no bytes: the trackers under a control (run_controls), decomposition and
+//   residual ratio tracking and ray marching on the input's medium.
 //
 // Work is bounded: a case whose majorant optical depth across the medium's box exceeds kBudget
 // is skipped, paths are at most 8 real vertices deep, and free_flight's own calls stop after 64
@@ -1140,6 +1142,64 @@ void run_unusable(Input& in, FuzzRng& rng, const M& medium, const std::array<int
     NSP_FUZZ_CHECK(c.status == Status::InvalidInput && (c.value == 0.f).all());
 }
 
+/// The trackers under a control (THEORY 5.10) on the input's medium, with a local generator (no
+/// bytes read, so the corpus keeps its meaning): GridControl at the medium's resolution, and
+/// GlobalControl at 0 (today's trackers) and at half the extinction bound (above the density where
+/// the medium is thin: negative residuals). Decomposition tracking (track_delta, VertexKernels::track),
+/// residual ratio tracking (track_ratio, VertexKernels::shadow, transmittance_residual_ratio) and
+/// ray marching under the grid majorant: statuses Ok, Aborted or NonFinite, estimates and null
+/// products finite, null products in [0, 1] and transmittances >= 0 under the grid control (a
+/// minorant: no negative residual). Skipped past the work budget, as the majorant cases are.
+template <SpectralMode S, class M, class Lambda>
+void run_controls(const M& medium, const std::array<int, 3>& res, const Lambda& lambda) {
+    g_context = "controls";
+    const Box b = medium.bounds();
+    if (!(medium.max_extinction() * glm::length(b.hi - b.lo) <= kBudget)) return;
+    std::optional<GridControl<M>> grid;
+    std::optional<GridMajorant<M>> gmaj;
+    std::optional<GlobalControl<M>> zero, half;
+    try {
+        grid.emplace(medium, res);
+        gmaj.emplace(medium, res);
+        zero.emplace(medium, constant_coefficient<S>(0.f));
+        half.emplace(medium, constant_coefficient<S>(0.5f * medium.max_extinction()));
+    } catch (const InvalidArgument&) {
+        return;
+    }
+    Pcg32 rng(std::uint64_t(res[0]) * 131u + std::uint64_t(res[1]) * 17u + std::uint64_t(res[2]), 11);
+    LookupCount counter;
+    const VertexKernels<strategy::NullScatteringMis, mis::Balance> k;
+    auto ok = [](Status st) { return st == Status::Ok || st == Status::Aborted || st == Status::NonFinite; };
+    for (int i = 0; i < 4; ++i) {
+        Vec3 d(2.f * rng.uniform() - 1.f, 2.f * rng.uniform() - 1.f, 2.f * rng.uniform() - 1.f);
+        d = glm::length(d) > 1e-3f ? glm::normalize(d) : Vec3(1.f, 0.f, 0.f);
+        const Vec3 p = b.lo + Vec3(rng.uniform(), rng.uniform(), rng.uniform()) * (b.hi - b.lo);
+        const Ray ray{p - 2.f * glm::length(b.hi - b.lo) * d, d};
+        const float tmax = i % 2 ? kInf : 2.f * glm::length(b.hi - b.lo) * rng.uniform();
+        auto drive = [&](const auto& control, bool minorant) {
+            const auto dt = track_delta<absorption::Weight>(medium, control, ray, tmax, lambda, rng, counter);
+            NSP_FUZZ_CHECK(ok(flight_status(dt.end)) && all_finite(dt.weight) && std::isfinite(dt.null_pdf_product));
+            NSP_FUZZ_CHECK(dt.null_pdf_product >= 0.f && dt.null_pdf_product <= 1.f);
+            const auto rt = track_ratio<absorption::Event, true>(medium, control, ray, tmax, lambda, rng, counter);
+            NSP_FUZZ_CHECK(ok(flight_status(rt.end)) && all_finite(rt.transmittance));
+            NSP_FUZZ_CHECK(rt.null_pdf_product >= 0.f && rt.null_pdf_product <= 1.f);
+            if (minorant) NSP_FUZZ_CHECK((rt.transmittance >= 0.f).all());
+            const auto kt = k.track(medium, control, ray, tmax, lambda, rng, counter);
+            NSP_FUZZ_CHECK(ok(flight_status(kt.end)) && all_finite(kt.weight));
+            const auto ks = k.shadow(medium, control, ray, tmax, lambda, rng, counter);
+            NSP_FUZZ_CHECK(ok(ks.status) && all_finite(ks.transmittance) && std::isfinite(ks.null_pdf_product));
+            const auto rr = transmittance_residual_ratio(medium, control, ray, tmax, lambda, rng, counter, 4096);
+            NSP_FUZZ_CHECK(ok(rr.status) && all_finite(rr.value));
+            if (minorant) NSP_FUZZ_CHECK((rr.value >= 0.f).all());
+        };
+        drive(*grid, true);
+        drive(*zero, true);
+        drive(*half, false);
+        const auto rm = transmittance_ray_marching(medium, *gmaj, ray, tmax, lambda, rng, counter);
+        NSP_FUZZ_CHECK(ok(rm.status) && all_finite(rm.value));
+    }
+}
+
 // ---------------------------------------------------------------------------------------------
 
 template <SpectralMode S>
@@ -1164,6 +1224,7 @@ void run(Input& in) {
     run_tracking_any<S>(in, rng, *medium, res, lambda);
     run_estimator_any<S>(in, rng, *medium, b.box, lambda, std::make_index_sequence<std::tuple_size_v<kEstimators>>{});
     run_unusable<S>(in, rng, *medium, res, lambda);
+    run_controls<S>(*medium, res, lambda);
 }
 
 }  // namespace

@@ -14,6 +14,12 @@
 // which scales steps and lookups alike where the medium is uniform, and the variance a majorant
 // changes (none for delta tracking's weights; ratio-tracked NEE varies a little more under tighter
 // bounds): it ranks resolutions, measured against the renders in docs/majorants.md.
+//
+// A control (GridControl, THEORY 5.10) keeps the grid's steps and removes lookups: decomposition
+// and residual ratio tracking draw tentative collisions only for the residual above each cell's
+// minorant, (4 / S_B) sum_c (mu_bar_c - mu_c) V_c per line (a real collision costs one lookup
+// either way). Its cells cost `control_step_cost` per step instead of step_cost: the second
+// float, the control's clock and the residual's rescaling of each lookup.
 #pragma once
 
 #include <algorithm>
@@ -24,6 +30,7 @@
 #include "../core/error.hpp"
 #include "../majorant.hpp"
 #include "../medium.hpp"
+#include "control.hpp"
 #include "grid.hpp"
 
 namespace nsp {
@@ -32,9 +39,14 @@ namespace nsp {
 /// (core/counter.hpp: kDdaStepCost).
 inline constexpr float kDefaultStepCost = kDdaStepCost;
 
+/// A GridControl cell's step cost in density lookups that choose_majorant assumes by default
+/// (docs/transmittance.md measures it).
+inline constexpr float kDefaultControlStepCost = 0.5f;
+
 /// What the cost model expects of a majorant per random line through the medium's bounds.
 struct MajorantCost {
     bool global = false;                 ///< the GlobalMajorant (no grid, no steps)
+    bool control = false;                ///< a GridControl (per-cell minorants beside the grid's bounds)
     std::array<int, 3> resolution{1, 1, 1};  ///< the grid's cells per axis (global: {1, 1, 1})
     double steps = 0.0;                  ///< DDA steps (cells crossed)
     double lookups = 0.0;                ///< tentative collisions, each a density lookup
@@ -89,6 +101,27 @@ MajorantCost grid_majorant_cost(const M& medium, std::array<int, 3> res, float s
     return c;
 }
 
+/// The cost model's steps and lookups per random line for a GridControl of `res` cells over `medium`'s
+/// bounds: the grid's steps at `step_cost` each, and lookups for the residual above the cells'
+/// minorants (see the header). Throws as GridControl does, and on a step_cost that is negative or
+/// not finite.
+template <RegionBoundedMedium M>
+MajorantCost grid_control_cost(const M& medium, std::array<int, 3> res, float step_cost = kDefaultStepCost) {
+    detail::require_step_cost(step_cost);
+    const GridControl<M> grid(medium, res);
+    const Box b = medium.bounds();
+    const double s = detail::box_surface(b);
+    const Vec3 h = grid.cell_size();
+    const double cell_surface = 2.0 * (double(h.x) * h.y + double(h.y) * h.z + double(h.z) * h.x);
+    MajorantCost c;
+    c.control = true;
+    c.resolution = res;
+    c.steps = double(res[0]) * res[1] * res[2] * cell_surface / s;
+    c.lookups = 4.0 * grid.residual_sum() * double(h.x) * h.y * h.z / s;
+    c.cost = c.lookups + double(step_cost) * c.steps;
+    return c;
+}
+
 /// The majorant the cost model prefers for `medium`: the GlobalMajorant, or a GridMajorant of
 /// 2, 4, 8, ... up to max_res cells per axis (as GridMajorant(medium, R) builds it), whichever
 /// costs least per random line (ties to the coarser). Builds each candidate grid once (at 64,
@@ -102,6 +135,26 @@ MajorantCost choose_grid_resolution(const M& medium, int max_res = 64, float ste
     for (int r = 2; r <= max_res; r *= 2) {
         const MajorantCost c = grid_majorant_cost(medium, {r, r, r}, step_cost);
         if (c.cost < best.cost) best = c;
+    }
+    return best;
+}
+
+/// The majorant or control the cost model prefers for `medium`: choose_grid_resolution's pick, or a
+/// GridControl of 2, 4, 8, ... up to max_res cells per axis where the medium bounds its density
+/// from below (LowerBoundedMedium; a medium without that query gets no control) and the control
+/// costs less with its steps at `control_step_cost` (ties to the majorant). The estimators that
+/// take a control are PathEstimator's without equiangular sampling, on media without emission
+/// (THEORY 5.10); the caller decides whether its estimator is one. Throws as choose_grid_resolution.
+template <CellBoundedMedium M>
+MajorantCost choose_majorant(const M& medium, int max_res = 64, float step_cost = kDefaultStepCost,
+                             float control_step_cost = kDefaultControlStepCost) {
+    MajorantCost best = choose_grid_resolution(medium, max_res, step_cost);
+    if constexpr (LowerBoundedMedium<M>) {
+        detail::require_step_cost(control_step_cost);
+        for (int r = 2; r <= max_res; r *= 2) {
+            const MajorantCost c = grid_control_cost(medium, {r, r, r}, control_step_cost);
+            if (c.cost < best.cost) best = c;
+        }
     }
     return best;
 }

@@ -143,7 +143,7 @@ public:
     /// that is not finite, is negative or exceeds the cell's upper bound.
     GridControl(const M& medium, std::array<int, 3> resolution)
         : upper_(medium, resolution, 1.f, "GridControl"), unit_(medium.extinction_per_density()),
-          unit_max_(max_value(unit_)) {
+          unit_max_(max_value(unit_)), unit_min_(min_value(unit_)) {
         const std::array<int, 3> res = upper_.resolution();
         lower_.assign(std::size_t(res[0]) * std::size_t(res[1]) * std::size_t(res[2]), 0.f);
         if constexpr (LowerBoundedMedium<M>) {
@@ -204,6 +204,17 @@ public:
     }
 
     std::array<int, 3> resolution() const noexcept { return upper_.resolution(); }
+    Vec3 cell_size() const noexcept { return upper_.cell_size(); }
+    /// The sum over the cells of the residual majorant that tracking under this control pays
+    /// lookups for: the majorant d_max max_c u_c less the grey control d_min min_c u_c (the
+    /// free-flight loop's, tracking.hpp), per unit volume of a cell (the cost model's, choose.hpp).
+    double residual_sum() const noexcept {
+        double sum = 0.0;
+        const float* up = upper_.data();
+        for (std::size_t i = 0; i < lower_.size(); ++i)
+            sum += double(up[i]) * unit_max_ - double(lower_[i]) * unit_min_;
+        return sum;
+    }
     /// Bytes of cell storage (two floats per cell).
     std::size_t memory_bytes() const noexcept { return upper_.memory_bytes() + lower_.size() * sizeof(float); }
 
@@ -212,6 +223,7 @@ private:
     std::vector<float> lower_;
     typename Spectral::Coefficient unit_;
     float unit_max_;
+    float unit_min_;
 };
 
 }  // namespace nsp
