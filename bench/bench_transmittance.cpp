@@ -39,6 +39,7 @@ void run(benchmark::State& state, F&& estimate) {
     }
     const double n = double(state.iterations());
     state.counters["lookups/estimate"] = double(counter.count()) / (2.0 * n);
+    state.counters["steps/estimate"] = double(counter.steps) / (2.0 * n);
     state.counters["mean"] = sum / n;
     state.counters["variance"] = half_sq / n;
     if (failed > 0) state.SkipWithError("an estimate failed");
@@ -75,10 +76,51 @@ void BM_RayMarching_Grid16(benchmark::State& state) {
     });
 }
 
+// The free-flight loop under a control (THEORY 5.10) against the same loop under the grid majorant
+// of the same cells: residual ratio tracking (transmittance_ratio under a GridControl) and
+// decomposition tracking (transmittance_delta's passing weight), at 16^3 and 64^3. Their time per
+// lookup and step gives the control's step cost that choose_majorant assumes.
+template <int R>
+void BM_Ratio_Grid(benchmark::State& state) {
+    const nsp::GridMajorant<M> maj(cloud(), R);
+    run(state, [&](const nsp::Ray& r, nsp::Pcg32& rng, nsp::LookupCount& c) {
+        return nsp::transmittance_ratio(cloud(), maj, r, kTmax, {}, rng, c);
+    });
+}
+template <int R>
+void BM_Ratio_GridControl(benchmark::State& state) {
+    const nsp::GridControl<M> control(cloud(), R);
+    run(state, [&](const nsp::Ray& r, nsp::Pcg32& rng, nsp::LookupCount& c) {
+        return nsp::transmittance_ratio(cloud(), control, r, kTmax, {}, rng, c);
+    });
+}
+template <int R>
+void BM_Delta_Grid(benchmark::State& state) {
+    const nsp::GridMajorant<M> maj(cloud(), R);
+    run(state, [&](const nsp::Ray& r, nsp::Pcg32& rng, nsp::LookupCount& c) {
+        return nsp::transmittance_delta(cloud(), maj, r, kTmax, {}, rng, c);
+    });
+}
+template <int R>
+void BM_Delta_GridControl(benchmark::State& state) {
+    const nsp::GridControl<M> control(cloud(), R);
+    run(state, [&](const nsp::Ray& r, nsp::Pcg32& rng, nsp::LookupCount& c) {
+        return nsp::transmittance_delta(cloud(), control, r, kTmax, {}, rng, c);
+    });
+}
+
 BENCHMARK(BM_Ratio_Global)->MinTime(kMinTime);
 BENCHMARK(BM_Ratio_Grid16)->MinTime(kMinTime);
 BENCHMARK(BM_ResidualRatio_GridControl16)->MinTime(kMinTime);
 BENCHMARK(BM_RayMarching_Global)->MinTime(kMinTime);
 BENCHMARK(BM_RayMarching_Grid16)->MinTime(kMinTime);
+
+BENCHMARK(BM_Ratio_Grid<64>)->MinTime(kMinTime);
+BENCHMARK(BM_Ratio_GridControl<16>)->MinTime(kMinTime);
+BENCHMARK(BM_Ratio_GridControl<64>)->MinTime(kMinTime);
+BENCHMARK(BM_Delta_Grid<16>)->MinTime(kMinTime);
+BENCHMARK(BM_Delta_Grid<64>)->MinTime(kMinTime);
+BENCHMARK(BM_Delta_GridControl<16>)->MinTime(kMinTime);
+BENCHMARK(BM_Delta_GridControl<64>)->MinTime(kMinTime);
 
 }  // namespace

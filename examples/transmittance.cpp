@@ -225,6 +225,20 @@ int run(int argc, char** argv) {
                         r.ltuv(), best > 0.0 ? (std::to_string(r.ltuv() / best).substr(0, 5) + "x").c_str() : "-");
         }
     }
+    // The cost model's pick per medium (choose_majorant: choose_grid_resolution's majorants and the
+    // grid controls, lookups + step cost x steps per random line through the box).
+    std::printf("\n## The cost model's pick (choose_majorant; per random line: lookups + %.2f x steps, a control's "
+                "steps at %.2f)\n\n| medium | pick | lookups | steps | cost | best grid alone |\n|---|---|---|---|---|---|\n",
+                double(kDefaultStepCost), double(kDefaultControlStepCost));
+    for (const auto& [name, medium] : media) {
+        const MajorantCost pick = choose_majorant(medium);
+        const MajorantCost plain = choose_grid_resolution(medium);
+        const auto label = [](const MajorantCost& c) {
+            return c.global ? std::string("global") : (c.control ? "grid control " : "grid ") + std::to_string(c.resolution[0]) + "^3";
+        };
+        std::printf("| %s | %s | %.3g | %.3g | %.3g | %s, cost %.3g |\n", name, label(pick).c_str(), pick.lookups, pick.steps,
+                    pick.cost, label(plain).c_str(), plain.cost);
+    }
     return bad ? kExitRuntime : kExitOk;
 }
 

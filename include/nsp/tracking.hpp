@@ -339,20 +339,6 @@ FlightEnd<MajorantValue<Maj, M>> free_flight(const M& medium, const Maj& majoran
     float e = -1.f;
     [[maybe_unused]] double tau_ctl = 0.0;  // the control's optical depth so far (ControlUse)
     [[maybe_unused]] float e_ctl = -1.f;    // the control depth left to the next control collision (Collide)
-    // The lookup at t with the bound policy applied: false where bound::Reject ends the flight.
-    auto look_up = [&](float t, const auto& maj, Coefficients<typename M::Spectral>& coeff) {
-        counter.lookup();
-        coeff = medium.coefficients(ray.at(t), lambda);
-        NSP_DEBUG_ASSERT((coeff.sigma_a >= 0.f).all() && (coeff.sigma_s >= 0.f).all() &&
-                             all_finite(coeff.sigma_a) && all_finite(coeff.sigma_s),
-                         "the medium returned a negative or non-finite coefficient");
-        if constexpr (std::is_same_v<B, bound::Clamp>) {
-            detail::clamp_to_majorant(coeff, maj);
-        } else if constexpr (std::is_same_v<B, bound::Reject>) {
-            if (detail::exceeds_majorant(coeff, maj)) return false;
-        }
-        return true;
-    };
     while (auto seg = segments.next()) {
         float mu_bar = channel_of(seg->sigma_maj, channel);
         [[maybe_unused]] float ctl = 0.f;
@@ -410,43 +396,51 @@ FlightEnd<MajorantValue<Maj, M>> free_flight(const M& medium, const Maj& majoran
                 break;
             }
             t += dt;
-            if (++collisions > max_collisions) return {false, true, false, t, V{}};
-            Coefficients<typename M::Spectral> coeff;
-            if (!look_up(t, seg->sigma_maj, coeff)) return {false, true, true, t, V{}};
-            float rate = mu_bar;  // the callback's majorant
+            [[maybe_unused]] float rate = mu_bar;  // the callback's majorant under a control
             if constexpr (collide) {
                 tau += (mu_bar + ctl) * dt;
                 tau_ctl += double(ctl) * double(dt);
                 if (control_first) {  // a control collision: real (THEORY 5.10)
                     if (mu_bar > 0.f && e > 0.f) e -= mu_bar * dt;
                     e_ctl = -1.f;
-                    detail::to_control(coeff, ctl);
                     rate = ctl;
                 } else {
                     if (ctl > 0.f && e_ctl > 0.f) e_ctl -= ctl * dt;
                     e = -1.f;
-                    detail::to_residual(coeff, ctl, mu_bar);
                 }
             } else {
                 if constexpr (grey) tau += e;
                 else add_depth(seg->sigma_maj, dt);
                 e = -1.f;
-                if constexpr (residual) detail::to_residual(coeff, ctl, mu_bar);
+            }
+            if (++collisions > max_collisions) return {false, true, false, t, V{}};
+            counter.lookup();
+            auto coeff = medium.coefficients(ray.at(t), lambda);
+            NSP_DEBUG_ASSERT((coeff.sigma_a >= 0.f).all() && (coeff.sigma_s >= 0.f).all() &&
+                                 all_finite(coeff.sigma_a) && all_finite(coeff.sigma_s),
+                             "the medium returned a negative or non-finite coefficient");
+            if constexpr (std::is_same_v<B, bound::Clamp>) {
+                detail::clamp_to_majorant(coeff, seg->sigma_maj);
+            } else if constexpr (std::is_same_v<B, bound::Reject>) {
+                if (detail::exceeds_majorant(coeff, seg->sigma_maj)) return {false, true, true, t, V{}};
+            }
+            if constexpr (collide) {
+                if (control_first) detail::to_control(coeff, ctl);
+                else detail::to_residual(coeff, ctl, mu_bar);
+            } else if constexpr (residual) {
+                detail::to_residual(coeff, ctl, mu_bar);
             }
             const V tau_step = tau;
             if constexpr (grey) tau = 0.f;
             else tau.setZero();
-            bool go_on;
-            if constexpr (residual) go_on = on_collision(t, coeff, rate, tau_step);
-            else go_on = on_collision(t, coeff, seg->sigma_maj, tau_step);
-            if (!go_on) {
-                if constexpr (residual) {
+            if constexpr (residual) {
+                if (!on_collision(t, coeff, rate, tau_step)) {
                     FlightEnd<V> end{true, false, false, t, 0.f};
                     end.tau_ctl = tau_ctl;
                     return end;
-                } else {
-                    return {true, false, false, t, V{}};
                 }
+            } else if (!on_collision(t, coeff, seg->sigma_maj, tau_step)) {
+                return {true, false, false, t, V{}};
             }
         }
     }

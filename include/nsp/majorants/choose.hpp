@@ -39,9 +39,10 @@ namespace nsp {
 /// (core/counter.hpp: kDdaStepCost).
 inline constexpr float kDefaultStepCost = kDdaStepCost;
 
-/// A GridControl cell's step cost in density lookups that choose_majorant assumes by default
-/// (docs/transmittance.md measures it).
-inline constexpr float kDefaultControlStepCost = 0.5f;
+/// A GridControl cell's step cost in density lookups that choose_majorant assumes by default:
+/// measured 0.31 against the grid's 0.3 (residual ratio and decomposition tracking through the
+/// cloud at 16^3 and 64^3, docs/transmittance.md), rounded up.
+inline constexpr float kDefaultControlStepCost = 0.32f;
 
 /// What the cost model expects of a majorant per random line through the medium's bounds.
 struct MajorantCost {
@@ -141,16 +142,22 @@ MajorantCost choose_grid_resolution(const M& medium, int max_res = 64, float ste
 
 /// The majorant or control the cost model prefers for `medium`: choose_grid_resolution's pick, or a
 /// GridControl of 2, 4, 8, ... up to max_res cells per axis where the medium bounds its density
-/// from below (LowerBoundedMedium; a medium without that query gets no control) and the control
-/// costs less with its steps at `control_step_cost` (ties to the majorant). The estimators that
-/// take a control are PathEstimator's without equiangular sampling, on media without emission
-/// (THEORY 5.10); the caller decides whether its estimator is one. Throws as choose_grid_resolution.
+/// from below (LowerBoundedMedium; a medium without that query gets no control), its extinction per
+/// unit density is grey (the same in every channel and wavelength), and the control costs less
+/// with its steps at `control_step_cost` (ties to the majorant). A chromatic medium gets no
+/// control: the loop's control is grey (the smallest channel's), the denser channels' residual
+/// nulls then weigh far from 1, and the variance that costs (2-7x on the chromatic cloud at 16^3,
+/// docs/transmittance.md) is not in a model of lookups. The estimators that take a control are
+/// PathEstimator's without equiangular sampling, on media without emission (THEORY 5.10); the
+/// caller decides whether its estimator is one. Throws as choose_grid_resolution.
 template <CellBoundedMedium M>
 MajorantCost choose_majorant(const M& medium, int max_res = 64, float step_cost = kDefaultStepCost,
                              float control_step_cost = kDefaultControlStepCost) {
     MajorantCost best = choose_grid_resolution(medium, max_res, step_cost);
     if constexpr (LowerBoundedMedium<M>) {
         detail::require_step_cost(control_step_cost);
+        const auto unit = medium.extinction_per_density();
+        if (min_value(unit) != max_value(unit)) return best;
         for (int r = 2; r <= max_res; r *= 2) {
             const MajorantCost c = grid_control_cost(medium, {r, r, r}, control_step_cost);
             if (c.cost < best.cost) best = c;
