@@ -237,6 +237,7 @@ template <class M>
 int render(const M& medium, const VolumeOptions& o, const char* mode, const char* scene) {
     std::string label = o.compare ? "majorants compared, uni-nee-mis balance"
                         : o.majorant == "grid" ? "grid " + std::to_string(o.grid_res) + "^3 majorant"
+                        : o.majorant == "grid-control" ? "grid " + std::to_string(o.grid_res) + "^3 majorant and control"
                                                : o.majorant + " majorant";
     if (o.compare && o.runs > 1) label += ", median of " + std::to_string(o.runs) + " runs per row";
     std::printf("Volume (%s, %dx%d, %d spp, %d threads, %s): %s\n", mode, o.res, o.res, o.spp, o.threads, label.c_str(),
@@ -244,6 +245,13 @@ int render(const M& medium, const VolumeOptions& o, const char* mode, const char
     std::uint64_t failed = 0;
     if (o.compare) failed = compare_majorants(medium, o);
     else if (o.majorant == "grid") failed = run_strategies(medium, nsp::GridMajorant<M>(medium, o.grid_res), o);
+    else if (o.majorant == "grid-control") {
+        // Decomposition tracking (THEORY 5.10): PathEstimator takes a control on media without emission.
+        if constexpr (nsp::LowerBoundedMedium<M> && !nsp::EmissiveMedium<M>)
+            failed = run_strategies(medium, nsp::GridControl<M>(medium, o.grid_res), o);
+        else
+            throw nsp_examples::UsageError("--majorant grid-control takes a medium without emission (not --temperature)");
+    }
     else if (o.majorant == "tree") failed = run_strategies(medium, tree_majorant(medium, o), o);
     else if (o.majorant == "tree-nodes") failed = run_strategies(medium, tree_majorant(medium, o, true), o);
     else failed = run_strategies(medium, nsp::GlobalMajorant<M>(medium), o);

@@ -39,8 +39,9 @@ VolumeOptions parse_volume_flags(int argc, char** argv) {
     app.add_option("--albedo", o.albedo, "single-scattering albedo (grey)")->check(real_in(0.0, 1.0));
     app.add_option("--g", o.g, "Henyey-Greenstein asymmetry")->check(real_in(-0.99, 0.99));
     app.add_option("--majorant", o.majorant,
-                   "global (one value), grid (a grid of cell maxima), tree (adaptive, hierarchical) or tree-nodes (on a VDB grid's nodes)")
-        ->check(CLI::IsMember({"global", "grid", "tree", "tree-nodes"}));
+                   "global (one value), grid (a grid of cell maxima), grid-control (the grid with each cell's minimum beside it: "
+                   "decomposition tracking), tree (adaptive, hierarchical) or tree-nodes (on a VDB grid's nodes)")
+        ->check(CLI::IsMember({"global", "grid", "grid-control", "tree", "tree-nodes"}));
     app.add_option("--grid-res", o.grid_res, "cells per axis of the grid majorant")->check(integer_in(1, 256));
     app.add_option("--tree-split", o.tree_split, "cells of the tree majorant per leaf (8 voxels) and axis")
         ->check(CLI::IsMember({1, 2, 4, 8}));

@@ -23,13 +23,7 @@ constexpr int kSamples = 20000;
 
 template <SpectralMode S>
 void check_mean(const SpecStat<S>& stat, const typename S::Spectrum& expected, const std::string& label) {
-    for (int c = 0; c < S::channels; ++c) {
-        const Stat& s = stat.ch[std::size_t(c)];
-        CAPTURE(label);
-        CAPTURE(c);
-        MESSAGE(label << " channel " << c << ": " << s.mean << " (SE " << s.se() << "), closed form " << expected[c]);
-        CHECK(std::abs(s.mean - double(expected[c])) <= kSigmas * s.se() + kRoundingFloor);
-    }
+    check_channel_means(stat, expected, label, kSigmas);
 }
 
 /// n estimates of `estimate(rng, counter)` (a TransmittanceSample), every one Ok: their statistics and lookups.

@@ -54,6 +54,18 @@ struct EventProbabilities {
 };
 
 namespace detail {
+/// The coefficient that drives a real event's probability: the channel mean of |mu_x,c|. A
+/// medium's mu_a and mu_s are >= 0 and this is their mean; a residual under a control above the
+/// density is negative (THEORY 5.10), and its real events are then drawn by |mu_x| and weighed
+/// mu_x / (mu_bar P_x), negative, as bound::Signed weighs negative nulls; clamped at 0 they would
+/// be lost, and decomposition tracking's control collisions would carry the whole control. The
+/// mean of |.|, not |mean|: channels of both signs must not cancel.
+template <class Spec>
+float event_coefficient(const Spec& sigma) noexcept {
+    if constexpr (Spec::SizeAtCompileTime == 1) return std::abs(sigma[0]);
+    else return sampling_scalar(Spec(sigma.abs()));
+}
+
 /// The null coefficient that drives delta tracking's null probability: the channel mean of
 /// |mu_bar - mu_t,c|, which is mu_bar - mean(mu_t) wherever the majorant bounds every channel.
 /// Not |mu_bar - mean(mu_t)|: under bound::Signed on a chromatic medium that is 0 where the
@@ -62,18 +74,6 @@ namespace detail {
 /// mu_bar - (a + s) everywhere, so event_probabilities and null_probability agree on whether it is
 /// 0 (where they differed, a null was chosen with P_n > 0 in float and weighed with P_n = 0: NaN;
 /// found by the fuzzer).
-/// The coefficient that drives a real event's probability: the channel mean of |mu_x,c|. A
-/// medium's mu_a and mu_s are >= 0 and this is their mean; a residual under a control above the
-/// density is negative (THEORY 5.10), and its real events are then drawn by |mu_x| and weighed
-/// mu_x / (mu_bar P_x), negative, as bound::Signed weighs negative nulls: drawn with probability
-/// 0 they were lost (decomposition tracking's control collisions would have carried the whole
-/// control). The mean of |.|, not |mean|: channels of both signs must not cancel.
-template <class Spec>
-float event_coefficient(const Spec& sigma) noexcept {
-    if constexpr (Spec::SizeAtCompileTime == 1) return std::abs(sigma[0]);
-    else return sampling_scalar(Spec(sigma.abs()));
-}
-
 template <SpectralMode S>
 float null_coefficient(const Coefficients<S>& c, float mu_bar) noexcept {
     if constexpr (S::channels == 1) return std::abs(mu_bar - (c.sigma_a[0] + c.sigma_s[0]));

@@ -177,6 +177,20 @@ struct SpecStat {
 /// estimate is ~1e-6 relative, so 1e-5 absolute is far below any bias a test looks for.
 inline constexpr double kRoundingFloor = 1e-5;
 
+/// Checks every channel's mean in `stat` against `expected` within `sigmas` standard errors of the
+/// mean (estimated from the samples) plus kRoundingFloor, with a message naming `label`.
+template <SpectralMode S>
+void check_channel_means(const SpecStat<S>& stat, const typename S::Spectrum& expected, const std::string& label,
+                         double sigmas) {
+    for (int c = 0; c < S::channels; ++c) {
+        const Stat& s = stat.ch[std::size_t(c)];
+        CAPTURE(label);
+        CAPTURE(c);
+        MESSAGE(label << " channel " << c << ": " << s.mean << " (SE " << s.se() << "), closed form " << expected[c]);
+        CHECK(std::abs(s.mean - double(expected[c])) <= sigmas * s.se() + kRoundingFloor);
+    }
+}
+
 /// Pearson's chi-square statistic of `counts` against bin probabilities `prob` (summing to 1)
 /// for `n` samples. Checks that every expected count is at least 5 (the usual validity rule).
 inline double chi_square(const std::vector<double>& counts, const std::vector<double>& prob, double n) {

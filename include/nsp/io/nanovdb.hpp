@@ -22,6 +22,7 @@
 #include <cmath>
 #include <cstdint>
 #include <iostream>  // NanoVDB's GridValidator.h uses std::cerr without including it
+#include <limits>
 #include <memory>
 #include <string>
 #include <utility>
@@ -180,6 +181,46 @@ public:
         return m;
     }
 
+    /// The smallest density a lookup can return in world region `region` (LowerBoundedMedium,
+    /// majorants/control.hpp): the smallest voxel value among those the trilinear lookups there read
+    /// (found as density_bound finds the largest: tiles, whole leaves by their minimum, cut leaves
+    /// voxel by voxel), less 2^-20 of it for the interpolation's rounding; 0 where the lookups read
+    /// past the non-zero values' box (the ramp down to the background).
+    float density_lower_bound(const Box& region) const noexcept {
+        int lo[3], hi[3];
+        for (int a = 0; a < 3; ++a) {
+            const double x0 = (double(region.lo[a]) - t_[a]) / s_[a] - 1e-3, x1 = (double(region.hi[a]) - t_[a]) / s_[a] + 1e-3;
+            const double l = std::floor(x0), h = std::floor(x1) + 1.0;
+            if (!(l >= double(nz_lo_[a]) && h <= double(nz_hi_[a]))) return 0.f;  // NaN too
+            lo[a] = int(l);
+            hi[a] = int(h);
+        }
+        const auto acc = grid_->getAccessor();
+        const auto* first = grid_->tree().getFirstLeaf();
+        float m = std::numeric_limits<float>::infinity();
+        for (int bz = lo[2] & ~7; bz <= hi[2] && m > 0.f; bz += 8)
+            for (int by = lo[1] & ~7; by <= hi[1]; by += 8)
+                for (int bx = lo[0] & ~7; bx <= hi[0]; bx += 8) {
+                    const nanovdb::Coord block(bx, by, bz);
+                    const auto* leaf = acc.probeLeaf(block);
+                    if (!leaf) {  // a tile (or the background): one value over the block
+                        m = std::min(m, acc.getValue(block));
+                        continue;
+                    }
+                    const bool inside = bx >= lo[0] && by >= lo[1] && bz >= lo[2] && bx + 7 <= hi[0] && by + 7 <= hi[1] &&
+                                        bz + 7 <= hi[2];
+                    if (inside) {
+                        m = std::min(m, leaf_min_[std::size_t(leaf - first)]);
+                        continue;
+                    }
+                    for (int z = std::max(bz, lo[2]); z <= std::min(bz + 7, hi[2]); ++z)
+                        for (int y = std::max(by, lo[1]); y <= std::min(by + 7, hi[1]); ++y)
+                            for (int x = std::max(bx, lo[0]); x <= std::min(bx + 7, hi[0]); ++x)
+                                m = std::min(m, leaf->getValue(nanovdb::Coord(x, y, z)));
+                }
+        return m > 0.f && m < std::numeric_limits<float>::infinity() ? m * (1.f - 0x1p-20f) : 0.f;
+    }
+
     /// The world box outside which the density is 0: the non-zero values' index box widened by
     /// one voxel (the trilinear ramp down to the background), mapped to world space.
     Box bounds() const noexcept { return bounds_; }
@@ -279,17 +320,20 @@ private:
         };
         const std::uint32_t leaves = tree.nodeCount(0);
         leaf_max_.assign(leaves, 0.f);
+        leaf_min_.assign(leaves, 0.f);
         for (std::uint32_t i = 0; i < leaves; ++i) {
             const auto& leaf = tree.getFirstLeaf()[i];
             check_origin(leaf.origin(), "leaf");
-            float m = 0.f;
+            float m = 0.f, low = std::numeric_limits<float>::infinity();
             for (std::uint32_t n = 0; n < 512; ++n) {
                 const float v = leaf.getValue(n);
                 check(v, leaf.offsetToGlobalCoord(n), "voxel");
                 if (v > 0.f) extend(leaf.offsetToGlobalCoord(n), 1);
                 m = std::max(m, v);
+                low = std::min(low, v);
             }
             leaf_max_[i] = m;
+            leaf_min_[i] = low;
             max_ = std::max(max_, m);
         }
         auto tiles = [&](const auto* nodes, std::uint32_t count, std::uint32_t size, int dim, const char* kind, const char* node,
@@ -352,6 +396,7 @@ private:
     Box bounds_;
     float max_ = 0.f;
     std::vector<float> leaf_max_;
+    std::vector<float> leaf_min_;  ///< each leaf's smallest voxel value (density_lower_bound)
 };
 
 /// A NanoVDB fog volume as a medium: mu_a(p) = density(p) sigma_a_scale, mu_s(p) = density(p)
@@ -390,6 +435,7 @@ public:
     Coefficient extinction_bound_coefficient() const { return scale<Coefficient>(sigma_a_ + sigma_s_, grid_->max_density()); }
     Coefficient extinction_per_density() const { return sigma_a_ + sigma_s_; }
     float density_bound(const Box& region) const noexcept { return grid_->density_bound(region); }
+    float density_lower_bound(const Box& region) const noexcept { return grid_->density_lower_bound(region); }
     TreeLayout tree_layout(int leaf_split = 1) const noexcept { return grid_->tree_layout(leaf_split); }
     const NanoDensityGrid& grid() const noexcept { return *grid_; }
 

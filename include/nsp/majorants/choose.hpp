@@ -62,6 +62,19 @@ inline void require_step_cost(float step_cost) {
              " is not allowed: it must be finite and >= 0 (a DDA step's cost in density lookups)");
 }
 
+/// The cost model's line through a grid of `res` cells of size `h` over box `b` whose cells' (residual)
+/// majorants sum to `mu_sum`: steps sum_c S_c / S_B, lookups (4 / S_B) sum_c mu_c V_c (see the header).
+inline MajorantCost grid_line_cost(const Box& b, std::array<int, 3> res, const Vec3& h, double mu_sum, float step_cost) {
+    const double s = box_surface(b);
+    const double cell_surface = 2.0 * (double(h.x) * h.y + double(h.y) * h.z + double(h.z) * h.x);
+    MajorantCost c;
+    c.resolution = res;
+    c.steps = double(res[0]) * res[1] * res[2] * cell_surface / s;
+    c.lookups = 4.0 * mu_sum * (double(h.x) * h.y * h.z) / s;
+    c.cost = c.lookups + double(step_cost) * c.steps;
+    return c;
+}
+
 }  // namespace detail
 
 /// The cost model's steps and lookups per random line for the GlobalMajorant of `medium`.
@@ -85,21 +98,11 @@ template <CellBoundedMedium M>
 MajorantCost grid_majorant_cost(const M& medium, std::array<int, 3> res, float step_cost = kDefaultStepCost) {
     detail::require_step_cost(step_cost);
     const GridMajorant<M> grid(medium, res);
-    const Box b = medium.bounds();
-    const double s = detail::box_surface(b);
-    const Vec3 h = grid.cell_size();
-    const double cell_surface = 2.0 * (double(h.x) * h.y + double(h.y) * h.z + double(h.z) * h.x);
-    const double cell_volume = double(h.x) * h.y * h.z;
-    double mu_volume = 0.0;
+    double mu_sum = 0.0;
     for (int z = 0; z < res[2]; ++z)
         for (int y = 0; y < res[1]; ++y)
-            for (int x = 0; x < res[0]; ++x) mu_volume += double(grid.cell(x, y, z));
-    MajorantCost c;
-    c.resolution = res;
-    c.steps = double(res[0]) * res[1] * res[2] * cell_surface / s;
-    c.lookups = 4.0 * mu_volume * cell_volume / s;
-    c.cost = c.lookups + double(step_cost) * c.steps;
-    return c;
+            for (int x = 0; x < res[0]; ++x) mu_sum += double(grid.cell(x, y, z));
+    return detail::grid_line_cost(medium.bounds(), res, grid.cell_size(), mu_sum, step_cost);
 }
 
 /// The cost model's steps and lookups per random line for a GridControl of `res` cells over `medium`'s
@@ -110,16 +113,8 @@ template <RegionBoundedMedium M>
 MajorantCost grid_control_cost(const M& medium, std::array<int, 3> res, float step_cost = kDefaultStepCost) {
     detail::require_step_cost(step_cost);
     const GridControl<M> grid(medium, res);
-    const Box b = medium.bounds();
-    const double s = detail::box_surface(b);
-    const Vec3 h = grid.cell_size();
-    const double cell_surface = 2.0 * (double(h.x) * h.y + double(h.y) * h.z + double(h.z) * h.x);
-    MajorantCost c;
+    MajorantCost c = detail::grid_line_cost(medium.bounds(), res, grid.cell_size(), grid.residual_sum(), step_cost);
     c.control = true;
-    c.resolution = res;
-    c.steps = double(res[0]) * res[1] * res[2] * cell_surface / s;
-    c.lookups = 4.0 * grid.residual_sum() * double(h.x) * h.y * h.z / s;
-    c.cost = c.lookups + double(step_cost) * c.steps;
     return c;
 }
 
