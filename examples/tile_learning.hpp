@@ -52,20 +52,20 @@ void pilot_tiles(nsp::TileCounts& plan, bool halves, Pool&& run_pool, PilotPixel
     auto work = [&](Out& out) {
         for (int j; (j = next_slot.fetch_add(1)) < nsp::TileCounts::kSlots;)
             for (const int tile : plan.slot_tiles(j)) {
-                std::array<nsp::NeeCountLearner, 2> half{plan.learner(), plan.learner()};
+                std::array<nsp::NeeCountLearner, 2> by_half{plan.learner(), plan.learner()};  // not `half`: OpenEXR's type
                 const nsp::TileCounts::Rect r = plan.tile_rect(tile);
                 for (int y = r.y0; y < r.y1; ++y)
                     for (int x = r.x0; x < r.x1; ++x) {
-                        nsp::NeeCountLearner& learner = half[std::size_t((x + y) & 1)];
+                        nsp::NeeCountLearner& learner = by_half[std::size_t((x + y) & 1)];
                         pilot_pixel(out, learner, x, y);
                         learner.end_pixel();
                     }
-                for (const nsp::NeeCountLearner& l : half) add_work(out, l);
+                for (const nsp::NeeCountLearner& l : by_half) add_work(out, l);
                 if (halves) {
-                    plan.add(tile, half[0], half[1]);
+                    plan.add(tile, by_half[0], by_half[1]);
                 } else {
-                    half[0].merge(half[1]);
-                    plan.add(tile, half[0]);
+                    by_half[0].merge(by_half[1]);
+                    plan.add(tile, by_half[0]);
                 }
             }
     };

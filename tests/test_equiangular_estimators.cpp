@@ -48,14 +48,13 @@ TEST_CASE_TEMPLATE_DEFINE("equiangular strategies: single scattering from a poin
     using S = typename C::Spectral;
     using M = typename C::Medium;
     using A = typename C::Absorption;
-    const Box box{Vec3(-1.f), Vec3(1.f)};
-    // Optical thickness about 1 across the box, chromatic (Rgb channels differ 3x).
-    const M medium = make_medium<M>(box, 0.5f, spec<S>(0.2f, 0.1f, 0.4f), spec<S>(0.8f, 0.4f, 1.2f));
-    const Vec3 light(0.2f, 0.25f, -0.1f);  // inside the medium, 0.3 from the camera ray
-    Lights<S> lights;
-    lights.set(PointLight<S>{light, grey<S>(2.f)});
-    const Ray ray{Vec3(-3.f, 0.05f, -0.05f), glm::normalize(Vec3(1.f, 0.01f, -0.02f))};
-    const auto ref = single_scatter_reference(medium, ray, light, 2.f);
+    // Optical thickness about 1 across the box, chromatic (Rgb channels differ 3x); the light inside
+    // the medium, 0.3 from the camera ray.
+    const PointLightSingleScatter<M> setup;
+    const M& medium = setup.medium;
+    const auto& lights = setup.lights;
+    const Ray ray = setup.ray;
+    const auto& ref = setup.ref;
     EstimatorOptions opts;
     opts.max_depth = 1;
 

@@ -261,13 +261,11 @@ TEST_CASE_TEMPLATE("ray-marched shadow rays: NEE single scattering from a point 
     // against the quadrature of the closed-form integrand (exponential medium, optical thickness
     // about 1). The lookups differ from ratio tracking's: the option took effect.
     using M = ExponentialMedium<S>;
-    const Box box{Vec3(-1.f), Vec3(1.f)};
-    const M medium = make_medium<M>(box, 0.5f, spec<S>(0.2f, 0.1f, 0.4f), spec<S>(0.8f, 0.4f, 1.2f));
-    const Vec3 light(0.2f, 0.25f, -0.1f);
-    Lights<S> lights;
-    lights.set(PointLight<S>{light, grey<S>(2.f)});
-    const Ray ray{Vec3(-3.f, 0.05f, -0.05f), glm::normalize(Vec3(1.f, 0.01f, -0.02f))};
-    const auto ref = single_scatter_reference(medium, ray, light, 2.f);
+    const PointLightSingleScatter<M> setup;
+    const M& medium = setup.medium;
+    const auto& lights = setup.lights;
+    const Ray ray = setup.ray;
+    const auto& ref = setup.ref;
     EstimatorOptions ratio, marched;
     ratio.max_depth = marched.max_depth = 1;
     marched.shadow_estimator = ShadowEstimator::RayMarching;

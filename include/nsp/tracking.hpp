@@ -236,7 +236,9 @@ void to_residual(Coefficients<S>& k, float ctl, float rate) noexcept {
     if (!(ctl > 0.f)) return;  // no control here: the lookup as it is (a control of 0 is today's tracker, bit for bit)
     const Spec t = k.sigma_t();
     const Spec r = t - ctl;
-    k.sigma_s = (t > 0.f).select(k.sigma_s * (r / t), 0.f);
+    // r times the albedo s / t (in [0, 1]), not s times r / t: under a control far above a
+    // subnormal extinction r / t overflowed and made the probabilities NaN (found by the fuzzer).
+    k.sigma_s = (t > 0.f).select(r * (k.sigma_s / t), 0.f);
     k.sigma_a = r - k.sigma_s;
     const Spec over = k.sigma_t() - rate;
     if ((over > 0.f).any()) [[unlikely]]
@@ -249,7 +251,7 @@ template <SpectralMode S>
 void to_control(Coefficients<S>& k, float ctl) noexcept {
     using Spec = typename S::Spectrum;
     const Spec t = k.sigma_t();
-    k.sigma_s = (t > 0.f).select(k.sigma_s * (ctl / t), 0.f).min(ctl);
+    k.sigma_s = (t > 0.f).select(ctl * (k.sigma_s / t), 0.f).min(ctl);  // the albedo first, as to_residual
     k.sigma_a = ctl - k.sigma_s;
 }
 

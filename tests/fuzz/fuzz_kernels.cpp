@@ -1148,8 +1148,8 @@ void run_unusable(Input& in, FuzzRng& rng, const M& medium, const std::array<int
 /// the medium is thin: negative residuals). Decomposition tracking (track_delta, VertexKernels::track),
 /// residual ratio tracking (track_ratio, VertexKernels::shadow, transmittance_residual_ratio) and
 /// ray marching under the grid majorant: statuses Ok, Aborted or NonFinite, estimates and null
-/// products finite, null products in [0, 1] and transmittances >= 0 under the grid control (a
-/// minorant: no negative residual). Skipped past the work budget, as the majorant cases are.
+/// products finite, null products in [0, 1] and transmittances >= 0 up to rounding under the grid
+/// control (a minorant: no negative residual). Skipped past the work budget, as the majorant cases are.
 template <SpectralMode S, class M, class Lambda>
 void run_controls(const M& medium, const std::array<int, 3>& res, const Lambda& lambda) {
     g_context = "controls";
@@ -1166,7 +1166,8 @@ void run_controls(const M& medium, const std::array<int, 3>& res, const Lambda& 
     } catch (const InvalidArgument&) {
         return;
     }
-    Pcg32 rng(std::uint64_t(res[0]) * 131u + std::uint64_t(res[1]) * 17u + std::uint64_t(res[2]), 11);
+    const std::uint64_t seed = std::uint64_t(res[0]) * 131u + std::uint64_t(res[1]) * 17u + std::uint64_t(res[2]);
+    Pcg32 rng(seed, 11);
     LookupCount counter;
     const VertexKernels<strategy::NullScatteringMis, mis::Balance> k;
     auto ok = [](Status st) { return st == Status::Ok || st == Status::Aborted || st == Status::NonFinite; };
@@ -1176,21 +1177,33 @@ void run_controls(const M& medium, const std::array<int, 3>& res, const Lambda& 
         const Vec3 p = b.lo + Vec3(rng.uniform(), rng.uniform(), rng.uniform()) * (b.hi - b.lo);
         const Ray ray{p - 2.f * glm::length(b.hi - b.lo) * d, d};
         const float tmax = i % 2 ? kInf : 2.f * glm::length(b.hi - b.lo) * rng.uniform();
-        auto drive = [&](const auto& control, bool minorant) {
+        // Under a minorant every factor (R - r) / R lies in [0, 1] up to rounding (the control sits
+        // 2^-20 below the density); a product of them is then >= -2e-5, the rounding-sized negative
+        // null ratio tracking has (drive_grey; clang found -6e-8 under a control of 0). Where a
+        // segment's majorant is below 1e-30 its residual majorant (>= 2^-20 of it) may be
+        // subnormal and rounded to the 2^-149 grid: no sign is checked there.
+        auto normal = [&](const auto& control) {
+            auto it = control.iterate(ray, 0.f, tmax, lambda);
+            while (auto s = it.next())
+                if (s->sigma_maj > 0.f && s->sigma_maj < 1e-30f) return false;
+            return true;
+        };
+        auto drive = [&](const auto& control, bool minorant_arg) {
+            const bool minorant = minorant_arg && normal(control);
             const auto dt = track_delta<absorption::Weight>(medium, control, ray, tmax, lambda, rng, counter);
             NSP_FUZZ_CHECK(ok(flight_status(dt.end)) && all_finite(dt.weight) && std::isfinite(dt.null_pdf_product));
             NSP_FUZZ_CHECK(dt.null_pdf_product >= 0.f && dt.null_pdf_product <= 1.f);
             const auto rt = track_ratio<absorption::Event, true>(medium, control, ray, tmax, lambda, rng, counter);
             NSP_FUZZ_CHECK(ok(flight_status(rt.end)) && all_finite(rt.transmittance));
             NSP_FUZZ_CHECK(rt.null_pdf_product >= 0.f && rt.null_pdf_product <= 1.f);
-            if (minorant) NSP_FUZZ_CHECK((rt.transmittance >= 0.f).all());
+            if (minorant) NSP_FUZZ_CHECK((rt.transmittance >= -2e-5f).all());
             const auto kt = k.track(medium, control, ray, tmax, lambda, rng, counter);
             NSP_FUZZ_CHECK(ok(flight_status(kt.end)) && all_finite(kt.weight));
             const auto ks = k.shadow(medium, control, ray, tmax, lambda, rng, counter);
             NSP_FUZZ_CHECK(ok(ks.status) && all_finite(ks.transmittance) && std::isfinite(ks.null_pdf_product));
             const auto rr = transmittance_residual_ratio(medium, control, ray, tmax, lambda, rng, counter, 4096);
             NSP_FUZZ_CHECK(ok(rr.status) && all_finite(rr.value));
-            if (minorant) NSP_FUZZ_CHECK((rr.value >= 0.f).all());
+            if (minorant) NSP_FUZZ_CHECK((rr.value >= -2e-5f).all());
         };
         drive(*grid, true);
         drive(*zero, true);

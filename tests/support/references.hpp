@@ -64,4 +64,23 @@ inline std::array<double, 3> emitting_absorber_reference(const Base& base, const
     return ref;
 }
 
+/// The single-scattering set-up of the quadrature tests: medium M over [-1, 1]^3 at density 0.5
+/// with per-unit-density mu_a (0.2, 0.1, 0.4) and mu_s (0.8, 0.4, 1.2) (optical thickness about 1
+/// across the box, channels 3x apart in Rgb), an isotropic point light of intensity 2 inside it, 0.3
+/// from the camera ray, and the quadrature of the single scattering along that ray.
+template <class M>
+struct PointLightSingleScatter {
+    using S = typename M::Spectral;
+    Box box{Vec3(-1.f), Vec3(1.f)};
+    M medium = make_medium<M>(box, 0.5f, spec<S>(0.2f, 0.1f, 0.4f), spec<S>(0.8f, 0.4f, 1.2f));
+    Vec3 light{0.2f, 0.25f, -0.1f};
+    Lights<S> lights = [this] {
+        Lights<S> l;
+        l.set(PointLight<S>{light, grey<S>(2.f)});
+        return l;
+    }();
+    Ray ray{Vec3(-3.f, 0.05f, -0.05f), glm::normalize(Vec3(1.f, 0.01f, -0.02f))};
+    std::array<double, 3> ref = single_scatter_reference(medium, ray, light, 2.f);
+};
+
 }  // namespace nsp_test
