@@ -155,30 +155,7 @@ public:
             lo[a] = int(l);
             hi[a] = int(h);
         }
-        const auto acc = grid_->getAccessor();
-        const auto* first = grid_->tree().getFirstLeaf();
-        float m = 0.f;
-        for (int bz = lo[2] & ~7; bz <= hi[2]; bz += 8)
-            for (int by = lo[1] & ~7; by <= hi[1]; by += 8)
-                for (int bx = lo[0] & ~7; bx <= hi[0]; bx += 8) {
-                    const nanovdb::Coord block(bx, by, bz);
-                    const auto* leaf = acc.probeLeaf(block);
-                    if (!leaf) {  // a tile (or the background): one value over the block
-                        m = std::max(m, acc.getValue(block));
-                        continue;
-                    }
-                    const bool inside = bx >= lo[0] && by >= lo[1] && bz >= lo[2] && bx + 7 <= hi[0] && by + 7 <= hi[1] &&
-                                        bz + 7 <= hi[2];
-                    if (inside) {
-                        m = std::max(m, leaf_max_[std::size_t(leaf - first)]);
-                        continue;
-                    }
-                    for (int z = std::max(bz, lo[2]); z <= std::min(bz + 7, hi[2]); ++z)
-                        for (int y = std::max(by, lo[1]); y <= std::min(by + 7, hi[1]); ++y)
-                            for (int x = std::max(bx, lo[0]); x <= std::min(bx + 7, hi[0]); ++x)
-                                m = std::max(m, leaf->getValue(nanovdb::Coord(x, y, z)));
-                }
-        return m;
+        return fold_voxels(lo, hi, 0.f, leaf_max_, [](float a, float b) { return std::max(a, b); });
     }
 
     /// The smallest density a lookup can return in world region `region` (LowerBoundedMedium,
@@ -195,29 +172,8 @@ public:
             lo[a] = int(l);
             hi[a] = int(h);
         }
-        const auto acc = grid_->getAccessor();
-        const auto* first = grid_->tree().getFirstLeaf();
-        float m = std::numeric_limits<float>::infinity();
-        for (int bz = lo[2] & ~7; bz <= hi[2] && m > 0.f; bz += 8)
-            for (int by = lo[1] & ~7; by <= hi[1]; by += 8)
-                for (int bx = lo[0] & ~7; bx <= hi[0]; bx += 8) {
-                    const nanovdb::Coord block(bx, by, bz);
-                    const auto* leaf = acc.probeLeaf(block);
-                    if (!leaf) {  // a tile (or the background): one value over the block
-                        m = std::min(m, acc.getValue(block));
-                        continue;
-                    }
-                    const bool inside = bx >= lo[0] && by >= lo[1] && bz >= lo[2] && bx + 7 <= hi[0] && by + 7 <= hi[1] &&
-                                        bz + 7 <= hi[2];
-                    if (inside) {
-                        m = std::min(m, leaf_min_[std::size_t(leaf - first)]);
-                        continue;
-                    }
-                    for (int z = std::max(bz, lo[2]); z <= std::min(bz + 7, hi[2]); ++z)
-                        for (int y = std::max(by, lo[1]); y <= std::min(by + 7, hi[1]); ++y)
-                            for (int x = std::max(bx, lo[0]); x <= std::min(bx + 7, hi[0]); ++x)
-                                m = std::min(m, leaf->getValue(nanovdb::Coord(x, y, z)));
-                }
+        const float m = fold_voxels(lo, hi, std::numeric_limits<float>::infinity(), leaf_min_,
+                                    [](float a, float b) { return std::min(a, b); });
         return m > 0.f && m < std::numeric_limits<float>::infinity() ? m * (1.f - 0x1p-20f) : 0.f;
     }
 
@@ -385,6 +341,38 @@ private:
                 nsp::detail::fail(what_, ": its world box on axis ", a, " is [", bounds_.lo[a], ", ", bounds_.hi[a],
                              "]; it must be finite and not empty in float");
         }
+    }
+
+    /// `op` folded from `init` over the voxel values in index box [lo, hi] (inclusive), block by
+    /// block of 8^3: a tile's (or the background's) one value, a whole leaf's `per_leaf` value
+    /// (its maximum or minimum), a cut leaf voxel by voxel. density_bound and density_lower_bound.
+    template <class Op>
+    float fold_voxels(const int (&lo)[3], const int (&hi)[3], float init, const std::vector<float>& per_leaf,
+                      Op op) const noexcept {
+        const auto acc = grid_->getAccessor();
+        const auto* first = grid_->tree().getFirstLeaf();
+        float m = init;
+        for (int bz = lo[2] & ~7; bz <= hi[2]; bz += 8)
+            for (int by = lo[1] & ~7; by <= hi[1]; by += 8)
+                for (int bx = lo[0] & ~7; bx <= hi[0]; bx += 8) {
+                    const nanovdb::Coord block(bx, by, bz);
+                    const auto* leaf = acc.probeLeaf(block);
+                    if (!leaf) {  // a tile (or the background): one value over the block
+                        m = op(m, acc.getValue(block));
+                        continue;
+                    }
+                    const bool inside = bx >= lo[0] && by >= lo[1] && bz >= lo[2] && bx + 7 <= hi[0] && by + 7 <= hi[1] &&
+                                        bz + 7 <= hi[2];
+                    if (inside) {
+                        m = op(m, per_leaf[std::size_t(leaf - first)]);
+                        continue;
+                    }
+                    for (int z = std::max(bz, lo[2]); z <= std::min(bz + 7, hi[2]); ++z)
+                        for (int y = std::max(by, lo[1]); y <= std::min(by + 7, hi[1]); ++y)
+                            for (int x = std::max(bx, lo[0]); x <= std::min(bx + 7, hi[0]); ++x)
+                                m = op(m, leaf->getValue(nanovdb::Coord(x, y, z)));
+                }
+        return m;
     }
 
     NanoHandle handle_;
