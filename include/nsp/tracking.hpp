@@ -427,6 +427,9 @@ FlightEnd<MajorantValue<Maj, M>> free_flight(const M& medium, const Maj& majoran
                 if (detail::exceeds_majorant(coeff, seg->sigma_maj)) return {false, true, true, t, V{}};
             }
             if constexpr (collide) {
+                // A visitor sees the medium's own coefficients and the whole collision rate (below).
+                if constexpr (requires { on_collision.visit_collision(t, coeff, 0.f, 0.0); })
+                    on_collision.visit_collision(t, coeff, channel_of(seg->sigma_maj, channel), tau_ctl);
                 if (control_first) detail::to_control(coeff, ctl);
                 else detail::to_residual(coeff, ctl, mu_bar);
             } else if constexpr (residual) {
@@ -514,10 +517,11 @@ struct NoVisit {
 /// A visitor with `enabled` is called at every tentative collision before its event is chosen,
 /// as `visit(t, coefficients, mu_bar, weight, null_pdf_product)` with the weight and null-pdf
 /// product of the nulls before it (the collision estimator of emission, THEORY 5.7, uses it).
-template <AbsorptionPolicy A, SpectralMode S, UniformRng R, class Rec, class Visit = NoVisit>
+/// Under a control, decomposition tracking (THEORY 5.10); with `kControlled` (track_delta_visiting
+/// sets it when the majorant carries a control) the visitor is called from visit_collision instead.
+template <AbsorptionPolicy A, SpectralMode S, UniformRng R, class Rec, class Visit = NoVisit,
+          bool kControlled = false>
 struct DeltaCollision {
-    /// Under a control, decomposition tracking (THEORY 5.10; track_delta_visiting refuses a control
-    /// with a visitor).
     static constexpr ControlUse control_use = ControlUse::Collide;
     R& rng;
     Rec& rec;
@@ -529,7 +533,7 @@ struct DeltaCollision {
     double null_pdf_product = 1.0;
 
     bool operator()(float t, const Coefficients<S>& c, float mu_bar, float tau) {
-        if constexpr (Visit::enabled)
+        if constexpr (Visit::enabled && !kControlled)
             visit(t, c, mu_bar, typename S::Spectrum(weight.template cast<float>()), float(null_pdf_product));
         const EventProbabilities p = event_probabilities<A>(c, mu_bar);
         NSP_DEBUG_ASSERT(p.absorb >= 0.f && p.scatter >= 0.f && p.null >= 0.f &&
@@ -559,6 +563,19 @@ struct DeltaCollision {
         out.event_density = mu_bar * p_event;  // 0 where it lies below float's range (see DeltaTrack)
         if constexpr (Rec::enabled) rec.vertex(t, std::log(double(mu_bar) * p_event) - tau);
         return false;
+    }
+
+    /// Under a control, the loop's call at every collision y, control or residual, before its
+    /// coefficients become the control's or the residual's: the visitor sees the medium's own
+    /// coefficients `c` at y, the rate `rate` = mu_c + mu_bar_r of collisions there (the segment's
+    /// majorant) and the null product with the control's exp(-tau_c) up to y (`tau_ctl`). The
+    /// collision estimator of emission is then unbiased and its pdf is the full majorant's formula
+    /// with the residual's null product (docs/theory.md, 5.10).
+    void visit_collision(float t, const Coefficients<S>& c, float rate, double tau_ctl)
+        requires(kControlled && Visit::enabled)
+    {
+        visit(t, c, rate, typename S::Spectrum(weight.template cast<float>()),
+              float(null_pdf_product * std::exp(-tau_ctl)));
     }
 
     /// sigma / (mu_bar P) of the chosen real event. In float where mu_bar P is a normal float (the
@@ -633,18 +650,18 @@ struct RatioCollision {
 };
 
 /// Delta-tracks `ray` over [0, tmax] as `track_delta` does, calling `visit` at every tentative
-/// collision (see DeltaCollision).
+/// collision (see DeltaCollision); under a control at every control and residual collision, with
+/// the medium's own coefficients, the segment's majorant and the null product with exp(-tau_c) so
+/// far (DeltaCollision::visit_collision).
 template <AbsorptionPolicy A, Medium M, MajorantPolicy<M> Maj, UniformRng R, LookupCounter C, class Visit,
           class Rec = NoRecord>
 DeltaTrack<typename M::Spectral> track_delta_visiting(const M& medium, const Maj& majorant, const Ray& ray,
                                                       float tmax, const typename M::Spectral::Wavelengths& lambda,
                                                       R& rng, C& counter, Visit visit, Rec&& rec = Rec{}) {
     using S = typename M::Spectral;
-    static_assert(!Visit::enabled || !detail::has_control_v<std::remove_cvref_t<decltype(*majorant.iterate(
-                                         ray, 0.f, tmax, lambda).next())>>,
-                  "a visitor (the collision estimator of emission) sees the full majorant's tentative collisions, "
-                  "which decomposition tracking under a control does not draw: track under a majorant without one");
-    DeltaCollision<A, S, R, std::remove_reference_t<Rec>, Visit> cb{rng, rec, std::move(visit)};
+    constexpr bool kControlled =
+        detail::has_control_v<std::remove_cvref_t<decltype(*majorant.iterate(ray, 0.f, tmax, lambda).next())>>;
+    DeltaCollision<A, S, R, std::remove_reference_t<Rec>, Visit, kControlled> cb{rng, rec, std::move(visit)};
     const auto f = free_flight(medium, majorant, ray, 0.f, tmax, lambda, rng, counter, cb);
     if (f.aborted) return {aborted_end(f), f.t, S::Spectrum::Zero(), 1.f};
     if (!f.stopped) {

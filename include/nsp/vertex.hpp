@@ -258,7 +258,9 @@ public:
     /// track(), calling `visit(t, coefficients, mu_bar, weight, null_pdf_product)` at every
     /// tentative collision before its event is chosen, with the weight and null-pdf product of
     /// the nulls before it (see DeltaCollision): the collision estimator of volume emission
-    /// (THEORY 5.7) is such a visitor. `Visit` has `static constexpr bool enabled = true`.
+    /// (THEORY 5.7) is such a visitor. Under a control, at every control and residual collision,
+    /// with the medium's own coefficients, the segment's majorant and exp(-tau_c) in the null
+    /// product (track_delta_visiting, THEORY 5.10). `Visit` has `static constexpr bool enabled = true`.
     template <Medium M, MajorantPolicy<M> Maj, UniformRng R, LookupCounter C, class Visit>
     DeltaTrack<typename M::Spectral> track_visiting(const M& medium, const Maj& majorant, const Ray& ray, float t_max,
                                                     const typename M::Spectral::Wavelengths& lambda, R& rng,
