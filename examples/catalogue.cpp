@@ -117,7 +117,9 @@ std::vector<SceneEntry> make_catalogue() {
                  {nsp::Rgb::name}, 64, 64, 256,
                  {"unidirectional_grey_absorb-weight", "ratio-nee_grey_absorb-weight", "uni-nee-mis_grey_absorb-weight",
                   "uni-nee-mis_grey_balance_absorb-weight_learned"},
-                 {"global", "grid"},
+                 // grid-control: decomposition tracking, the collision estimator at every control and
+                 // residual collision
+                 {"global", "grid", "grid-control"},
                  // directional MIS weights under the grid majorant: they sum to 1 and tame NEE's 1/d^2
                  // near the flame as the null-scattering ones do; none of the default rows
                  "directional-mis_grid_balance_absorb-weight", true,

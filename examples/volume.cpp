@@ -246,11 +246,11 @@ int render(const M& medium, const VolumeOptions& o, const char* mode, const char
     if (o.compare) failed = compare_majorants(medium, o);
     else if (o.majorant == "grid") failed = run_strategies(medium, nsp::GridMajorant<M>(medium, o.grid_res), o);
     else if (o.majorant == "grid-control") {
-        // Decomposition tracking (THEORY 5.10): PathEstimator takes a control on media without emission.
-        if constexpr (nsp::LowerBoundedMedium<M> && !nsp::EmissiveMedium<M>)
+        // Decomposition tracking (THEORY 5.10), over media with a density lower bound.
+        if constexpr (nsp::LowerBoundedMedium<M>)
             failed = run_strategies(medium, nsp::GridControl<M>(medium, o.grid_res), o);
         else
-            throw nsp_examples::UsageError("--majorant grid-control takes a medium without emission (not --temperature)");
+            throw nsp_examples::UsageError("--majorant grid-control takes a medium with a density lower bound");
     }
     else if (o.majorant == "tree") failed = run_strategies(medium, tree_majorant(medium, o), o);
     else if (o.majorant == "tree-nodes") failed = run_strategies(medium, tree_majorant(medium, o, true), o);
