@@ -4,7 +4,8 @@
 // a global and a grid majorant. Two tables: a 1-D set of analytic extinction profiles along one
 // ray (constant, linear ramp, Gaussian bump, a hole, a step, a high-frequency cosine; optical depth
 // 2 each), each against its exact transmittance, and shadow rays through the example media (the
-// cloud, the sparse medium, the fog, the plume's smoke). Per estimator: the variance of one
+// cloud, the sparse medium, the fog, the plume's smoke) and through any .nvdb or .vdb files given
+// with --volume (NanoVdbMedium: the sparse tree's lookups, its leaves' bounds for the grids). Per estimator: the variance of one
 // estimate, its lookups, their product LTUV (lookups x variance: the cost of a given error, machine
 // independent) and LTUV over the best ratio-tracking row's. Exits 0, or 1 when an estimate failed
 // or a 1-D mean is more than 5 standard errors from its exact value.
@@ -14,6 +15,7 @@
 #include <cstdio>
 #include <functional>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -23,6 +25,7 @@
 
 #include "default_scene.hpp"
 #include "tool.hpp"
+#include "volume_files.hpp"
 
 namespace {
 
@@ -36,6 +39,9 @@ struct Options {
     int grid = 16;         ///< grid majorant and control resolution (per axis; 1-D: along x)
     std::uint64_t seed = 1;
     RayMarchingOptions marching;
+    std::vector<std::string> volumes;  ///< .nvdb / .vdb files whose grid `grid` joins the media table
+    std::string grid_name = "density";
+    float density_scale = 20.f;  ///< extinction per unit of the files' density (albedo 1: mu_s)
 };
 
 /// Running mean and variance.
@@ -63,11 +69,12 @@ struct Estimators {
     std::vector<std::function<TransmittanceSample<Mono>(const Ray&, float, Pcg32&, LookupCount&)>> run;
 };
 
-Estimators estimators_for(const M& medium, std::array<int, 3> res, const RayMarchingOptions& marching) {
+template <class Med>
+Estimators estimators_for(const Med& medium, std::array<int, 3> res, const RayMarchingOptions& marching) {
     // Owned by the closures (shared_ptr: std::function copies them).
-    auto global = std::make_shared<GlobalMajorant<M>>(medium);
-    auto grid = std::make_shared<GridMajorant<M>>(medium, res);
-    auto control = std::make_shared<GridControl<M>>(medium, res);
+    auto global = std::make_shared<GlobalMajorant<Med>>(medium);
+    auto grid = std::make_shared<GridMajorant<Med>>(medium, res);
+    auto control = std::make_shared<GridControl<Med>>(medium, res);
     Estimators e;
     const std::string g = std::to_string(res[0]) + (res[1] == 1 ? "" : "^3");
     e.names = {"ratio, global majorant", "ratio, grid " + g, "residual ratio, grid control " + g,
@@ -139,6 +146,96 @@ void print_header(const char* first) {
     std::printf("| %s | estimator | variance | lookups | LTUV | vs best ratio |\n|---|---|---|---|---|---|\n", first);
 }
 
+/// Set-up A's lamp, over the example media's box [-1, 1]^3.
+constexpr float kLampX = 0.8f, kLampY = 2.2f, kLampZ = -0.6f;
+
+/// Shadow rays through `medium` (o.rays of them, from points with density toward `lamp`, o.per_ray
+/// estimates each): one table row per estimator. Returns the number of rows with a failed estimate.
+template <class Med>
+int media_rows(const char* name, const Med& medium, const Vec3& lamp, const Options& o) {
+    Pcg32 pick(o.seed, 7);
+    std::vector<std::pair<Ray, float>> rays;
+    const Box b = medium.bounds();
+    for (std::uint64_t tries = 0; int(rays.size()) < o.rays; ++tries) {
+        if (tries > 1'000'000u)
+            throw std::runtime_error(std::string(name) + ": no point with density > 0 in 1e6 uniform draws over its box");
+        const Vec3 p = b.lo + (b.hi - b.lo) * Vec3(pick.uniform(), pick.uniform(), pick.uniform());
+        if (!(medium.density(p) > 0.f)) continue;  // start where there is medium, as a scattering vertex does
+        const Vec3 to = lamp - p;
+        rays.push_back({Ray{p, glm::normalize(to)}, glm::length(to)});
+    }
+    const Estimators e = estimators_for(medium, {o.grid, o.grid, o.grid}, o.marching);
+    std::vector<Result> results;
+    for (std::size_t k = 0; k < e.run.size(); ++k) results.push_back(measure(e, k, rays, o.per_ray, o.seed));
+    const double best = std::min(results[0].ltuv(), results[1].ltuv());
+    int bad = 0;
+    for (std::size_t k = 0; k < results.size(); ++k) {
+        const Result& r = results[k];
+        bad += r.failed > 0;
+        std::printf("| %s | %s | %.3g | %.2f | %.3g | %s |\n", name, e.names[k].c_str(), r.variance, r.lookups,
+                    r.ltuv(), best > 0.0 ? (std::to_string(r.ltuv() / best).substr(0, 5) + "x").c_str() : "-");
+    }
+    return bad;
+}
+
+/// The cost model's pick for `medium` (choose_majorant) beside its pick without controls.
+template <class Med>
+void pick_row(const char* name, const Med& medium) {
+    const MajorantCost pick = choose_majorant(medium);
+    const MajorantCost plain = choose_grid_resolution(medium);
+    const auto label = [](const MajorantCost& c) {
+        return c.global ? std::string("global") : (c.control ? "grid control " : "grid ") + std::to_string(c.resolution[0]) + "^3";
+    };
+    std::printf("| %s | %s | %.3g | %.3g | %.3g | %s, cost %.3g |\n", name, label(pick).c_str(), pick.lookups, pick.steps,
+                pick.cost, label(plain).c_str(), plain.cost);
+}
+
+#if NSP_HAVE_NANOVDB
+using FileMedium = io::NanoVdbMedium<Mono>;
+#else
+using FileMedium = M;  // never built: --volume is refused without NanoVDB
+#endif
+
+/// A volume file of the media table: its grid as a NanoVdbMedium, scattering only (albedo 1).
+struct VolumeRow {
+    std::string name;
+    FileMedium medium;
+};
+
+/// Loads o.volumes (their format and that they are regular files checked first: usage errors).
+std::vector<VolumeRow> load_volumes(const Options& o) {
+    std::vector<VolumeRow> out;
+    for (const std::string& path : o.volumes) {
+        const std::string ext = nsp_examples::extension_of(path);
+        if (ext == ".vol")
+            throw nsp_examples::UsageError("--volume '" + path + "': a .nvdb or .vdb file is needed (a sparse NanoVDB "
+                                           "grid); the table's example media are dense grids already");
+        try {
+            nsp_examples::require_format(path, ext);
+        } catch (const nsp::InvalidArgument& e) {
+            throw nsp_examples::UsageError(std::string("--volume ") + e.what());
+        }
+        nsp_examples::require_regular_file(path, "a volume file");
+#if NSP_HAVE_NANOVDB
+        std::shared_ptr<const io::NanoDensityGrid> g;
+        try {
+#if NSP_HAVE_OPENVDB
+            if (ext == ".vdb") g = io::load_vdb(path, o.grid_name);
+#endif
+            if (ext == ".nvdb") g = io::load_nvdb(path, o.grid_name);
+        } catch (const nsp::InvalidArgument& e) {
+            throw nsp_examples::UsageError(std::string("--volume ") + e.what());
+        }
+        const std::string base = path.substr(path.find_last_of('/') == std::string::npos ? 0 : path.find_last_of('/') + 1);
+        char scale[32];
+        std::snprintf(scale, sizeof scale, "%g", double(o.density_scale));
+        out.push_back({base + " (NanoVDB, x" + scale + ")",
+                       FileMedium(g, Mono::Spectrum::Constant(0.f), Mono::Spectrum::Constant(o.density_scale))});
+#endif
+    }
+    return out;
+}
+
 int run(int argc, char** argv) {
     Options o;
     CLI::App app("nsp_transmittance: ratio tracking, residual ratio tracking and unbiased ray marching on 1-D "
@@ -156,8 +253,14 @@ int run(int argc, char** argv) {
         ->check(CLI::Range(1e-3, 1e3));
     app.add_option("--term-scale", o.marching.term_scale, "ray marching: the roulette's term scale")
         ->check(CLI::Range(1e-6, 1e3));
+    app.add_option("--volume", o.volumes,
+                   "a .nvdb or .vdb file whose grid (--grid-name) joins the media table (repeatable)");
+    app.add_option("--grid-name", o.grid_name, "the files' density grid");
+    app.add_option("--density-scale", o.density_scale, "extinction per unit of the files' density")
+        ->check(CLI::Range(1e-6, 1e6));
     nsp_examples::parse_flags(app, argc, argv);
     validate(o.marching);
+    const std::vector<VolumeRow> volumes = load_volumes(o);  // bad paths fail before any work
 
     int bad = 0;
     std::printf("## 1-D extinction profiles (optical depth 2 along x, 256 voxels, grid %d x 1 x 1; %d estimates)\n\n",
@@ -191,9 +294,10 @@ int run(int argc, char** argv) {
         }
     }
 
-    std::printf("\n## Shadow rays through the example media (%d rays from points inside toward set-up A's lamp, "
+    std::printf("\n## Shadow rays through the example media (%d rays from points inside toward set-up A's lamp%s, "
                 "%d estimates each, grid %d^3)\n\n",
-                o.rays, o.per_ray, o.grid);
+                o.rays, volumes.empty() ? "" : "; for a volume file at the same place relative to its box", o.per_ray,
+                o.grid);
     print_header("medium");
     using namespace nsp_examples;
     const std::vector<std::pair<const char*, M>> media = {
@@ -203,42 +307,19 @@ int run(int argc, char** argv) {
         {"dense fog (F3)", make_fog_medium<Mono>(FogSetup::F3)},
         {"plume's smoke (P1)", make_plume_medium<Mono>().base()},
     };
-    const Vec3 lamp(0.8f, 2.2f, -0.6f);
-    for (const auto& [name, medium] : media) {
-        Pcg32 pick(o.seed, 7);
-        std::vector<std::pair<Ray, float>> rays;
-        const Box b = medium.bounds();
-        while (int(rays.size()) < o.rays) {
-            const Vec3 p = b.lo + (b.hi - b.lo) * Vec3(pick.uniform(), pick.uniform(), pick.uniform());
-            if (!(medium.density(p) > 0.f)) continue;  // start where there is medium, as a scattering vertex does
-            const Vec3 to = lamp - p;
-            rays.push_back({Ray{p, glm::normalize(to)}, glm::length(to)});
-        }
-        const Estimators e = estimators_for(medium, {o.grid, o.grid, o.grid}, o.marching);
-        std::vector<Result> results;
-        for (std::size_t k = 0; k < e.run.size(); ++k) results.push_back(measure(e, k, rays, o.per_ray, o.seed));
-        const double best = std::min(results[0].ltuv(), results[1].ltuv());
-        for (std::size_t k = 0; k < results.size(); ++k) {
-            const Result& r = results[k];
-            bad += r.failed > 0;
-            std::printf("| %s | %s | %.3g | %.2f | %.3g | %s |\n", name, e.names[k].c_str(), r.variance, r.lookups,
-                        r.ltuv(), best > 0.0 ? (std::to_string(r.ltuv() / best).substr(0, 5) + "x").c_str() : "-");
-        }
+    for (const auto& [name, medium] : media) bad += media_rows(name, medium, Vec3(kLampX, kLampY, kLampZ), o);
+    for (const auto& v : volumes) {  // the lamp where set-up A's is, relative to the file's box
+        const Box b = v.medium.bounds();
+        const Vec3 lamp = 0.5f * (b.lo + b.hi) + 0.5f * (b.hi - b.lo) * Vec3(kLampX, kLampY, kLampZ);
+        bad += media_rows(v.name.c_str(), v.medium, lamp, o);
     }
     // The cost model's pick per medium (choose_majorant: choose_grid_resolution's majorants and the
     // grid controls, lookups + step cost x steps per random line through the box).
     std::printf("\n## The cost model's pick (choose_majorant; per random line: lookups + %.2f x steps, a control's "
                 "steps at %.2f)\n\n| medium | pick | lookups | steps | cost | best grid alone |\n|---|---|---|---|---|---|\n",
                 double(kDefaultStepCost), double(kDefaultControlStepCost));
-    for (const auto& [name, medium] : media) {
-        const MajorantCost pick = choose_majorant(medium);
-        const MajorantCost plain = choose_grid_resolution(medium);
-        const auto label = [](const MajorantCost& c) {
-            return c.global ? std::string("global") : (c.control ? "grid control " : "grid ") + std::to_string(c.resolution[0]) + "^3";
-        };
-        std::printf("| %s | %s | %.3g | %.3g | %.3g | %s, cost %.3g |\n", name, label(pick).c_str(), pick.lookups, pick.steps,
-                    pick.cost, label(plain).c_str(), plain.cost);
-    }
+    for (const auto& [name, medium] : media) pick_row(name, medium);
+    for (const auto& v : volumes) pick_row(v.name.c_str(), v.medium);
     return bad ? kExitRuntime : kExitOk;
 }
 

@@ -24,7 +24,8 @@
 #     tables and out/plume_vdb/volume.png, out/cloud_vdb/volume.png; then the plume glowing by its
 #     temperature grid (blackbody emission, Rgb) with every strategy, out/plume_fire/volume.png;
 #  1d. nsp_transmittance: ratio tracking, residual ratio tracking and unbiased ray marching on 1-D
-#     extinction profiles and on shadow rays through the example media (two tables, about 6 s);
+#     extinction profiles and on shadow rays through the example media and the cloud's .vdb (its
+#     NanoVDB tree), and the cost model's pick per medium (three tables, about 8 s);
 # With --with-references it then also runs (about 90 s more, which would take the default run past
 # five minutes on 2 cores with the renderer's build; README's heavy-tail tables come from it):
 #  2. the heavy-tail comparison: the grey-majorant baseline against spectral MIS + NEE (per-channel
@@ -82,7 +83,7 @@ build/examples/nsp_volume out/cloud.vdb --compare-majorants --res 96 --spp 64 --
 build/examples/nsp_volume out/plume.vdb --temperature temperature --normalize-blackbody --emission-scale 60 \
     --density-scale 100 --majorant tree --res 96 --spp 64 --out out/plume_fire
 # The transmittance estimators: 1-D profiles and the example media (about 6 s).
-build/examples/nsp_transmittance
+build/examples/nsp_transmittance --volume out/cloud.vdb --density-scale 20
 if [ "$references" = 0 ]; then
     echo
     echo "main job: $((SECONDS - start)) s of rendering (scripts/run-main.sh --with-references adds the"
