@@ -248,3 +248,123 @@ TEST_CASE_TEMPLATE("emissive furnace under a control: L_e equal to the environme
 }
 
 }  // namespace
+
+namespace {
+
+// Equiangular sampling under a control: the tracked vertex's density is decomposition tracking's,
+// the sum over its control and residual routes (detail::decomposition_event_densities), on the
+// tracked side (DeltaTrack::event_density) and on the equiangular side (tracking_over_equiangular
+// with the control at the point) alike; the equiangular vertex's nulls are residual ratio
+// tracking's. The three-way MIS must stay unbiased.
+template <AbsorptionPolicy A>
+using EquiangularControlEstimators = std::tuple<PathEstimator<strategy::EquiangularNextEvent, mis::None, A>,
+                                                PathEstimator<strategy::EquiangularMis, mis::Balance, A>,
+                                                PathEstimator<strategy::EquiangularMis, mis::Power, A>>;
+
+TEST_CASE_TEMPLATE_DEFINE("equiangular strategies under a control: single scattering = quadrature", C, ctl_eq_single) {
+    using S = typename C::Spectral;
+    using M = typename C::Medium;
+    using A = typename C::Absorption;
+    const PointLightSingleScatter<M> setup;
+    const Box& box = setup.box;
+    const M& medium = setup.medium;
+    EstimatorOptions opts;
+    opts.max_depth = 1;
+    auto run = [&](const auto& control, const std::string& name, int seed0) {
+        const auto scene = Scene(medium, control, IsotropicPhase{}, setup.lights);
+        int seed = seed0;
+        auto each = [&](const auto& est) {
+            using E = std::remove_cvref_t<decltype(est)>;
+            const auto res = estimate_radiance(E(opts), scene, setup.ray, 20000, std::uint64_t(++seed));
+            check_channels(res, setup.ref, S::channels, combo_name<C>() + " " + name + " " + estimator_name<E>());
+        };
+        std::apply([&](const auto&... e) { (each(e), ...); }, EquiangularControlEstimators<A>{});
+        // The equiangular vertex on 40 % of the pieces (THEORY 5.9): its count in every weight.
+        EstimatorOptions some = opts;
+        some.equiangular_count = 0.4f;
+        each(PathEstimator<strategy::EquiangularMis, mis::Balance, A>(some));
+    };
+    if constexpr (std::is_same_v<M, HomogeneousMedium<S>>) {
+        run(GlobalControl<M>(medium, medium.coefficients(Vec3(0.f), {}).sigma_t()), "global control = extinction", 90);
+    } else {
+        run(GridControl<M>(medium, 8), "grid control (8^3)", 90);
+        run(GlobalControl<M>(medium, box_control(medium, 0.9f)), "global control", 100);
+        const float above = 0.5f * (medium.density_lower_bound(box) + medium.density_bound(box));
+        run(GlobalControl<M>(medium, scale(medium.extinction_per_density(), above)), "global control above the density",
+            110);
+    }
+}
+TEST_CASE_TEMPLATE_APPLY(ctl_eq_single, AnalyticMediaCombos);
+
+TEST_CASE_TEMPLATE("equiangular furnace under a control: albedo 1 with a point light as target gives 1", S, Mono, Rgb) {
+    // Albedo 1 under a unit environment: radiance 1 everywhere, after many scatterings. A point
+    // light of intensity 0 gives the equiangular vertices a target, so their NEE toward the
+    // environment and the three-way weights of every tracked vertex are exercised.
+    const Box box{Vec3(-1.f), Vec3(1.f)};
+    Lights<S> lights;
+    lights.set(EnvironmentLight<S>{grey<S>(1.f)});
+    lights.set(PointLight<S>{Vec3(0.1f, -0.2f, 0.3f), grey<S>(0.f)});
+    const Ray ray{Vec3(-3.f, 0.15f, -0.1f), glm::normalize(Vec3(1.f, 0.02f, 0.03f))};
+    auto run_all = [&](const auto& medium, const auto& control, const std::string& name, std::uint64_t seed) {
+        const Scene scene(medium, control, HenyeyGreensteinPhase(0.3f), lights);
+        auto each = [&](const auto& est) {
+            using E = std::remove_cvref_t<decltype(est)>;
+            const auto res = estimate_radiance(est, scene, ray, 6000, seed++);
+            check_channels(res, {1.0, 1.0, 1.0}, S::channels, std::string(S::name) + " " + name + " " + estimator_name<E>());
+        };
+        std::apply([&](const auto&... e) { (each(e), ...); }, EquiangularControlEstimators<absorption::Weight>{});
+        each(PathEstimator<strategy::EquiangularMis, mis::Balance, absorption::Event>{});
+    };
+    using Exp = ExponentialMedium<S>;
+    using Grid = DenseGridMedium<S>;
+    // Mildly chromatic in Rgb, as the furnace above (the grey axis's control is the smallest channel's).
+    const auto exp_medium = make_medium<Exp>(box, 1.5f, spec<S>(0.f, 0.f, 0.f), spec<S>(1.f, 0.8f, 1.25f));
+    const auto grid_medium = make_medium<Grid>(box, 1.5f, spec<S>(0.f, 0.f, 0.f), spec<S>(1.f, 0.8f, 1.25f));
+    run_all(exp_medium, GridControl<Exp>(exp_medium, 8), "exponential, grid control", 700);
+    run_all(grid_medium, GridControl<Grid>(grid_medium, 8), "noise grid, grid control", 720);
+    const float lo = exp_medium.density_lower_bound(box);  // a fifth of the way up, as the furnace above
+    const float above = lo + 0.2f * (exp_medium.density_bound(box) - lo);
+    run_all(exp_medium, GlobalControl<Exp>(exp_medium, scale(exp_medium.extinction_per_density(), above)),
+            "exponential, global control above the density", 740);
+}
+
+TEST_CASE("decomposition_event_densities: delta tracking's mu_bar P_x under a minorant, both routes' sum above it") {
+    // Under a control below the extinction in every channel, each route's density is linear in the
+    // coefficients, so the sum is delta tracking's mu_bar P_x (float rounding at the scale of the
+    // extinction, from which the residual's mu_a = r - mu_s is a difference: 1e-5 x mu_bar).
+    // Above it the residual's events are drawn by |r| and the sum is the two routes' densities
+    // computed here independently from THEORY 5.10: the control route ctl P_s = ctl mean(a_s)
+    // (albedo a_s = mu_s / mu_t kept, no null), the residual route R P_s = R mean|r a_s| /
+    // (mean|r a_a| + mean|r a_s| + mean|R - r|), R = mu_bar - ctl.
+    Pcg32 rng(17, 5);
+    for (int i = 0; i < 2000; ++i) {
+        CAPTURE(i);
+        const float sa0 = 3.f * rng.uniform(), ss0 = 3.f * rng.uniform();
+        Coefficients<Rgb> k{Rgb::Spectrum(sa0, 0.7f * sa0, 1.3f * sa0), Rgb::Spectrum(ss0, 1.2f * ss0, 0.6f * ss0)};
+        const float t_min = k.sigma_t().minCoeff(), t_max = k.sigma_t().maxCoeff();
+        const float mu_bar = t_max * (1.f + 2.f * rng.uniform()) + 1e-3f;
+        const float below = t_min * rng.uniform();
+        const auto full = event_probabilities<absorption::Event>(k, mu_bar);
+        const auto d = detail::decomposition_event_densities<absorption::Event>(k, below, mu_bar);
+        CHECK(d.scatter == doctest::Approx(mu_bar * full.scatter).epsilon(1e-5).scale(mu_bar));
+        CHECK(d.absorb == doctest::Approx(mu_bar * full.absorb).epsilon(1e-5).scale(mu_bar));
+        const auto fw = event_probabilities<absorption::Weight>(k, mu_bar);
+        const auto dw = detail::decomposition_event_densities<absorption::Weight>(k, below, mu_bar);
+        CHECK(dw.scatter == doctest::Approx(mu_bar * fw.scatter).epsilon(1e-5).scale(mu_bar));
+        // Above the extinction of every channel (r < 0 everywhere), below the majorant.
+        const float over = t_max + (mu_bar - t_max) * rng.uniform();
+        const auto du = detail::decomposition_event_densities<absorption::Event>(k, over, mu_bar);
+        const Eigen::Array3d t = k.sigma_t().cast<double>();
+        const Eigen::Array3d a_s = (t > 0.0).select(k.sigma_s.cast<double>() / t, 0.0), a_a = 1.0 - a_s;
+        const Eigen::Array3d r = t - double(over);  // < 0 in every channel
+        const double big_r = double(mu_bar) - double(over);
+        const double ctl_part = double(over) * a_s.mean();
+        const double res_part = big_r > 0.0 ? big_r * (r * a_s).abs().mean() /
+                                                  ((r * a_a).abs().mean() + (r * a_s).abs().mean() + (big_r - r).abs().mean())
+                                            : 0.0;
+        CHECK(double(du.scatter) == doctest::Approx(ctl_part + res_part).epsilon(1e-4).scale(1e-6));
+        CHECK(double(du.scatter) >= double(mu_bar * full.scatter) - 1e-5);  // never below delta tracking's
+    }
+}
+
+}  // namespace

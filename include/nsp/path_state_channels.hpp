@@ -190,7 +190,8 @@ public:
     /// equiangular and tracking pdfs of it, and the survival tracking would give it.
     template <class Coeff, class Mu>
     std::optional<VertexRecord<P, S>> equiangular_vertex(const ShadowPiece<P, S>& w, const Coeff& k, const Mu& mu,
-                                                         float eq_pdf, int depth) const noexcept {
+                                                         float eq_pdf, int depth, float ctl = 0.f) const noexcept {
+        (void)ctl;  // 0: SpectralPathEstimator takes no control
         VertexRecord<P, S> x;
         x.f = st_.f * w.f * k.sigma_s;
         if (!(x.f != 0.f).any()) return std::nullopt;

@@ -214,19 +214,20 @@ public:
 
     /// An equiangular vertex x drawn on the current piece with density `eq_pdf` (select x the
     /// mixture's) after the walk `w` over the nulls before it, coefficients k and majorant mu there
-    /// (THEORY 5.4; w: the piece ratio-tracked up to x): the vertex NEE starts from, or nothing
+    /// (THEORY 5.4; w: the piece ratio-tracked up to x) and under a control the grey control `ctl`
+    /// (tracking's density is then decomposition tracking's, THEORY 5.10): the vertex NEE starts from, or nothing
     /// where it carries nothing. Its roulette survival is the one tracking would give x, a
     /// function of the path.
     template <class Coeff, class Mu>
     std::optional<VertexRecord<P, S>> equiangular_vertex(const ShadowPiece<P, S>& w, const Coeff& k, const Mu& mu,
-                                                         float eq_pdf, int depth) const noexcept {
+                                                         float eq_pdf, int depth, float ctl = 0.f) const noexcept {
         VertexRecord<P, S> x;
         x.f = beta_ * w.f * k.sigma_s / eq_pdf;
         if (!(x.f != 0.f).any()) return std::nullopt;
         x.p_eq = 1.f;
         x.eq_drawn = true;
         if constexpr (St::combines) {
-            x.p_track = tracking_over_equiangular<A>(eq_pdf, w.uni, k, mu);
+            x.p_track = tracking_over_equiangular<A>(eq_pdf, w.uni, k, mu, ctl);
             if (x.p_track > 0.f) x.survival = k_.survival(depth, x.f / x.p_track);
         }
         return x;

@@ -255,6 +255,38 @@ void to_control(Coefficients<S>& k, float ctl) noexcept {
     k.sigma_a = ctl - k.sigma_s;
 }
 
+/// The densities, over the shared null factors, with which decomposition tracking (THEORY 5.10)
+/// draws a real absorption and a real scattering event at a point whose lookup is `k` (after the
+/// bound policy), grey control `ctl` and segment majorant `mu_bar`: the control route's
+/// ctl P_x(control) plus the residual route's R P_x(residual), R = mu_bar - ctl. Under a minorant
+/// (every channel's residual >= 0) every term is linear in the coefficients and the sum is delta
+/// tracking's mu_bar P_x; where the control exceeds the extinction the residual's events are drawn
+/// by |r| and the sum is larger. A control of 0 gives delta tracking's densities.
+struct EventDensities {
+    float absorb = 0.f, scatter = 0.f;
+};
+/// Nothing, in a member that a policy without a control does not keep.
+struct Empty {};
+template <AbsorptionPolicy A, SpectralMode S>
+EventDensities decomposition_event_densities(const Coefficients<S>& k, float ctl, float mu_bar) noexcept {
+    const float rate = mu_bar - ctl;
+    EventDensities d;
+    if (rate > 0.f) {
+        Coefficients<S> r = k;
+        to_residual(r, ctl, rate);
+        const EventProbabilities p = event_probabilities<A>(r, rate);
+        d = {rate * p.absorb, rate * p.scatter};
+    }
+    if (ctl > 0.f) {
+        Coefficients<S> c = k;
+        to_control(c, ctl);
+        const EventProbabilities p = event_probabilities<A>(c, ctl);
+        d.absorb += ctl * p.absorb;
+        d.scatter += ctl * p.scatter;
+    }
+    return d;
+}
+
 /// bound::Clamp: scales a lookup's coefficients, albedo kept, so that mu_t <= mu_bar in every
 /// channel (mu_bar grey or per channel).
 template <SpectralMode S, class V>
@@ -427,9 +459,10 @@ FlightEnd<MajorantValue<Maj, M>> free_flight(const M& medium, const Maj& majoran
                 if (detail::exceeds_majorant(coeff, seg->sigma_maj)) return {false, true, true, t, V{}};
             }
             if constexpr (collide) {
-                // A visitor sees the medium's own coefficients and the whole collision rate (below).
-                if constexpr (requires { on_collision.visit_collision(t, coeff, 0.f, 0.0); })
-                    on_collision.visit_collision(t, coeff, channel_of(seg->sigma_maj, channel), tau_ctl);
+                // The callback may keep the medium's own coefficients (a real vertex's density, a
+                // visitor's estimate) before they become the control's or the residual's.
+                if constexpr (requires { on_collision.before_event(t, coeff, 0.f, 0.f, 0.0); })
+                    on_collision.before_event(t, coeff, channel_of(seg->sigma_maj, channel), ctl, tau_ctl);
                 if (control_first) detail::to_control(coeff, ctl);
                 else detail::to_residual(coeff, ctl, mu_bar);
             } else if constexpr (residual) {
@@ -502,8 +535,8 @@ struct DeltaTrack {
     /// mu_bar(t) P_event(t) at a real collision: its pdf over Tbar (THEORY 5.4). It is 0 where the
     /// product lies below float's range (an event of subnormal probability under a majorant below
     /// 1/2, fuzzer finding 15); `equiangular_over_tracking` then gives inf, as it should. Under a
-    /// control it is the density of the route that drew the vertex (control or residual), not the
-    /// vertex's: equiangular MIS does not run on a control.
+    /// control it is the vertex's density, the sum over decomposition tracking's two routes to it
+    /// (detail::decomposition_event_densities), whichever drew it.
     float event_density = 0.f;
 };
 
@@ -518,7 +551,8 @@ struct NoVisit {
 /// as `visit(t, coefficients, mu_bar, weight, null_pdf_product)` with the weight and null-pdf
 /// product of the nulls before it (the collision estimator of emission, THEORY 5.7, uses it).
 /// Under a control, decomposition tracking (THEORY 5.10); with `kControlled` (track_delta_visiting
-/// sets it when the majorant carries a control) the visitor is called from visit_collision instead.
+/// sets it when the majorant carries a control) the loop calls before_event at every collision,
+/// and the visitor is called from there instead.
 template <AbsorptionPolicy A, SpectralMode S, UniformRng R, class Rec, class Visit = NoVisit,
           bool kControlled = false>
 struct DeltaCollision {
@@ -527,6 +561,12 @@ struct DeltaCollision {
     Rec& rec;
     Visit visit{};
     DeltaTrack<S> out{SegmentEnd::Passed, 0.f, S::Spectrum::Ones(), 1.f};
+    /// Under a control, the current collision's own lookup, grey control and segment majorant.
+    struct Kept {
+        Coefficients<S> k{};
+        float ctl = 0.f, mu_bar = 0.f;
+    };
+    [[no_unique_address]] std::conditional_t<kControlled, Kept, detail::Empty> kept{};
     // The weight and P_n product accumulate in double (see detail::kFloatNulls; for one to a few
     // channels double costs no more than float); `finish` rounds them into `out`.
     detail::DoubleSpectrum<typename S::Spectrum> weight = decltype(weight)::Ones();
@@ -560,22 +600,32 @@ struct DeltaCollision {
         }
         NSP_DEBUG_ASSERT(p_event > 0.f, "delta tracking chose a real event of probability 0");
         out.t = t;
-        out.event_density = mu_bar * p_event;  // 0 where it lies below float's range (see DeltaTrack)
+        if constexpr (kControlled) {  // the vertex's density: both routes' (see DeltaTrack)
+            const detail::EventDensities d = detail::decomposition_event_densities<A>(kept.k, kept.ctl, kept.mu_bar);
+            out.event_density = out.end == SegmentEnd::Absorbed ? d.absorb : d.scatter;
+        } else {
+            out.event_density = mu_bar * p_event;  // 0 where it lies below float's range (see DeltaTrack)
+        }
         if constexpr (Rec::enabled) rec.vertex(t, std::log(double(mu_bar) * p_event) - tau);
         return false;
     }
 
     /// Under a control, the loop's call at every collision y, control or residual, before its
-    /// coefficients become the control's or the residual's: the visitor sees the medium's own
-    /// coefficients `c` at y, the rate `rate` = mu_c + mu_bar_r of collisions there (the segment's
-    /// majorant) and the null product with the control's exp(-tau_c) up to y (`tau_ctl`). The
-    /// collision estimator of emission is then unbiased and its pdf is the full majorant's formula
-    /// with the residual's null product (docs/theory.md, 5.10).
-    void visit_collision(float t, const Coefficients<S>& c, float rate, double tau_ctl)
-        requires(kControlled && Visit::enabled)
+    /// coefficients become the control's or the residual's: keeps the medium's own lookup `c`, the
+    /// grey control `ctl` and the segment's majorant `mu_bar` = mu_c + mu_bar_r (the rate of
+    /// collisions there) for a real vertex's density, and calls the visitor with them and the null
+    /// product with the control's exp(-tau_c) up to y (`tau_ctl`). The collision estimator of
+    /// emission is then unbiased and its pdf is the full majorant's formula with the residual's null
+    /// product (THEORY 5.10).
+    void before_event(float t, const Coefficients<S>& c, float mu_bar, float ctl, double tau_ctl)
+        requires kControlled
     {
-        visit(t, c, rate, typename S::Spectrum(weight.template cast<float>()),
-              float(null_pdf_product * std::exp(-tau_ctl)));
+        kept = {c, ctl, mu_bar};
+        if constexpr (Visit::enabled)
+            visit(t, c, mu_bar, typename S::Spectrum(weight.template cast<float>()),
+                  float(null_pdf_product * std::exp(-tau_ctl)));
+        else
+            (void)t, (void)tau_ctl;
     }
 
     /// sigma / (mu_bar P) of the chosen real event. In float where mu_bar P is a normal float (the

@@ -98,6 +98,16 @@ float tracking_over_equiangular(float eq_pdf, float null_pdf_product, const Coef
     return null_pdf_product * mu_bar * event_probabilities<A>(c, mu_bar).scatter / eq_pdf;
 }
 
+/// The same under a grey control `ctl` > 0 (THEORY 5.10): decomposition tracking's density of the
+/// vertex, the sum over its control and residual routes, with the pair's null product
+/// exp(-tau_c) prod P_n,r.
+template <AbsorptionPolicy A, SpectralMode S>
+float tracking_over_equiangular(float eq_pdf, float null_pdf_product, const Coefficients<S>& c, float mu_bar,
+                                float ctl) noexcept {
+    if (!(ctl > 0.f)) return tracking_over_equiangular<A>(eq_pdf, null_pdf_product, c, mu_bar);
+    return null_pdf_product * detail::decomposition_event_densities<A>(c, ctl, mu_bar).scatter / eq_pdf;
+}
+
 /// The MIS weight of technique `which` for one path, from the three techniques' pdfs relative to
 /// any common reference (`track_nee`, `track_hit` = 0 for a point light, `eq_nee`). The three
 /// weights of one path sum to 1.

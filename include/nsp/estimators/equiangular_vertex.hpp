@@ -120,7 +120,7 @@ Status equiangular_nee(const State& st, const Sc& sc, int index, const Ray& ray,
     if (!(piece.f != 0.f).any()) return Status::Ok;
     const auto v = detail::lookup_untracked(m.medium, m.majorant, ray, ds.t, lambda, counter);
     if (!v) return Status::Rejected;
-    const auto x = st.equiangular_vertex(piece, v->k, v->mu, ds.pdf, depth);
+    const auto x = st.equiangular_vertex(piece, v->k, v->mu, ds.pdf, depth, v->ctl);
     if (!x) return Status::Ok;
     const SceneVertex xv{-1, index, {}};
     return light_nee(st, sc, xv, ray.at(ds.t), ray.d, *x, [&](const Vec3&) { return index; }, lambda, rng, counter, L);

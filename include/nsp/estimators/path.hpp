@@ -287,10 +287,6 @@ public:
         static_assert(!is_per_channel_majorant_v<typename Sc::MajorantType, typename Sc::MediumType>,
                       "nsp::PathEstimator drives every channel with one pdf and needs a grey majorant "
                       "(GlobalMajorant or GridMajorant); per-channel majorants go with nsp::SpectralPathEstimator");
-        static_assert(!is_control_v<typename Sc::MajorantType, typename Sc::MediumType> || !St::equiangular,
-                      "nsp::PathEstimator under a control (GridControl, GlobalControl: decomposition and residual "
-                      "ratio tracking) runs the strategies without equiangular sampling: the equiangular "
-                      "technique's pdfs are those of the full majorant's tracking");
         if (!usable_ray(camera_ray) || detail::refuses_nee_count(kernels_, scene))
             return {Sc::Spectrum::Zero(), Status::InvalidInput};
         detail::record_nee_count_may_be_0(counter, !scene.lights.has_delta_lights());

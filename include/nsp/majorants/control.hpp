@@ -122,6 +122,15 @@ public:
         return {bounds_.clip(r, tmin, tmax), majorant_, Spectral::sample(control_, l)};
     }
 
+    /// The majorant at point p (0 outside the medium's box, as `iterate` clips).
+    float value_at(const Vec3& p, const typename Spectral::Wavelengths&) const noexcept {
+        return bounds_.contains(p) ? majorant_ : 0.f;
+    }
+    /// The control at point p, per channel (0 outside the box): a segment's sigma_ctl there.
+    Spectrum control_value_at(const Vec3& p, const typename Spectral::Wavelengths& l) const noexcept {
+        return bounds_.contains(p) ? Spectrum(Spectral::sample(control_, l)) : Spectrum(Spectrum::Zero());
+    }
+
 private:
     Box bounds_;
     Coefficient control_;
@@ -189,6 +198,17 @@ public:
 
     Iterator iterate(const Ray& r, float tmin, float tmax, const typename Spectral::Wavelengths& l) const noexcept {
         return {*this, upper_.walk(r, tmin, tmax), Spectral::sample(unit_, l)};
+    }
+
+    /// The majorant at point p (its cell's, 0 outside the box): one lookup, no walk.
+    float value_at(const Vec3& p, const typename Spectral::Wavelengths&) const noexcept {
+        return upper_.at_point(p) * unit_max_;
+    }
+    /// The control at point p, per channel (its cell's, 0 outside the box): the sigma_ctl of the
+    /// segment `iterate` gives there.
+    Spectrum control_value_at(const Vec3& p, const typename Spectral::Wavelengths& l) const noexcept {
+        if (!upper_.box().contains(p)) return Spectrum::Zero();
+        return Spectral::sample(unit_, l) * lower_[upper_.index_at(p)];
     }
 
     /// The control's share of the majorant, sum d_min / sum d_max over the cells (0 for an empty

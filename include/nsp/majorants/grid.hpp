@@ -328,11 +328,14 @@ public:
 
     /// The value of the cell holding point p (faces rounded to the cell above, clamped to the
     /// grid), 0 outside the box.
-    float at_point(const Vec3& p) const noexcept {
-        if (!box_.contains(p)) return 0.f;
+    float at_point(const Vec3& p) const noexcept { return box_.contains(p) ? values_[index_at(p)] : 0.f; }
+
+    /// The index into data() of the cell holding point p of the box (faces rounded to the cell
+    /// above, clamped to the grid).
+    std::size_t index_at(const Vec3& p) const noexcept {
         int c[3];
         for (int a = 0; a < 3; ++a) c[a] = std::clamp(int((p[a] - box_.lo[a]) / cell_[a]), 0, res_[a] - 1);
-        return at(c[0], c[1], c[2]);
+        return std::size_t(c[0]) + std::size_t(res_[0]) * (std::size_t(c[1]) + std::size_t(res_[1]) * std::size_t(c[2]));
     }
 
     /// The value of cell (x, y, z).
