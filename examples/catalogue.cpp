@@ -95,7 +95,7 @@ std::vector<SceneEntry> make_catalogue() {
                    {"ratio-nee_grey_absorb-weight", "uni-nee-mis_grey_balance_absorb-weight",
                     "equiangular-nee_grey_absorb-weight", "uni-nee-eq-mis_grey_absorb-weight",
                     "uni-nee-eq-mis_grey_balance_absorb-weight_learned"},
-                   // grid-control (decomposition tracking) takes the strategies without equiangular sampling
+                   // grid-control: decomposition tracking, equiangular vertices weighed by its two routes
                    {"global", "grid", "grid-control"},
                    // its NEE from tracked vertices near the lamp is weighted down by the equiangular pdf
                    // there: no 1/r^2 tail, unlike tracking + NEE

@@ -190,9 +190,8 @@ using MediumKinds = tl::list<DenseGridCloud, EmissivePlume>;
 ///   smoke is grey, so SpectralPathEstimator's emission rows would repeat PathEstimator's at about
 ///   twice the cost per sample; the tests cover them.
 /// - the grid control (GridControlPolicy) with PathEstimator in Mono and Rgb (the plume: Rgb, as
-///   its other rows), absorb-weight, and the strategies without equiangular sampling: what
-///   PathEstimator takes under a control (its static_assert), without the Hero<4> points the grey
-///   axis does not need.
+///   its other rows; the equiangular strategies: Mono, as under the other majorants), absorb-weight:
+///   what PathEstimator takes under a control, without the Hero<4> points the grey axis does not need.
 template <class Tuple>
 struct is_valid;
 template <class S, class CP, class Maj, class St, class H, class A, class Med>
@@ -214,8 +213,9 @@ struct is_valid<tl::list<S, CP, Maj, St, H, A, Med>> {
     static constexpr bool estimator_fits = grey || (S::channels > 1 && (St::null_pdfs || !St::combines));
     static constexpr bool build_fits = [] {
         if constexpr (std::is_same_v<Maj, GridControlPolicy>)
-            return grey && weight && !St::equiangular && S::channels <= 3 && !nsp::is_hero_v<S> &&
-                   (!Med::emissive || std::is_same_v<S, nsp::Rgb>);
+            return grey && weight && S::channels <= 3 && !nsp::is_hero_v<S> &&
+                   (St::equiangular ? std::is_same_v<S, nsp::Mono> && !Med::emissive
+                                    : !Med::emissive || std::is_same_v<S, nsp::Rgb>);
         else if constexpr (Med::emissive)
             return grey && std::is_same_v<S, nsp::Rgb> && Maj::bounding && weight && !St::equiangular;
         else if constexpr (St::equiangular) return grey && std::is_same_v<S, nsp::Mono>;
@@ -299,9 +299,9 @@ using CombinationsOf = tl::transform<
 // tracking max and average global, spectral MIS per-channel and global), and 5 pairs with the grid
 // majorants x absorb-weight (independent channel-grid, spectral tracking max and average grid,
 // spectral MIS grid and channel-grid). The emissive medium, in Rgb: the 6 grey rows with global and
-// grid, absorb-weight. The grid control, in Mono and Rgb: the 6 grey rows, absorb-weight, and in
-// Rgb 6 more on the emissive medium.
-static_assert(tl::size<CombinationsOf<nsp::Mono>> == 9 * 2 + (9 + 3) + 9 * 4 + 6);
+// grid, absorb-weight. The grid control, absorb-weight: in Mono the 9 grey rows, in Rgb the 6
+// without equiangular sampling and 6 more on the emissive medium.
+static_assert(tl::size<CombinationsOf<nsp::Mono>> == 9 * 2 + (9 + 3) + 9 * 4 + 9);
 static_assert(tl::size<CombinationsOf<nsp::Rgb>> == 6 * 2 + 6 + 5 * 3 * 2 + 5 * 3 + 6 * 3 + 6);
 static_assert(tl::size<CombinationsOf<Hero4>> == 6 * 2 + 6 + 5 * 3 * 2 + 5 * 3);
 

@@ -206,8 +206,8 @@ void list_combinations() {
     }
     std::printf("%zu valid combinations. channels 'grey' is nsp::PathEstimator (a grey majorant: global or grid, "
                 "and in mono also the non-bounding global-signed, global-clamp, grid-signed, grid-clamp; grid-control "
-                "(a grid with per-cell minorants: decomposition tracking) in mono and rgb for the strategies without "
-                "equiangular sampling; a "
+                "(a grid with per-cell minorants: decomposition tracking) in mono and rgb (the equiangular strategies "
+                "in mono); a "
                 "heuristic on a single strategy and mis::None on an MIS strategy are rejected); the others are "
                 "nsp::SpectralPathEstimator, only in multi-channel modes: independent tracking with a per-channel "
                 "majorant (per-channel, channel-grid), spectral tracking with a grey one (global, grid), "
