@@ -104,6 +104,24 @@ TEST_CASE_TEMPLATE("furnace under a control: albedo 1 under a unit environment g
 using AnalyticMediaCombos = decltype(std::tuple_cat(CombosOf<Mono, HomogeneousMedium>{}, CombosOf<Mono, ExponentialMedium>{},
                                                     CombosOf<Rgb, HomogeneousMedium>{}, CombosOf<Rgb, ExponentialMedium>{}));
 
+/// Runs `run(control, name, seed)` under the controls of the analytic media: on a homogeneous
+/// medium (kHomogeneous) its extinction itself, no null anywhere and one lookup per real
+/// collision; else a grid control of 8^3, a global control below the density (0.9 of its lower
+/// bound) and one above it over part of the box (halfway between its bounds: negative residuals,
+/// whose real events and nulls are weighed by sign, THEORY 5.10). Seeds from seed0, 10 apart.
+template <bool kHomogeneous, class M, class F>
+void for_each_control(const M& medium, const Box& box, int seed0, F&& run) {
+    if constexpr (kHomogeneous) {
+        run(GlobalControl<M>(medium, medium.coefficients(Vec3(0.f), {}).sigma_t()), "global control = extinction", seed0);
+    } else {
+        run(GridControl<M>(medium, 8), "grid control (8^3)", seed0);
+        run(GlobalControl<M>(medium, box_control(medium, 0.9f)), "global control", seed0 + 10);
+        const float above = 0.5f * (medium.density_lower_bound(box) + medium.density_bound(box));
+        run(GlobalControl<M>(medium, scale(medium.extinction_per_density(), above)), "global control above the density",
+            seed0 + 20);
+    }
+}
+
 TEST_CASE_TEMPLATE_DEFINE("single scattering under a control from a point light = quadrature", C, ctl_single) {
     using S = typename C::Spectral;
     using M = typename C::Medium;
@@ -117,7 +135,8 @@ TEST_CASE_TEMPLATE_DEFINE("single scattering under a control from a point light 
     const auto& ref = setup.ref;
     EstimatorOptions opts;
     opts.max_depth = 1;
-    auto run = [&](const auto& control, const std::string& name) {
+    for_each_control<std::is_same_v<M, HomogeneousMedium<S>>>(medium, box, 50, [&](const auto& control,
+                                                                                      const std::string& name, int) {
         const auto scene = Scene(medium, control, IsotropicPhase{}, lights);
         auto check = [&](const auto& est, int seed) {
             using E = std::remove_cvref_t<decltype(est)>;
@@ -128,30 +147,9 @@ TEST_CASE_TEMPLATE_DEFINE("single scattering under a control from a point light 
         check(PathEstimator<strategy::DirectionalMis, mis::Balance, A>(opts), 52);
         check(PathEstimator<strategy::NullScatteringMis, mis::Balance, A>(opts), 53);
         check(PathEstimator<strategy::NullScatteringMis, mis::Power, A>(opts), 54);
-    };
-    if constexpr (std::is_same_v<M, HomogeneousMedium<S>>) {
-        // The extinction itself as control: no null anywhere, one lookup per real collision.
-        run(GlobalControl<M>(medium, medium.coefficients(Vec3(0.f), {}).sigma_t()), "global control = extinction");
-    } else {
-        run(GridControl<M>(medium, 8), "grid control (8^3)");
-        run(GlobalControl<M>(medium, box_control(medium, 0.9f)), "global control");
-        // Above the density over part of the box: negative residuals, whose real events and nulls
-        // are weighed by sign (THEORY 5.10).
-        const float above = 0.5f * (medium.density_lower_bound(box) + medium.density_bound(box));
-        run(GlobalControl<M>(medium, scale(medium.extinction_per_density(), above)), "global control above the density");
-    }
+    });
 }
 TEST_CASE_TEMPLATE_APPLY(ctl_single, AnalyticMediaCombos);
-
-/// An emission grid over `b`, voxel values uniform in [0, 2 mean) from `seed` (all `mean` at seed 0).
-EmissionGrid control_emission(const Box& b, std::array<int, 3> res, float mean, std::uint64_t seed) {
-    std::vector<float> v(std::size_t(res[0] * res[1] * res[2]), mean);
-    if (seed != 0) {
-        Pcg32 rng(seed, 3);
-        for (float& x : v) x = 2.f * mean * rng.uniform();
-    }
-    return EmissionGrid(b, res, std::move(v));
-}
 
 // Volume emission under a control: the collision estimator visits every collision, control and
 // residual, with the medium's own coefficients, the rate mu_c + mu_bar_r and the null product
@@ -166,7 +164,7 @@ TEST_CASE_TEMPLATE_DEFINE("emitting absorber under a control = quadrature", C, c
     const Box box{Vec3(-1.f), Vec3(1.f)};
     // No scattering: L_c = int T_c mu_a,c L_e,c dt along the ray (references.hpp, Simpson in double).
     const M base = make_medium<M>(box, 0.9f, spec<S>(0.8f, 0.4f, 1.5f), grey<S>(0.f));
-    const EM medium(base, control_emission(Box{Vec3(-1.f, -0.8f, -1.2f), Vec3(0.9f, 1.f, 1.f)}, {5, 3, 4}, 1.f, 77),
+    const EM medium(base, make_emission(Box{Vec3(-1.f, -0.8f, -1.2f), Vec3(0.9f, 1.f, 1.f)}, {5, 3, 4}, 1.f, 77),
                     spec<S>(2.f, 1.f, 0.5f), {6, 5, 4});
     const Ray ray{Vec3(-3.f, 0.25f, -0.3f), glm::normalize(Vec3(1.f, -0.05f, 0.12f))};
     const auto ref = emitting_absorber_reference(base, medium, ray);
@@ -187,14 +185,7 @@ TEST_CASE_TEMPLATE_DEFINE("emitting absorber under a control = quadrature", C, c
         };
         std::apply([&](const auto&... e) { (each(e), ...); }, ControlEstimators<A>{});
     };
-    if constexpr (std::is_same_v<M, HomogeneousMedium<S>>) {
-        run(GlobalControl<EM>(medium, medium.coefficients(Vec3(0.f), {}).sigma_t()), "global control = extinction", 60);
-    } else {
-        run(GridControl<EM>(medium, 8), "grid control (8^3)", 60);
-        const float above = 0.5f * (medium.density_lower_bound(box) + medium.density_bound(box));
-        run(GlobalControl<EM>(medium, scale(medium.extinction_per_density(), above)), "global control above the density",
-            80);
-    }
+    for_each_control<std::is_same_v<M, HomogeneousMedium<S>>>(medium, box, 60, run);
 }
 TEST_CASE_TEMPLATE_APPLY(ctl_absorber, AnalyticMediaCombos);
 
@@ -231,7 +222,7 @@ TEST_CASE_TEMPLATE("emissive furnace under a control: L_e equal to the environme
     };
     using Exp = Emissive<ExponentialMedium<S>>;
     using Grid = Emissive<DenseGridMedium<S>>;
-    const auto emission = control_emission(box, {3, 2, 4}, 1.f, 0);
+    const auto emission = make_emission(box, {3, 2, 4}, 1.f, 0);
     const Exp exp_medium(make_medium<ExponentialMedium<S>>(box, 1.f, spec<S>(0.5f, 0.3f, 0.8f), spec<S>(0.6f, 0.9f, 0.3f)),
                          emission, le, {4, 4, 4});
     const Grid grid_medium(make_medium<DenseGridMedium<S>>(box, 1.f, spec<S>(0.5f, 0.3f, 0.8f), spec<S>(0.6f, 0.9f, 0.3f)),
@@ -284,15 +275,7 @@ TEST_CASE_TEMPLATE_DEFINE("equiangular strategies under a control: single scatte
         some.equiangular_count = 0.4f;
         each(PathEstimator<strategy::EquiangularMis, mis::Balance, A>(some));
     };
-    if constexpr (std::is_same_v<M, HomogeneousMedium<S>>) {
-        run(GlobalControl<M>(medium, medium.coefficients(Vec3(0.f), {}).sigma_t()), "global control = extinction", 90);
-    } else {
-        run(GridControl<M>(medium, 8), "grid control (8^3)", 90);
-        run(GlobalControl<M>(medium, box_control(medium, 0.9f)), "global control", 100);
-        const float above = 0.5f * (medium.density_lower_bound(box) + medium.density_bound(box));
-        run(GlobalControl<M>(medium, scale(medium.extinction_per_density(), above)), "global control above the density",
-            110);
-    }
+    for_each_control<std::is_same_v<M, HomogeneousMedium<S>>>(medium, box, 90, run);
 }
 TEST_CASE_TEMPLATE_APPLY(ctl_eq_single, AnalyticMediaCombos);
 

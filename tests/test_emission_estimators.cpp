@@ -33,17 +33,6 @@ using EmissionEstimatorsWith = std::tuple<PathEstimator<strategy::Unidirectional
 using AnalyticCombosForEmission = decltype(std::tuple_cat(CombosOf<Mono, HomogeneousMedium>{}, CombosOf<Mono, ExponentialMedium>{},
                                                           CombosOf<Rgb, HomogeneousMedium>{}, CombosOf<Rgb, ExponentialMedium>{}));
 
-/// An emission grid over `b` (voxel values uniform in [0, 2 mean) from `seed`, or all `mean`
-/// when seed is 0).
-EmissionGrid make_emission(const Box& b, std::array<int, 3> res, float mean, std::uint64_t seed) {
-    std::vector<float> v(std::size_t(res[0] * res[1] * res[2]), mean);
-    if (seed != 0) {
-        Pcg32 rng(seed, 3);
-        for (float& x : v) x = 2.f * mean * rng.uniform();
-    }
-    return EmissionGrid(b, res, std::move(v));
-}
-
 /// Which estimators of EmissionEstimatorsWith<A> a check runs.
 /// - kAll: every one.
 /// - kFiniteVariance: all but NEE alone (ratio-nee). Where the path scatters inside the emitting

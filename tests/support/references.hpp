@@ -4,6 +4,8 @@
 
 #include <array>
 #include <cmath>
+#include <cstdint>
+#include <vector>
 
 #include "common.hpp"
 
@@ -40,6 +42,17 @@ inline std::array<double, 3> single_scatter_reference(const M& medium, const Ray
     }
     for (int c = 0; c < 3; ++c) sum[c] *= (th1 - th0) / (3.0 * n) * intensity / (4.0 * kPi);
     return sum;
+}
+
+/// An emission grid over `b`, voxel values uniform in [0, 2 mean) from `seed` (all `mean` at
+/// seed 0): the emission tests' spatially varying L_e.
+inline EmissionGrid make_emission(const Box& b, std::array<int, 3> res, float mean, std::uint64_t seed) {
+    std::vector<float> v(std::size_t(res[0] * res[1] * res[2]), mean);
+    if (seed != 0) {
+        Pcg32 rng(seed, 3);
+        for (float& x : v) x = 2.f * mean * rng.uniform();
+    }
+    return EmissionGrid(b, res, std::move(v));
 }
 
 /// Emission of a non-scattering medium along `ray`: L_c = int T_c(0, t) mu_a,c(t) L_e,c(t) dt over
