@@ -55,6 +55,34 @@ typename M::Spectral::Coefficient box_control(const M& medium, float f) {
     return scale(medium.extinction_per_density(), f * medium.density_lower_bound(medium.bounds()));
 }
 
+/// The furnaces' media and controls: `run_all(medium, control, name, seed)` on an exponential
+/// medium and a noise grid over `box`, albedo 1 (mu_a = 0), optical thickness a few across, mildly
+/// chromatic in Rgb. The grey axis drives every channel with one pdf, and under the grey control
+/// (the smallest channel's) a channel far above it carries null weights far from 1: at 1 : 0.5 : 2
+/// the densest channel's furnace estimates were heavy-tailed under the grid majorant too (channel
+/// 2 of three seeds at 40000 paths: 0.93, 0.96, 0.88 with SEs 0.05), so the sample SE of 4000
+/// paths understated the error. Chromatic residuals are checked against quadrature below and
+/// against closed forms in test_decomposition.cpp. Controls: grid (both media), global below the
+/// density, and global a fifth of the way from the density's lower to its upper bound: above the
+/// density near the lower bound's side only. Further up, multiple scattering through negative
+/// residuals multiplies null weights above 1 over many nulls: at halfway the furnace's SEs were
+/// 20-100x the answer. Seeds seed0, seed0 + step, ...
+template <SpectralMode S, class F>
+void furnace_controls(const Box& box, F&& run_all, int seed0, int step) {
+    using Exp = ExponentialMedium<S>;
+    using Grid = DenseGridMedium<S>;
+    const auto exp_medium = make_medium<Exp>(box, 1.5f, spec<S>(0.f, 0.f, 0.f), spec<S>(1.f, 0.8f, 1.25f));
+    const auto grid_medium = make_medium<Grid>(box, 1.5f, spec<S>(0.f, 0.f, 0.f), spec<S>(1.f, 0.8f, 1.25f));
+    run_all(exp_medium, GridControl<Exp>(exp_medium, 8), "exponential, grid control", std::uint64_t(seed0));
+    run_all(exp_medium, GlobalControl<Exp>(exp_medium, box_control(exp_medium, 0.9f)), "exponential, global control",
+            std::uint64_t(seed0 + step));
+    run_all(grid_medium, GridControl<Grid>(grid_medium, 8), "noise grid, grid control", std::uint64_t(seed0 + 2 * step));
+    const float lo = exp_medium.density_lower_bound(box);
+    const float above = lo + 0.2f * (exp_medium.density_bound(box) - lo);
+    run_all(exp_medium, GlobalControl<Exp>(exp_medium, scale(exp_medium.extinction_per_density(), above)),
+            "exponential, global control above the density", std::uint64_t(seed0 + 3 * step));
+}
+
 TEST_CASE_TEMPLATE("furnace under a control: albedo 1 under a unit environment gives 1", S, Mono, Rgb) {
     const Box box{Vec3(-1.f), Vec3(1.f)};
     Lights<S> lights;
@@ -77,27 +105,7 @@ TEST_CASE_TEMPLATE("furnace under a control: albedo 1 under a unit environment g
         std::apply([&](const auto&... e) { (each(e), ...); }, ControlEstimators<absorption::Weight>{});
         each(PathEstimator<strategy::NullScatteringMis, mis::Balance, absorption::Event>{});
     };
-    using Exp = ExponentialMedium<S>;
-    using Grid = DenseGridMedium<S>;
-    // Albedo 1 (mu_a = 0), optical thickness a few across the box, mildly chromatic in Rgb. The grey
-    // axis drives every channel with one pdf, and under the grey control (the smallest channel's) a
-    // channel far above it carries null weights far from 1: at 1 : 0.5 : 2 the densest channel's
-    // furnace estimates were heavy-tailed under the grid majorant too (channel 2 of three seeds at
-    // 40000 paths: 0.93, 0.96, 0.88 with SEs 0.05), so the sample SE of 4000 paths understated the
-    // error. Chromatic residuals are checked against quadrature below and against closed forms in
-    // test_decomposition.cpp.
-    const auto exp_medium = make_medium<Exp>(box, 1.5f, spec<S>(0.f, 0.f, 0.f), spec<S>(1.f, 0.8f, 1.25f));
-    const auto grid_medium = make_medium<Grid>(box, 1.5f, spec<S>(0.f, 0.f, 0.f), spec<S>(1.f, 0.8f, 1.25f));
-    run_all(exp_medium, GridControl<Exp>(exp_medium, 8), "exponential, grid control", 40);
-    run_all(exp_medium, GlobalControl<Exp>(exp_medium, box_control(exp_medium, 0.9f)), "exponential, global control", 42);
-    run_all(grid_medium, GridControl<Grid>(grid_medium, 8), "noise grid, grid control", 44);
-    // A fifth of the way from the density's lower to its upper bound: above the density near the
-    // lower bound's side only. Further up, multiple scattering through negative residuals multiplies
-    // null weights above 1 over many nulls: at halfway the furnace's SEs were 20-100x the answer.
-    const float lo = exp_medium.density_lower_bound(box);
-    const float above = lo + 0.2f * (exp_medium.density_bound(box) - lo);
-    run_all(exp_medium, GlobalControl<Exp>(exp_medium, scale(exp_medium.extinction_per_density(), above)),
-            "exponential, global control above the density", 46);
+    furnace_controls<S>(box, run_all, 40, 2);
 }
 
 /// The media with a closed-form optical depth: {Mono, Rgb} x {homogeneous, exponential} x absorption.
@@ -298,17 +306,7 @@ TEST_CASE_TEMPLATE("equiangular furnace under a control: albedo 1 with a point l
         std::apply([&](const auto&... e) { (each(e), ...); }, EquiangularControlEstimators<absorption::Weight>{});
         each(PathEstimator<strategy::EquiangularMis, mis::Balance, absorption::Event>{});
     };
-    using Exp = ExponentialMedium<S>;
-    using Grid = DenseGridMedium<S>;
-    // Mildly chromatic in Rgb, as the furnace above (the grey axis's control is the smallest channel's).
-    const auto exp_medium = make_medium<Exp>(box, 1.5f, spec<S>(0.f, 0.f, 0.f), spec<S>(1.f, 0.8f, 1.25f));
-    const auto grid_medium = make_medium<Grid>(box, 1.5f, spec<S>(0.f, 0.f, 0.f), spec<S>(1.f, 0.8f, 1.25f));
-    run_all(exp_medium, GridControl<Exp>(exp_medium, 8), "exponential, grid control", 700);
-    run_all(grid_medium, GridControl<Grid>(grid_medium, 8), "noise grid, grid control", 720);
-    const float lo = exp_medium.density_lower_bound(box);  // a fifth of the way up, as the furnace above
-    const float above = lo + 0.2f * (exp_medium.density_bound(box) - lo);
-    run_all(exp_medium, GlobalControl<Exp>(exp_medium, scale(exp_medium.extinction_per_density(), above)),
-            "exponential, global control above the density", 740);
+    furnace_controls<S>(box, run_all, 700, 20);
 }
 
 TEST_CASE("decomposition_event_densities: delta tracking's mu_bar P_x under a minorant, both routes' sum above it") {
