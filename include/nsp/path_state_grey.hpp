@@ -214,9 +214,9 @@ public:
 
     /// An equiangular vertex x drawn on the current piece with density `eq_pdf` (select x the
     /// mixture's) after the walk `w` over the nulls before it, coefficients k and majorant mu there
-    /// (THEORY 5.4; w: the piece ratio-tracked up to x) and under a control the grey control `ctl`
-    /// (tracking's density is then decomposition tracking's, THEORY 5.10): the vertex NEE starts from, or nothing
-    /// where it carries nothing. Its roulette survival is the one tracking would give x, a
+    /// (THEORY 5.4; w: the piece ratio-tracked up to x), and under a control the grey control
+    /// `ctl` there (tracking's density is then decomposition tracking's, THEORY 5.10): the vertex
+    /// NEE starts from, or nothing where it carries nothing. Its roulette survival is the one tracking would give x, a
     /// function of the path.
     template <class Coeff, class Mu>
     std::optional<VertexRecord<P, S>> equiangular_vertex(const ShadowPiece<P, S>& w, const Coeff& k, const Mu& mu,

@@ -255,6 +255,14 @@ void to_control(Coefficients<S>& k, float ctl) noexcept {
     k.sigma_a = ctl - k.sigma_s;
 }
 
+/// A real absorption's and a real scattering's density at a point (decomposition_event_densities).
+struct EventDensities {
+    float absorb = 0.f, scatter = 0.f;
+};
+
+/// Nothing, in a member that a policy without a control does not keep.
+struct Empty {};
+
 /// The densities, over the shared null factors, with which decomposition tracking (THEORY 5.10)
 /// draws a real absorption and a real scattering event at a point whose lookup is `k` (after the
 /// bound policy), grey control `ctl` and segment majorant `mu_bar`: the control route's
@@ -262,11 +270,6 @@ void to_control(Coefficients<S>& k, float ctl) noexcept {
 /// (every channel's residual >= 0) every term is linear in the coefficients and the sum is delta
 /// tracking's mu_bar P_x; where the control exceeds the extinction the residual's events are drawn
 /// by |r| and the sum is larger. A control of 0 gives delta tracking's densities.
-struct EventDensities {
-    float absorb = 0.f, scatter = 0.f;
-};
-/// Nothing, in a member that a policy without a control does not keep.
-struct Empty {};
 template <AbsorptionPolicy A, SpectralMode S>
 EventDensities decomposition_event_densities(const Coefficients<S>& k, float ctl, float mu_bar) noexcept {
     const float rate = mu_bar - ctl;
@@ -702,7 +705,7 @@ struct RatioCollision {
 /// Delta-tracks `ray` over [0, tmax] as `track_delta` does, calling `visit` at every tentative
 /// collision (see DeltaCollision); under a control at every control and residual collision, with
 /// the medium's own coefficients, the segment's majorant and the null product with exp(-tau_c) so
-/// far (DeltaCollision::visit_collision).
+/// far (DeltaCollision::before_event).
 template <AbsorptionPolicy A, Medium M, MajorantPolicy<M> Maj, UniformRng R, LookupCounter C, class Visit,
           class Rec = NoRecord>
 DeltaTrack<typename M::Spectral> track_delta_visiting(const M& medium, const Maj& majorant, const Ray& ray,

@@ -143,7 +143,7 @@ MajorantCost choose_grid_resolution(const M& medium, int max_res = 64, float ste
 /// control: the loop's control is grey (the smallest channel's), the denser channels' residual
 /// nulls then weigh far from 1, and the variance that costs (2-7x on the chromatic cloud at 16^3,
 /// docs/transmittance.md) is not in a model of lookups. The estimators that take a control are
-/// PathEstimator's without equiangular sampling (THEORY 5.10); the
+/// PathEstimator's, every strategy (THEORY 5.10; SpectralPathEstimator and BDPT do not); the
 /// caller decides whether its estimator is one. Throws as choose_grid_resolution.
 template <CellBoundedMedium M>
 MajorantCost choose_majorant(const M& medium, int max_res = 64, float step_cost = kDefaultStepCost,
