@@ -210,22 +210,17 @@ std::vector<VolumeRow> load_volumes(const Options& o) {
         if (ext == ".vol")
             throw nsp_examples::UsageError("--volume '" + path + "': a .nvdb or .vdb file is needed (a sparse NanoVDB "
                                            "grid); the table's example media are dense grids already");
-        try {
-            nsp_examples::require_format(path, ext);
-        } catch (const nsp::InvalidArgument& e) {
-            throw nsp_examples::UsageError(std::string("--volume ") + e.what());
-        }
+        nsp_examples::usage_checked([&] { nsp_examples::require_format(path, ext); });
         nsp_examples::require_regular_file(path, "a volume file");
 #if NSP_HAVE_NANOVDB
-        std::shared_ptr<const io::NanoDensityGrid> g;
-        try {
+        const auto g = nsp_examples::usage_checked([&] {
+            std::shared_ptr<const io::NanoDensityGrid> grid;
 #if NSP_HAVE_OPENVDB
-            if (ext == ".vdb") g = io::load_vdb(path, o.grid_name);
+            if (ext == ".vdb") grid = io::load_vdb(path, o.grid_name);
 #endif
-            if (ext == ".nvdb") g = io::load_nvdb(path, o.grid_name);
-        } catch (const nsp::InvalidArgument& e) {
-            throw nsp_examples::UsageError(std::string("--volume ") + e.what());
-        }
+            if (ext == ".nvdb") grid = io::load_nvdb(path, o.grid_name);
+            return grid;
+        });
         const std::string base = path.substr(path.find_last_of('/') == std::string::npos ? 0 : path.find_last_of('/') + 1);
         char scale[32];
         std::snprintf(scale, sizeof scale, "%g", double(o.density_scale));

@@ -260,16 +260,7 @@ int render(const M& medium, const VolumeOptions& o, const char* mode, const char
     return nsp_examples::kExitRuntime;
 }
 
-/// f(), with the library's nsp::InvalidArgument (a loader's or a constructor's message: a bad file
-/// or a value the medium rejects) turned into a usage error.
-template <class F>
-auto usage_checked(F&& f) {
-    try {
-        return f();
-    } catch (const nsp::InvalidArgument& e) {
-        throw nsp_examples::UsageError(e.what());
-    }
-}
+using nsp_examples::usage_checked;
 
 /// --export-cloud / --export-plume: the path checked first (format, directory), then written.
 int export_volume(const VolumeOptions& o) {

@@ -13,6 +13,7 @@
 #include <nsp/io/vol.hpp>
 
 #include "default_scene.hpp"
+#include "tool.hpp"
 #include "volume_data.hpp"
 
 #if NSP_HAVE_NANOVDB
@@ -31,6 +32,17 @@ inline std::string extension_of(const std::string& path) {
     std::string e = path.substr(dot);
     for (char& c : e) c = char(std::tolower(static_cast<unsigned char>(c)));
     return e;
+}
+
+/// f(), with the library's nsp::InvalidArgument (a loader's or a constructor's message: a bad file
+/// or a value the medium rejects) turned into a usage error.
+template <class F>
+auto usage_checked(F&& f) {
+    try {
+        return f();
+    } catch (const nsp::InvalidArgument& e) {
+        throw UsageError(e.what());
+    }
 }
 
 /// Fails unless this build reads and writes files of extension `ext`.
