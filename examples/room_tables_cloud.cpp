@@ -1,7 +1,8 @@
 // examples/room_tables_cloud.cpp: nsp_room's tables of the main job's cloud in empty space (on
 // request, --tables cloud: set-ups A and B) as a SurfaceScene whose sphere light is a shape the
 // geometry reports, through nsp_render's camera: the path tracers against BDPT with light
-// tracing, plain, with a fixed light subpath probability and with its counts learned.
+// tracing, plain, with a fixed light subpath probability and with its counts learned; then
+// uni + NEE MIS and BDPT under a grid control.
 #include <algorithm>
 #include <cstdio>
 
@@ -32,6 +33,12 @@ std::vector<RoomTable> cloud_tables(const RoomOptions& o) {
         rows.pinhole(cloud, camera, BdptEstimator<bdpt::NullScattering, mis::Balance>(BdptEstimator<>::default_options(), {}, 0.25f),
                      "bdpt_null-mis_balance_light-0.25");  // a light subpath on 1/4 of the samples
         rows.learned_bdpt(cloud, camera, "bdpt_null-mis_balance_learned", bdpt::Grey{});
+        // Under a grid control of 16^3 (decomposition tracking, residual ratio tracking: THEORY 5.10).
+        const auto controlled = share(make_cloud_surface_scene_controlled(setup, 16));
+        rows.pinhole(controlled, camera, PathEstimator<strategy::NullScatteringMis, mis::Balance>{},
+                     "uni-nee-mis_balance_grid-control");
+        rows.pinhole(controlled, camera, BdptEstimator<bdpt::NullScattering, mis::Balance>{},
+                     "bdpt_null-mis_balance_grid-control");
         t.summary = [name = a ? "A" : "B"](const std::vector<Row>& r) {
             const double best_path = best_cost(r, 2, {0, 1, 2});
             std::printf("cloud %s: bdpt_null-mis_balance / best path tracer in cpu-s*var: %.3g; / "
@@ -39,6 +46,9 @@ std::vector<RoomTable> cloud_tables(const RoomOptions& o) {
                         name, cost(r, 4) / best_path, cost(r, 4) / cost(r, 3));
             std::printf("cloud %s: bdpt_null-mis_balance_learned / best path tracer in cpu-s*var: %.3g\n", name,
                         cost(r, 6) / best_path);
+            std::printf("cloud %s under a grid control: uni-nee-mis_balance / best path tracer in cpu-s*var: %.3g; "
+                        "bdpt_null-mis_balance / bdpt_null-mis_balance without: %.3g\n",
+                        name, cost(r, 7) / best_path, cost(r, 8) / cost(r, 4));
         };
     }
     return tables;

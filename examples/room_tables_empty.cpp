@@ -1,7 +1,7 @@
 // examples/room_tables_empty.cpp: nsp_room's tables of nsp_render's other scenes in empty space,
 // as SurfaceScenes through its camera (on request, --tables empty: the set-ups SA, F1-F3, C1, C2
 // and P1): the path tracers against BDPT with light tracing, plain and with its counts learned
-// over the image.
+// over the image, and uni + NEE MIS and BDPT under a grid control.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -58,10 +58,12 @@ bool wanted(const SceneChoice& c, const RoomOptions& o) {
 /// The grey pdfs' rows of scene `sc`: the path tracers (with the equiangular one when
 /// `equiangular`), BDPT, BDPT learned (and then, where a point light gives BDPT its equiangular
 /// strategy, BDPT without it; where an emitting medium gives BDPT its segment technique, BDPT
-/// without that; with `fixed_light` BDPT with that light subpath probability).
-template <class Sc, bool kEquiangular>
-RoomTable grey_empty_table(std::shared_ptr<const Sc> sc, const SceneChoice& c, const char* mode,
-                           std::bool_constant<kEquiangular>, const RoomOptions& o, float fixed_light = 0.f) {
+/// without that; with `fixed_light` BDPT with that light subpath probability), and last uni + NEE
+/// MIS and BDPT on `controlled`, the scene under a grid control of the same cells (THEORY 5.10).
+template <class Sc, class CtlSc, bool kEquiangular>
+RoomTable grey_empty_table(std::shared_ptr<const Sc> sc, std::shared_ptr<const CtlSc> controlled, const SceneChoice& c,
+                           const char* mode, std::bool_constant<kEquiangular>, const RoomOptions& o,
+                           float fixed_light = 0.f) {
     RoomTable t = empty_table(c, mode, kEquiangular ? 4 : 3, o);
     const PinholeCamera camera = cloud_pinhole();
     RowMaker rows(t, o, first_empty_seed(c, o));
@@ -89,6 +91,9 @@ RoomTable grey_empty_table(std::shared_ptr<const Sc> sc, const SceneChoice& c, c
     if (fixed_light > 0.f)  // a fixed light subpath probability, after the learned row
         rows.pinhole(sc, camera, BdptEstimator<bdpt::NullScattering, mis::Balance>(kDepth, {}, fixed_light),
                      "bdpt_null-mis_balance_light-1/" + std::to_string(int(std::lround(1.f / fixed_light))));
+    rows.pinhole(controlled, camera, PathEstimator<strategy::NullScatteringMis, mis::Balance>(kDepth),
+                 "uni-nee-mis_balance_grid-control");
+    rows.pinhole(controlled, camera, BdptEstimator<bdpt::NullScattering, mis::Balance>{}, "bdpt_null-mis_balance_grid-control");
     return t;
 }
 
@@ -127,6 +132,7 @@ std::vector<RoomTable> empty_tables(const RoomOptions& o) {
                                 SceneChoice{SceneKind::Fog, {}, {}, FogSetup::F2}, SceneChoice{SceneKind::Fog, {}, {}, FogSetup::F3}})
         if (wanted(c, o))
             tables.push_back(grey_empty_table(share(make_setup_surface_scene<Mono, DenseGridCloud, GridMajorantPolicy<>>(c)),
+                                              share(make_setup_surface_scene<Mono, DenseGridCloud, GridControlPolicy>(c)),
                                               c, "mono, grid majorant", std::true_type{}, o));
     for (const SceneChoice c : {SceneChoice{SceneKind::Chromatic, {}, ChromaticSetup::Env},
                                 SceneChoice{SceneKind::Chromatic, {}, ChromaticSetup::Small}})
@@ -134,7 +140,8 @@ std::vector<RoomTable> empty_tables(const RoomOptions& o) {
     // The plume (an emissive medium, no other light); Rgb (its flame's colour), grid majorant;
     // BDPT also with light subpaths on 1/64 of the samples.
     if (const SceneChoice c{SceneKind::Plume}; wanted(c, o))
-        tables.push_back(grey_empty_table(share(make_setup_surface_scene<Rgb, EmissivePlume, GridMajorantPolicy<>>(c)), c,
+        tables.push_back(grey_empty_table(share(make_setup_surface_scene<Rgb, EmissivePlume, GridMajorantPolicy<>>(c)),
+                                          share(make_setup_surface_scene<Rgb, EmissivePlume, GridControlPolicy>(c)), c,
                                           "rgb, grid majorant", std::false_type{}, o, 1.f / 64.f));
     return tables;
 }

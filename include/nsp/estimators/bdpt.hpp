@@ -213,9 +213,11 @@ private:
             static_assert(!is_per_channel_majorant_v<typename Sc::MajorantType, typename Sc::MediumType>,
                           "nsp::BdptEstimator<..., bdpt::Grey> drives every channel with one pdf and needs a grey "
                           "majorant (channels::SpectralMis: one per channel)");
-        static_assert(!is_control_v<typename Sc::MajorantType, typename Sc::MediumType>,
-                      "nsp::BdptEstimator does not track under a control (GridControl, GlobalControl): its pdfs "
-                      "are the full majorant's; use GridMajorant or GlobalMajorant");
+        else
+            static_assert(!is_control_v<typename Sc::MajorantType, typename Sc::MediumType>,
+                          "nsp::BdptEstimator<..., channels::SpectralMis> does not track under a control (GridControl, "
+                          "GlobalControl): its channel trackers walk the full majorant; use GridMajorant or "
+                          "GlobalMajorant, or the grey axis (bdpt::Grey)");
 
         static_assert(std::remove_cvref_t<decltype(std::declval<Sc>().lights)>::bidirectional_ready(),
                       "nsp::BdptEstimator: every light model must start light subpaths (EmittingLight: "

@@ -179,9 +179,13 @@ void BdptEstimator<Mis, H, A, MaxDepth, Ch>::BdptSample<Sc, Cam, R, C, Splat, Ob
     x.wo = ray.d;
     x.beta = beta * sh.tr * c->k.sigma_s / ds.pdf;
     x.nulls_in = sh.nulls;
-    // Tracking's event density mu_bar P_s at x (per channel, every channel's).
+    // Tracking's event density mu_bar P_s at x (per channel, every channel's); under a control,
+    // decomposition tracking's: the sum of its control and residual routes (THEORY 5.10), as the
+    // walk's DeltaTrack::event_density.
     if constexpr (kPerChannel)
         x.event = channel_event_densities<A, typename Sc::Spectral>(c->k, majorants<P>(c->mu)).scatter;
+    else if (c->ctl > 0.f)
+        x.event = nsp::detail::decomposition_event_densities<A>(c->k, c->ctl, c->mu).scatter;
     else
         x.event = c->mu * event_probabilities<A>(c->k, c->mu).scatter;
     const float pd = z.kind == VertexKind::Camera && !(pdf_dir > 0.f) ? 1.f : pdf_dir;  // as the walk's
