@@ -191,7 +191,9 @@ using MediumKinds = tl::list<DenseGridCloud, EmissivePlume>;
 ///   twice the cost per sample; the tests cover them.
 /// - the grid control (GridControlPolicy) with PathEstimator in Mono and Rgb (the plume: Rgb, as
 ///   its other rows; the equiangular strategies: Mono, as under the other majorants), absorb-weight:
-///   what PathEstimator takes under a control, without the Hero<4> points the grey axis does not need.
+///   what PathEstimator takes under a control, without the Hero<4> points the grey axis does not need;
+///   and with SpectralPathEstimator in Rgb on the cloud (spectral MIS and spectral tracking, which
+///   take a grey majorant; no equiangular or emissive points, as under the other majorants).
 template <class Tuple>
 struct is_valid;
 template <class S, class CP, class Maj, class St, class H, class A, class Med>
@@ -212,10 +214,14 @@ struct is_valid<tl::list<S, CP, Maj, St, H, A, Med>> {
     }();
     static constexpr bool estimator_fits = grey || (S::channels > 1 && (St::null_pdfs || !St::combines));
     static constexpr bool build_fits = [] {
-        if constexpr (std::is_same_v<Maj, GridControlPolicy>)
-            return grey && weight && S::channels <= 3 && !nsp::is_hero_v<S> &&
-                   (St::equiangular ? std::is_same_v<S, nsp::Mono> && !Med::emissive
-                                    : !Med::emissive || std::is_same_v<S, nsp::Rgb>);
+        if constexpr (std::is_same_v<Maj, GridControlPolicy>) {
+            if constexpr (!grey)  // spectral MIS and spectral tracking on the cloud, in Rgb
+                return weight && std::is_same_v<S, nsp::Rgb> && !Med::emissive && !St::equiangular;
+            else
+                return weight && S::channels <= 3 && !nsp::is_hero_v<S> &&
+                       (St::equiangular ? std::is_same_v<S, nsp::Mono> && !Med::emissive
+                                        : !Med::emissive || std::is_same_v<S, nsp::Rgb>);
+        }
         else if constexpr (Med::emissive)
             return grey && std::is_same_v<S, nsp::Rgb> && Maj::bounding && weight && !St::equiangular;
         else if constexpr (St::equiangular) return grey && std::is_same_v<S, nsp::Mono>;
@@ -300,9 +306,10 @@ using CombinationsOf = tl::transform<
 // majorants x absorb-weight (independent channel-grid, spectral tracking max and average grid,
 // spectral MIS grid and channel-grid). The emissive medium, in Rgb: the 6 grey rows with global and
 // grid, absorb-weight. The grid control, absorb-weight: in Mono the 9 grey rows, in Rgb the 6
-// without equiangular sampling and 6 more on the emissive medium.
+// without equiangular sampling, 6 more on the emissive medium, and 3 channel policies (spectral
+// tracking max and average, spectral MIS) x the 3 spectral strategies.
 static_assert(tl::size<CombinationsOf<nsp::Mono>> == 9 * 2 + (9 + 3) + 9 * 4 + 9);
-static_assert(tl::size<CombinationsOf<nsp::Rgb>> == 6 * 2 + 6 + 5 * 3 * 2 + 5 * 3 + 6 * 3 + 6);
+static_assert(tl::size<CombinationsOf<nsp::Rgb>> == 6 * 2 + 6 + 5 * 3 * 2 + 5 * 3 + 6 * 3 + 6 + 3 * 3);
 static_assert(tl::size<CombinationsOf<Hero4>> == 6 * 2 + 6 + 5 * 3 * 2 + 5 * 3);
 
 /// What the driver knows of one combination at run time: its names and traits as plain data, so

@@ -7,7 +7,8 @@
 // signed residuals), Mono and Rgb, both absorption policies, every strategy without equiangular
 // sampling. Volume emission under a control (the collision estimator, the segment technique, NEE
 // toward the volume and their MIS): an emitting absorber against quadrature and the emissive
-// furnace.
+// furnace. SpectralPathEstimator under a control (every channel's pdfs over both routes), every
+// channel policy with a grey majorant, against the same closed forms.
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -345,6 +346,197 @@ TEST_CASE("decomposition_event_densities: delta tracking's mu_bar P_x under a mi
                                             : 0.0;
         CHECK(double(du.scatter) == doctest::Approx(ctl_part + res_part).epsilon(1e-4).scale(1e-6));
         CHECK(double(du.scatter) >= double(mu_bar * full.scatter) - 1e-5);  // never below delta tracking's
+    }
+}
+
+}  // namespace
+
+namespace {
+
+// SpectralPathEstimator under a control (THEORY 5.10 with 5.3): the sampling channel's
+// decomposition tracking chooses each control or residual collision's event with that route's
+// densities; every channel's pdf of a real vertex is the sum over both routes (a residual null's
+// the residual's), the contributions the medium's own, and exp(-tau_c) joins f and uni; shadow rays
+// and the equiangular and emission techniques' nulls by residual ratio tracking. Every channel
+// policy that takes a grey majorant, against the same closed forms as PathEstimator above.
+
+/// "spectral-mis/null-scattering-mis/balance/absorb-weight" and the like.
+template <class E>
+std::string spectral_name() {
+    return std::string(E::Channels::name) + "/" + estimator_name<E>();
+}
+
+/// Runs `each(est)` over spectral MIS's three strategies and, under null-scattering MIS, the other
+/// channel policies with a grey majorant: independent tracking (each channel its own pdf, one
+/// estimated per path) and spectral tracking (one shared pdf: channel maxima, and the
+/// throughput-weighted average).
+template <AbsorptionPolicy A, class F>
+void for_each_spectral(F&& each) {
+    each(SpectralPathEstimator<channels::SpectralMis, strategy::Unidirectional, mis::None, A>{});
+    each(SpectralPathEstimator<channels::SpectralMis, strategy::NextEvent, mis::None, A>{});
+    each(SpectralPathEstimator<channels::SpectralMis, strategy::NullScatteringMis, mis::Balance, A>{});
+    each(SpectralPathEstimator<channels::Independent, strategy::NullScatteringMis, mis::Balance, A>{});
+    each(SpectralPathEstimator<channels::SpectralTrackingMax, strategy::NullScatteringMis, mis::Balance, A>{});
+    each(SpectralPathEstimator<channels::SpectralTrackingAverage, strategy::NullScatteringMis, mis::Balance, A>{});
+}
+
+TEST_CASE("spectral estimators under a control: albedo 1 under a unit environment gives 1") {
+    // The furnace of PathEstimator's test above (multiple scattering, two rays, the same media
+    // and controls), Rgb: every channel's own pdfs (spectral MIS, independent) or one shared one.
+    const Box box{Vec3(-1.f), Vec3(1.f)};
+    Lights<Rgb> lights;
+    lights.set(EnvironmentLight<Rgb>{grey<Rgb>(1.f)});
+    const Ray rays[] = {
+        {Vec3(-3.f, 0.2f, 0.1f), glm::normalize(Vec3(1.f, -0.05f, 0.02f))},
+        {Vec3(0.1f, -0.2f, 0.3f), glm::normalize(Vec3(0.3f, 0.9f, -0.2f))},
+    };
+    auto run_all = [&](const auto& medium, const auto& control, const std::string& name, std::uint64_t seed) {
+        const Scene scene(medium, control, HenyeyGreensteinPhase(0.5f), lights);
+        auto each = [&](const auto& est) {
+            using E = std::remove_cvref_t<decltype(est)>;
+            for (int r = 0; r < 2; ++r) {
+                const auto res = estimate_radiance(est, scene, rays[r], 4000, seed + std::uint64_t(r));
+                CHECK(res.lookups > 0);
+                check_channels(res, {1.0, 1.0, 1.0}, 3, "rgb " + name + " " + spectral_name<E>() + " ray " + std::to_string(r));
+            }
+        };
+        for_each_spectral<absorption::Weight>(each);
+        each(SpectralPathEstimator<channels::SpectralMis, strategy::NullScatteringMis, mis::Balance, absorption::Event>{});
+    };
+    furnace_controls<Rgb>(box, run_all, 1040, 2);
+}
+
+TEST_CASE_TEMPLATE_DEFINE("spectral estimators under a control: single scattering from a point light = quadrature", C,
+                          spectral_ctl_single) {
+    using M = typename C::Medium;
+    using A = typename C::Absorption;
+    const PointLightSingleScatter<M> setup;
+    EstimatorOptions opts;
+    opts.max_depth = 1;
+    // 100000 paths each: with the full majorant's scattering density at the equiangular vertex in
+    // place of the two routes' sum, the three-way MIS under the control above the density is
+    // about 1% high: 2-3 SE at 20000 paths, 6-8 SE here.
+    for_each_control<false>(setup.medium, setup.box, 1050, [&](const auto& control, const std::string& name, int seed0) {
+        const auto scene = Scene(setup.medium, control, IsotropicPhase{}, setup.lights);
+        int seed = seed0;
+        auto each = [&](const auto& est) {
+            using E = std::remove_cvref_t<decltype(est)>;
+            const auto res = estimate_radiance(E(opts), scene, setup.ray, 100000, std::uint64_t(++seed));
+            check_channels(res, setup.ref, 3, combo_name<C>() + " " + name + " " + spectral_name<E>());
+        };
+        each(SpectralPathEstimator<channels::SpectralMis, strategy::NextEvent, mis::None, A>{});
+        each(SpectralPathEstimator<channels::SpectralMis, strategy::NullScatteringMis, mis::Balance, A>{});
+        each(SpectralPathEstimator<channels::SpectralTrackingMax, strategy::NullScatteringMis, mis::Balance, A>{});
+        // Equiangular sampling: its vertex weighs against every channel's sum over both routes.
+        each(SpectralPathEstimator<channels::SpectralMis, strategy::EquiangularNextEvent, mis::None, A>{});
+        each(SpectralPathEstimator<channels::SpectralMis, strategy::EquiangularMis, mis::Balance, A>{});
+        each(SpectralPathEstimator<channels::SpectralTrackingAverage, strategy::EquiangularMis, mis::Balance, A>{});
+    });
+}
+TEST_CASE_TEMPLATE_APPLY(spectral_ctl_single, decltype(CombosOf<Rgb, ExponentialMedium>{}));
+
+TEST_CASE_TEMPLATE_DEFINE("spectral estimators under a control: emitting absorber = quadrature", C, spectral_ctl_absorber) {
+    // PathEstimator's emitting absorber above, Rgb: the collision estimator at every control and
+    // residual collision with every channel's pdfs, the segment technique and NEE toward the volume.
+    using S = Rgb;
+    using M = typename C::Medium;
+    using A = typename C::Absorption;
+    using EM = Emissive<M>;
+    const Box box{Vec3(-1.f), Vec3(1.f)};
+    const M base = make_medium<M>(box, 0.9f, spec<S>(0.8f, 0.4f, 1.5f), grey<S>(0.f));
+    const EM medium(base, make_emission(Box{Vec3(-1.f, -0.8f, -1.2f), Vec3(0.9f, 1.f, 1.f)}, {5, 3, 4}, 1.f, 77),
+                    spec<S>(2.f, 1.f, 0.5f), {6, 5, 4});
+    const Ray ray{Vec3(-3.f, 0.25f, -0.3f), glm::normalize(Vec3(1.f, -0.05f, 0.12f))};
+    const auto ref = emitting_absorber_reference(base, medium, ray);
+    for_each_control<false>(medium, box, 1060, [&](const auto& control, const std::string& name, int seed0) {
+        const auto scene = Scene(medium, control, IsotropicPhase{}, Lights<S>{});
+        EstimatorOptions off;
+        off.emission_along_segments = false;
+        int seed = seed0;
+        auto each = [&](const auto& est) {
+            using E = std::remove_cvref_t<decltype(est)>;
+            const auto res = estimate_radiance(est, scene, ray, 20000, std::uint64_t(++seed));
+            check_channels(res, ref, 3, combo_name<C>() + " " + name + " " + spectral_name<E>());
+            if constexpr (E::Strategy::combines) {
+                const auto r2 = estimate_radiance(E(off), scene, ray, 20000, std::uint64_t(++seed));
+                check_channels(r2, ref, 3, combo_name<C>() + " " + name + " " + spectral_name<E>() + " no segment technique");
+            }
+        };
+        for_each_spectral<A>(each);
+    });
+}
+TEST_CASE_TEMPLATE_APPLY(spectral_ctl_absorber, decltype(CombosOf<Rgb, ExponentialMedium>{}));
+
+TEST_CASE("spectral estimators under a control: the emissive furnace gives L_e") {
+    // PathEstimator's emissive furnace above (L_e equal to the environment: L = L_e after many
+    // scatterings), Rgb, spectral MIS with and without roulette.
+    using S = Rgb;
+    const Box box{Vec3(-1.f), Vec3(1.f)};
+    const auto le = spec<S>(0.7f, 0.4f, 1.1f);
+    Lights<S> lights;
+    lights.set(EnvironmentLight<S>{le});
+    const Ray ray{Vec3(-3.f, 0.15f, -0.1f), glm::normalize(Vec3(1.f, 0.02f, 0.03f))};
+    using Exp = Emissive<ExponentialMedium<S>>;
+    const Exp medium(make_medium<ExponentialMedium<S>>(box, 1.f, spec<S>(0.5f, 0.3f, 0.8f), spec<S>(0.6f, 0.9f, 0.3f)),
+                     make_emission(box, {3, 2, 4}, 1.f, 0), le, {4, 4, 4});
+    const float lo = medium.density_lower_bound(box);
+    const float above = lo + 0.2f * (medium.density_bound(box) - lo);
+    auto run = [&](const auto& control, const std::string& name, std::uint64_t seed) {
+        const Scene scene(medium, control, HenyeyGreensteinPhase(0.3f), lights);
+        EstimatorOptions rr;
+        rr.rr_start_depth = 1;
+        rr.rr_max_survival = 0.6f;
+        auto each = [&](const auto& est) {
+            using E = std::remove_cvref_t<decltype(est)>;
+            for (const bool roulette : {false, true}) {
+                const auto res = estimate_radiance(roulette ? E(rr) : est, scene, ray, 6000, seed++);
+                check_channels(res, {double(le[0]), double(le[1]), double(le[2])}, 3,
+                               name + " " + spectral_name<E>() + (roulette ? " roulette" : ""));
+            }
+        };
+        each(SpectralPathEstimator<channels::SpectralMis, strategy::Unidirectional, mis::None, absorption::Weight>{});
+        each(SpectralPathEstimator<channels::SpectralMis, strategy::NullScatteringMis, mis::Balance, absorption::Weight>{});
+        each(SpectralPathEstimator<channels::SpectralMis, strategy::NullScatteringMis, mis::Balance, absorption::Event>{});
+    };
+    run(GridControl<Exp>(medium, 8), "exponential, grid control", 1100);
+    run(GlobalControl<Exp>(medium, scale(medium.extinction_per_density(), above)),
+        "exponential, global control above the density", 1200);
+}
+
+TEST_CASE("channel_decomposition_densities: every channel's delta-tracking densities under a minorant, both routes above it") {
+    // Under a control below every channel's extinction each route's density is linear in the
+    // coefficients, so every channel's sum is its own delta-tracking density mu_bar P_x,c
+    // (channel_event_densities under mu_bar), float rounding at the scale of mu_bar. Above every
+    // channel's extinction the residual has no real event (its coefficients are negative, clamped
+    // at 0) and a null of density R, so the sum is the control route's: ctl times each channel's
+    // albedo (scattering) and its complement (absorption), computed here from THEORY 5.10.
+    Pcg32 rng(19, 5);
+    const Rgb::Spectrum w = Rgb::Spectrum::Ones();
+    for (int i = 0; i < 2000; ++i) {
+        CAPTURE(i);
+        const float sa0 = 3.f * rng.uniform(), ss0 = 3.f * rng.uniform();
+        Coefficients<Rgb> k{Rgb::Spectrum(sa0, 0.7f * sa0, 1.3f * sa0), Rgb::Spectrum(ss0, 1.2f * ss0, 0.6f * ss0)};
+        const float t_min = k.sigma_t().minCoeff(), t_max = k.sigma_t().maxCoeff();
+        const float mu_bar = t_max * (1.f + 2.f * rng.uniform()) + 1e-3f;
+        const float below = t_min * rng.uniform();
+        const auto full = channel_event_densities<absorption::Event, Rgb>(k, Rgb::Spectrum::Constant(mu_bar));
+        const auto d = detail::channel_decomposition_densities<channels::SpectralMis, absorption::Event, Rgb>(k, below, mu_bar, w);
+        for (int c = 0; c < 3; ++c) {
+            CAPTURE(c);
+            CHECK(d.scatter[c] == doctest::Approx(full.scatter[c]).epsilon(1e-5).scale(mu_bar));
+            CHECK(d.absorb[c] == doctest::Approx(full.absorb[c]).epsilon(1e-5).scale(mu_bar));
+            CHECK(d.null[c] == doctest::Approx(full.null[c]).epsilon(1e-5).scale(mu_bar));
+        }
+        const float over = t_max + (mu_bar - t_max) * rng.uniform();
+        const auto du = detail::channel_decomposition_densities<channels::SpectralMis, absorption::Event, Rgb>(k, over, mu_bar, w);
+        for (int c = 0; c < 3; ++c) {
+            CAPTURE(c);
+            const double t = double(k.sigma_t()[c]);
+            const double a_s = t > 0.0 ? double(k.sigma_s[c]) / t : 0.0;
+            CHECK(double(du.scatter[c]) == doctest::Approx(double(over) * a_s).epsilon(1e-5).scale(mu_bar));
+            CHECK(double(du.absorb[c]) == doctest::Approx(double(over) * (1.0 - a_s)).epsilon(1e-5).scale(mu_bar));
+            CHECK(double(du.null[c]) == doctest::Approx(double(mu_bar) - double(over)).epsilon(1e-5).scale(mu_bar));
+        }
     }
 }
 

@@ -10,8 +10,9 @@
 //   SpectralPathEstimator, own pdfs: Rgb ChannelMajorant; Hero ChannelGridMajorant<bound::Reject>;
 //                  shared pdf: Rgb GlobalMajorant; Hero GridMajorant.
 // A non-bounding policy with a majorant at the bound must behave exactly as bound::Guaranteed.
-// Every PathEstimator strategy also runs under a GridControl of the same cells in Mono and Rgb
-// (decomposition tracking, residual ratio tracking, the equiangular vertex's two-route density).
+// Every PathEstimator strategy also runs under a GridControl of the same cells in Mono and Rgb, and
+// every SpectralPathEstimator case in Rgb (decomposition tracking, residual ratio tracking, the
+// equiangular vertex's two-route density).
 //
 // Cases, each along five camera rays (from outside, from a face inward along an axis, from a
 // cell edge with denormal direction components, along a face, and leaving from a corner):
@@ -129,6 +130,19 @@ using ControlEstimatorsIn =
                EstCase<PathEstimator<strategy::EquiangularNextEvent, mis::None, absorption::Weight>, S, true>,
                EstCase<PathEstimator<strategy::EquiangularMis, mis::Balance, absorption::Weight>, S, true>>;
 using AllControlCases = decltype(std::tuple_cat(ControlEstimatorsIn<Mono>{}, ControlEstimatorsIn<Rgb>{}));
+/// Every SpectralPathEstimator case under a grid control, in Rgb (every channel's pdfs over both of
+/// decomposition tracking's routes).
+template <class S>
+using SpectralControlEstimatorsIn =
+    std::tuple<EstCase<Spectral<channels::Independent, strategy::NullScatteringMis, mis::Balance>, S, true>,
+               EstCase<Spectral<channels::SpectralTrackingMax, strategy::NullScatteringMis, mis::Balance>, S, true>,
+               EstCase<Spectral<channels::SpectralTrackingAverage, strategy::NullScatteringMis, mis::Balance>, S, true>,
+               EstCase<Spectral<channels::SpectralMis, strategy::NullScatteringMis, mis::Balance>, S, true>,
+               EstCase<Spectral<channels::SpectralMis, strategy::Unidirectional>, S, true>,
+               EstCase<Spectral<channels::SpectralMis, strategy::NextEvent>, S, true>,
+               EstCase<Spectral<channels::SpectralMis, strategy::EquiangularNextEvent>, S, true>,
+               EstCase<Spectral<channels::SpectralMis, strategy::EquiangularMis, mis::Balance>, S, true>>;
+using AllSpectralControlCases = SpectralControlEstimatorsIn<Rgb>;
 using AllSpectralCases = decltype(std::tuple_cat(SpectralEstimatorsIn<Rgb>{}, SpectralEstimatorsIn<Hero<4>>{}));
 
 }  // namespace nsp_test::stab
@@ -373,7 +387,12 @@ TEST_CASE_TEMPLATE_DEFINE("stability: path estimators at density 0, 1e-12, 1, 1e
     furnace_and_absorber<Ec>();
 }
 TEST_CASE_TEMPLATE_APPLY(stab_path, AllPathCases);
+TEST_CASE_TEMPLATE_DEFINE("stability: spectral path estimators at density 0, 1e-12, 1, 1e6, channels 1e8 apart, grid control",
+                          Ec, stab_spectral_control) {
+    furnace_and_absorber<Ec>();
+}
 TEST_CASE_TEMPLATE_APPLY(stab_control, AllControlCases);
+TEST_CASE_TEMPLATE_APPLY(stab_spectral_control, AllSpectralControlCases);
 TEST_CASE_TEMPLATE_APPLY(stab_spectral, AllSpectralCases);
 
 }  // namespace

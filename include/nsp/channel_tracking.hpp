@@ -137,21 +137,67 @@ EventProbabilities shared_event_probabilities(const Coefficients<S>& k, float mu
     return {p[0], p[1], p[2]};
 }
 
+namespace detail {
+/// Every channel's density mu_bar_c P_x,c of each event at a collision with coefficients k under
+/// majorant mu_v (a Spectrum per channel, or a grey float): the channel's own (channel policies
+/// with own pdfs) or the one spectral tracking shares, from the throughput w there (0 where the
+/// majorant is 0).
+template <ChannelPolicy CP, AbsorptionPolicy A, SpectralMode S, class V>
+ChannelEventDensities<typename S::Spectrum> channel_densities(const Coefficients<S>& k, const V& mu_v,
+                                                              const typename S::Spectrum& w) noexcept {
+    using Spec = typename S::Spectrum;
+    if constexpr (CP::own_pdfs) {
+        return channel_event_densities<A, S>(k, broadcast_majorant<Spec>(mu_v));
+    } else {
+        static_assert(std::is_same_v<V, float>, "nsp: spectral tracking shares one pdf and needs a grey majorant "
+                                                "(GlobalMajorant or GridMajorant)");
+        if (!(mu_v > 0.f)) return {Spec::Zero(), Spec::Zero(), Spec::Zero()};
+        const EventProbabilities p = shared_event_probabilities<A, CP::throughput_weighted, S>(k, mu_v, w);
+        return {Spec::Constant(mu_v * p.absorb), Spec::Constant(mu_v * p.scatter), Spec::Constant(mu_v * p.null)};
+    }
+}
+
+/// The same under decomposition tracking (THEORY 5.10 with 5.3) with grey control `ctl` and
+/// segment majorant `mu_bar`: a real event's density is the sum over the control route (ctl, the
+/// lookup scaled to extinction ctl, albedo kept) and the residual route (R = mu_bar - ctl, the
+/// lookup scaled to mu_t,c - ctl); a null's is the residual's. Under a minorant, with own pdfs,
+/// these are delta tracking's densities under mu_bar (every term is linear); where the control
+/// exceeds a channel's extinction the residual has no real event there (its coefficients are
+/// negative) and the control route's density is above it.
+template <ChannelPolicy CP, AbsorptionPolicy A, SpectralMode S>
+ChannelEventDensities<typename S::Spectrum> channel_decomposition_densities(const Coefficients<S>& k, float ctl,
+                                                                            float mu_bar,
+                                                                            const typename S::Spectrum& w) noexcept {
+    using Spec = typename S::Spectrum;
+    const float rate = mu_bar - ctl;
+    ChannelEventDensities<Spec> d{Spec::Zero(), Spec::Zero(), Spec::Zero()};
+    if (rate > 0.f) {
+        Coefficients<S> r = k;
+        to_residual(r, ctl, rate);
+        d = channel_densities<CP, A, S>(r, rate, w);
+    }
+    if (ctl > 0.f) {
+        Coefficients<S> q = k;
+        to_control(q, ctl);
+        const ChannelEventDensities<Spec> dc = channel_densities<CP, A, S>(q, ctl, w);
+        d.absorb += dc.absorb;
+        d.scatter += dc.scatter;
+    }
+    return d;
+}
+}  // namespace detail
+
 /// Every channel's tracking density mu_bar_c P_s,c of a real scattering vertex with coefficients
 /// k under majorant mu_v (a Spectrum per channel, or a grey float): the channel's own (channel
 /// policies with own pdfs) or the one spectral tracking shares, from the throughput w there. What
-/// an equiangular vertex's tracking pdf needs (THEORY 5.4 with 5.3).
+/// an equiangular vertex's tracking pdf needs (THEORY 5.4 with 5.3). Under a grey control `ctl` > 0
+/// (mu_v grey), decomposition tracking's: the sum over its two routes (THEORY 5.10).
 template <ChannelPolicy CP, AbsorptionPolicy A, SpectralMode S, class V>
-typename S::Spectrum channel_scatter_densities(const Coefficients<S>& k, const V& mu_v,
-                                               const typename S::Spectrum& w) noexcept {
-    using Spectrum = typename S::Spectrum;
-    if constexpr (CP::own_pdfs) {
-        return channel_event_densities<A, S>(k, detail::broadcast_majorant<Spectrum>(mu_v)).scatter;
-    } else {
-        const float m = channel_of(mu_v, 0);
-        return m > 0.f ? Spectrum(Spectrum::Constant(m * shared_event_probabilities<A, CP::throughput_weighted, S>(k, m, w).scatter))
-                       : Spectrum(Spectrum::Zero());
-    }
+typename S::Spectrum channel_scatter_densities(const Coefficients<S>& k, const V& mu_v, const typename S::Spectrum& w,
+                                               float ctl = 0.f) noexcept {
+    if constexpr (std::is_same_v<V, float>)
+        if (ctl > 0.f) return detail::channel_decomposition_densities<CP, A, S>(k, ctl, mu_v, w).scatter;
+    return detail::channel_densities<CP, A, S>(k, mu_v, w).scatter;
 }
 
 /// How a per-channel delta-tracked segment ended, and where.
@@ -172,10 +218,21 @@ struct ChannelTrack {
 /// tentative collision (relative, as the state's; ones for a grey majorant), the state before
 /// this collision (the collision estimator of emission, THEORY 5.7 with 5.3, uses it) and every
 /// channel's event densities there (ChannelEventDensities, the ones the event is chosen by).
+///
+/// Under a control (`kControlled`, which track_channels_delta_visiting sets where the majorant
+/// carries one), decomposition tracking (THEORY 5.10 with 5.3): the sampling channel chooses the
+/// event of each control or residual collision with that route's densities, and every channel's
+/// pdf of a real vertex is the sum over both routes (its residual nulls' are the residual's). The
+/// contributions are the medium's own (mu_s,c at a real vertex, mu_bar - mu_t,c at a null), and
+/// the control's exp(-tau_c), the probability of no control collision, joins f and uni (not nee:
+/// ratio tracking's pdf of the nulls is the residual's alone). The visitor is then called from
+/// before_event at every collision with the medium's own lookup, the full majorant and the state
+/// with exp(-tau_c) so far.
 template <ChannelPolicy CP, AbsorptionPolicy A, SpectralMode S, UniformRng R, class Rec, bool kEq = false,
-          class Visit = NoVisit>
+          class Visit = NoVisit, bool kControlled = false>
 struct ChannelDeltaCollision {
     using Spec = typename S::Spectrum;
+    static constexpr ControlUse control_use = ControlUse::Collide;
     R& rng;
     Rec& rec;
     ChannelPathState<S, kEq>& st;
@@ -184,25 +241,50 @@ struct ChannelDeltaCollision {
     Visit visit{};
     ChannelTrack out{};
     std::uint32_t nulls = 0;
+    /// Under a control, the current collision's own lookup and every channel's densities of a real
+    /// event there over both routes (before_event).
+    struct Kept {
+        Coefficients<S> k{};
+        ChannelEventDensities<Spec> d{};
+    };
+    [[no_unique_address]] std::conditional_t<kControlled, Kept, detail::Empty> kept{};
+
+    /// Under a control, the loop's call at every collision y, control or residual, before its
+    /// coefficients become the route's: keeps the medium's own lookup `k` and every channel's
+    /// densities of a real event at y over both routes, the control's ctl P_x,c(control) plus the
+    /// residual's R P_x,c(residual), R = mu_bar - ctl (nulls: the residual's), and calls the
+    /// visitor with them, the full majorant `mu_bar` and the state with exp(-tau_ctl) in f and uni.
+    void before_event(float t, const Coefficients<S>& k, float mu_bar, float ctl, double tau_ctl)
+        requires kControlled
+    {
+        kept.k = k;
+        kept.d = detail::channel_decomposition_densities<CP, A, S>(k, ctl, mu_bar, st.f);
+        const ChannelEventDensities<Spec>& d = kept.d;
+        if constexpr (Visit::enabled) {
+            ChannelPathState<S, kEq> here = st;
+            if (tau_ctl > 0.0) {
+                const float e = float(std::exp(-tau_ctl));
+                here.f *= e;
+                here.uni *= e;
+            }
+            visit(t, k, Spec(Spec::Constant(mu_bar)), Spec(Spec::Ones()), here, d);
+        } else {
+            (void)t, (void)tau_ctl;
+        }
+    }
 
     template <class V>
     bool operator()(float t, const Coefficients<S>& k, const V& mu_v, const V& tau_v) {
         constexpr bool grey = std::is_same_v<V, float>;
+        static_assert(grey || !kControlled, "a control's segments carry a grey majorant");
         const Spec mu = detail::broadcast_majorant<Spec>(mu_v);
         Spec tb;  // every channel's Tbar since the last tentative collision (a grey one cancels)
         if constexpr (!grey) tb = detail::relative_transmittance(tau_v, c);
         // Every channel's density mu_bar_c P_x,c of each event: its own (own pdfs) or the one
-        // shared by all channels (spectral tracking). The sampling channel's picks the event.
-        ChannelEventDensities<Spec> d;
-        if constexpr (CP::own_pdfs) {
-            d = channel_event_densities<A, S>(k, mu);
-        } else {
-            static_assert(grey, "nsp: spectral tracking shares one pdf and needs a grey majorant "
-                                "(GlobalMajorant or GridMajorant)");
-            const EventProbabilities p = shared_event_probabilities<A, CP::throughput_weighted, S>(k, mu_v, st.f);
-            d = {Spec::Constant(mu_v * p.absorb), Spec::Constant(mu_v * p.scatter), Spec::Constant(mu_v * p.null)};
-        }
-        if constexpr (Visit::enabled) {
+        // shared by all channels (spectral tracking). The sampling channel's picks the event
+        // (under a control: the route's).
+        const ChannelEventDensities<Spec> d = detail::channel_densities<CP, A, S>(k, mu_v, st.f);
+        if constexpr (Visit::enabled && !kControlled) {
             if constexpr (grey) visit(t, k, mu, Spec(Spec::Ones()), st, d);
             else visit(t, k, mu, tb, st, d);
         }
@@ -216,8 +298,13 @@ struct ChannelDeltaCollision {
         else if (u < pa + ps || !(d.null[c] > 0.f)) event = SegmentEnd::Scattered;  // never a null of probability 0
         else event = SegmentEnd::Passed;  // a null
         if constexpr (Rec::enabled) {
-            const float p_c = event == SegmentEnd::Absorbed    ? d.absorb[c]
-                              : event == SegmentEnd::Scattered ? d.scatter[c]
+            // Under a control, a real vertex's density is the routes' sum (a null's the residual's).
+            const ChannelEventDensities<Spec>& dv = [&]() -> const ChannelEventDensities<Spec>& {
+                if constexpr (kControlled) return kept.d;
+                else return d;
+            }();
+            const float p_c = event == SegmentEnd::Absorbed    ? dv.absorb[c]
+                              : event == SegmentEnd::Scattered ? dv.scatter[c]
                                                                : d.null[c];
             rec.vertex(t, std::log(double(p_c)) - double(channel_of(tau_v, c)));
         }
@@ -270,7 +357,10 @@ struct ChannelDeltaCollision {
             }
             if constexpr (kEq) st.eq.vertex *= nee_factor;
         } else {  // a real scattering vertex: mu_s,c Tbar_c and mu_bar_c P_s,c Tbar_c
-            if constexpr (grey) {
+            if constexpr (kControlled) {  // the medium's own mu_s,c, and both routes' densities
+                st.f *= kept.k.sigma_s;
+                st.uni *= kept.d.scatter;
+            } else if constexpr (grey) {
                 st.f *= k.sigma_s;
                 st.uni *= d.scatter;
             } else {
@@ -299,9 +389,22 @@ ChannelTrack track_channels_delta_visiting(const M& medium, const Maj& majorant,
                                            R& rng, C& counter, Visit visit, Rec&& rec = Rec{}) {
     using S = typename M::Spectral;
     using RecT = std::remove_reference_t<Rec>;
-    ChannelDeltaCollision<CP, A, S, R, RecT, kEq, Visit> cb{rng, rec, st, c, nee_alternative, std::move(visit)};
+    constexpr bool kControlled =
+        detail::has_control_v<std::remove_cvref_t<decltype(*majorant.iterate(ray, 0.f, tmax, lambda).next())>>;
+    ChannelDeltaCollision<CP, A, S, R, RecT, kEq, Visit, kControlled> cb{rng, rec, st, c, nee_alternative,
+                                                                         std::move(visit)};
     const auto f = free_flight(medium, majorant, ray, 0.f, tmax, lambda, rng, counter, cb, kDefaultMaxCollisions, c);
     if (f.aborted) return {aborted_end(f), f.t};
+    if constexpr (kControlled) {
+        // No control collision before the end: exp(-tau_c) in f and uni (THEORY 5.10).
+        if (f.tau_ctl > 0.0 && (f.stopped ? cb.out.end == SegmentEnd::Scattered : true)) {
+            const float e = float(std::exp(-f.tau_ctl));
+            st.f *= e;
+            st.uni *= e;
+            if (const StateScale r = st.template renormalize<CP>(c); r != StateScale::Ok)
+                return {detail::segment_end(r), f.stopped ? cb.out.t : tmax};
+        }
+    }
     if (f.stopped) return cb.out;
     if constexpr (is_per_channel_majorant_v<Maj, M>) {
         const auto tb = detail::relative_transmittance(f.tau_tail, c);
@@ -352,6 +455,11 @@ struct ChannelShadow {
 template <ChannelPolicy CP, AbsorptionPolicy A, SpectralMode S, class Rec>
 struct ChannelRatioCollision {
     using Spec = typename S::Spectrum;
+    /// Under a control, residual ratio tracking (THEORY 5.10): the loop hands over residual
+    /// collisions at rate R with the residual's coefficients, so that f gets R - r_c = mu_bar -
+    /// mu_t,c, nee R and uni R P_n,c(residual) per null; track_channels_ratio multiplies f and uni
+    /// by the control's exp(-tau_c).
+    static constexpr ControlUse control_use = ControlUse::ClosedForm;
     using D = detail::DoubleSpectrum<Spec>;
     Rec& rec;
     int c;
@@ -360,6 +468,14 @@ struct ChannelRatioCollision {
     ChannelShadow<S> out{};
     std::uint32_t nulls = 0;
     D f_d = D::Zero(), nee_d = D::Zero(), uni_d = D::Zero();
+    /// exp(tau_c) of the control's optical depth so far, past 20 only (control_depth): 1 otherwise.
+    double control_floor = 1.0;
+
+    /// Under a control, the loop's report of the control's optical depth up to the end of the
+    /// current segment (past 20): the estimate will be multiplied by exp(-tau), so the stop in
+    /// `normalize` must see it, or a shadow ray through a thick controlled medium walks all its
+    /// residual nulls (R times its length) for an estimate that rounds to 0.
+    void control_depth(double tau) noexcept { control_floor = std::exp(tau); }
 
     template <class V>
     bool operator()(float t, const Coefficients<S>& k, const V& mu_v, const V& tau_v) {
@@ -441,7 +557,8 @@ private:
     bool normalize(Arr& f, Arr& nee, Arr& uni) {
         using T = typename Arr::Scalar;
         const T k = CP::mis_over_channels ? nee.maxCoeff() : nee[c];
-        constexpr T tiny = std::numeric_limits<float>::min();
+        // Under a control, f will be multiplied by exp(-tau_c) (control_depth): the floor is raised by it.
+        const T tiny = T(double(std::numeric_limits<float>::min()) * control_floor);
         const bool negligible = CP::mis_over_channels ? (f.abs() < tiny * k).all() : !(std::abs(f[c]) >= tiny * k);
         if (!(k > T(0)) || !std::isfinite(k) || negligible) {
             // The pdfs go with it: where k overflowed they would be inf (found by the fuzzer).
@@ -510,7 +627,15 @@ ChannelShadow<typename M::Spectral> track_channels_ratio(const M& medium, const 
     if (f.stopped) return cb.finish();
     if constexpr (is_per_channel_majorant_v<Maj, M>) cb.multiply_tail(detail::relative_transmittance(f.tau_tail, c));
     if constexpr (RecT::enabled) rec.log_pdf -= double(channel_of(f.tau_tail, c));
-    return cb.finish();
+    ChannelShadow<S> out = cb.finish();
+    if (f.tau_ctl > 0.0 && out.end == SegmentEnd::Passed) {
+        // The control's transmittance in closed form, and decomposition tracking's probability of
+        // no control collision in uni (THEORY 5.10).
+        const float e = float(std::exp(-f.tau_ctl));
+        out.f *= e;
+        out.uni *= e;
+    }
+    return out;
 }
 
 }  // namespace nsp

@@ -191,7 +191,6 @@ public:
     template <class Coeff, class Mu>
     std::optional<VertexRecord<P, S>> equiangular_vertex(const ShadowPiece<P, S>& w, const Coeff& k, const Mu& mu,
                                                          float eq_pdf, int depth, float ctl = 0.f) const noexcept {
-        (void)ctl;  // 0: SpectralPathEstimator takes no control
         VertexRecord<P, S> x;
         x.f = st_.f * w.f * k.sigma_s;
         if (!(x.f != 0.f).any()) return std::nullopt;
@@ -200,7 +199,8 @@ public:
         x.eq_drawn = true;
         if constexpr (St::combines) {
             // Every channel's tracking pdf of the same nulls and of a real scattering vertex at x.
-            const Spectrum scatter = channel_scatter_densities<CP, A, S>(k, mu, Spectrum(st_.f * w.f));
+            // Under a control (ctl > 0), decomposition tracking's: both routes' (THEORY 5.10).
+            const Spectrum scatter = channel_scatter_densities<CP, A, S>(k, mu, Spectrum(st_.f * w.f), ctl);
             x.p_track = st_.uni * w.uni * scatter;
             // The survival tracking would give x: a function of the path (its f and tracking pdfs).
             if (opts_.russian_roulette && depth >= opts_.rr_start_depth)

@@ -20,7 +20,7 @@
 //   direction, a NaN or infinite origin) or a NaN distance, at every public tracking entry and at
 //   both path estimators: each must answer InvalidInput and no estimate (0), never a number;
 // - after it, reading no bytes: the trackers under a control (run_controls), decomposition and
-//   residual ratio tracking and ray marching on the input's medium.
+//   residual ratio tracking, grey and per channel, and ray marching on the input's medium.
 //
 // Work is bounded: a case whose majorant optical depth across the medium's box exceeds kBudget
 // is skipped, paths are at most 8 real vertices deep, and free_flight's own calls stop after 64
@@ -1204,6 +1204,16 @@ void run_controls(const M& medium, const std::array<int, 3>& res, const Lambda& 
             const auto rr = transmittance_residual_ratio(medium, control, ray, tmax, lambda, rng, counter, 4096);
             NSP_FUZZ_CHECK(ok(rr.status) && all_finite(rr.value));
             if (minorant) NSP_FUZZ_CHECK((rr.value >= -2e-5f).all());
+            // Per channel (spectral MIS's trackers): finite states, pdfs >= 0.
+            ChannelPathState<S> cst;
+            const auto cd = track_channels_delta<channels::SpectralMis, absorption::Weight>(medium, control, ray, tmax,
+                                                                                            lambda, 0, cst, true, rng, counter);
+            NSP_FUZZ_CHECK(ok(flight_status(cd.end)) && all_finite(cst.f) && all_finite(cst.uni) && all_finite(cst.nee));
+            NSP_FUZZ_CHECK((cst.uni >= 0.f).all() && (cst.nee >= 0.f).all());
+            const auto cr = track_channels_ratio<channels::SpectralMis, absorption::Weight>(
+                medium, control, ray, tmax, lambda, 0, S::Spectrum::Ones(), true, rng, counter);
+            NSP_FUZZ_CHECK(ok(flight_status(cr.end)) && all_finite(cr.f) && all_finite(cr.nee) && all_finite(cr.uni));
+            NSP_FUZZ_CHECK((cr.uni >= 0.f).all() && (cr.nee >= 0.f).all());
         };
         drive(*grid, true);
         drive(*zero, true);

@@ -349,9 +349,6 @@ public:
         static_assert(CP::own_pdfs || !is_per_channel_majorant_v<typename Sc::MajorantType, typename Sc::MediumType>,
                       "nsp::SpectralPathEstimator: spectral tracking shares one pdf over channels and needs a "
                       "grey majorant bounding every channel (GlobalMajorant)");
-        static_assert(!is_control_v<typename Sc::MajorantType, typename Sc::MediumType>,
-                      "nsp::SpectralPathEstimator does not track under a control (GridControl, GlobalControl): "
-                      "its channel trackers would see the full majorant; use GridMajorant or GlobalMajorant");
         if (!usable_ray(camera_ray) || detail::refuses_nee_count(kernels_, scene))
             return {Sc::Spectrum::Zero(), Status::InvalidInput};
         detail::record_nee_count_may_be_0(counter, !scene.lights.has_delta_lights());

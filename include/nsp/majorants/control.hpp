@@ -9,8 +9,9 @@
 // (residual ratio tracking), delta tracking draws control collisions at rate mu_c beside the
 // residual's tentative ones (decomposition tracking). Where the control is the whole extinction
 // (a homogeneous stretch) neither pays a lookup for its nulls; with a control of 0 both are
-// today's trackers, draw for draw. Code that walks the segments without knowing of the control
-// (the per-channel trackers, pdf evaluation) sees an ordinary majorant.
+// today's trackers, draw for draw. The per-channel trackers (channel_tracking.hpp) do the same with
+// every channel's pdfs; code that walks the segments without knowing of the control (pdf
+// evaluation) sees an ordinary majorant.
 //
 // GridControl stores per cell the density's lower bound beside its upper bound (two floats per
 // cell; a medium without a lower-bound query, LowerBoundedMedium, gets a control of 0 and pays
