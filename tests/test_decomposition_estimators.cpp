@@ -165,36 +165,55 @@ TEST_CASE_TEMPLATE_APPLY(ctl_single, AnalyticMediaCombos);
 // exp(-tau_c) prod P_n,r (docs/theory.md 5.10); the segment technique and NEE toward the volume
 // ratio-track their nulls by residual ratio tracking. Every strategy's estimate and MIS among the
 // three techniques must stay unbiased.
-TEST_CASE_TEMPLATE_DEFINE("emitting absorber under a control = quadrature", C, ctl_absorber) {
+
+/// "spectral-mis/uni-nee-mis/balance/absorb-weight" for a SpectralPathEstimator (its channel
+/// policy first), "uni-nee-mis/balance/absorb-weight" for a PathEstimator.
+template <class E>
+std::string any_estimator_name() {
+    if constexpr (requires { typename E::Channels; }) return std::string(E::Channels::name) + "/" + estimator_name<E>();
+    else return estimator_name<E>();
+}
+
+/// An emitting absorber of combo C (no scattering: L_c = int T_c mu_a,c L_e,c dt along the ray,
+/// references.hpp, Simpson in double) under each control of for_each_control (seeds from seed0):
+/// every estimator that `for_each_estimator(each)` hands to `each` against it, 20000 paths, and a
+/// combining one also without the segment technique (the collision estimator alone on the camera
+/// ray).
+template <class C, class ForEach>
+void check_emitting_absorber(int seed0, ForEach&& for_each_estimator) {
     using S = typename C::Spectral;
     using M = typename C::Medium;
-    using A = typename C::Absorption;
     using EM = Emissive<M>;
     const Box box{Vec3(-1.f), Vec3(1.f)};
-    // No scattering: L_c = int T_c mu_a,c L_e,c dt along the ray (references.hpp, Simpson in double).
     const M base = make_medium<M>(box, 0.9f, spec<S>(0.8f, 0.4f, 1.5f), grey<S>(0.f));
     const EM medium(base, make_emission(Box{Vec3(-1.f, -0.8f, -1.2f), Vec3(0.9f, 1.f, 1.f)}, {5, 3, 4}, 1.f, 77),
                     spec<S>(2.f, 1.f, 0.5f), {6, 5, 4});
     const Ray ray{Vec3(-3.f, 0.25f, -0.3f), glm::normalize(Vec3(1.f, -0.05f, 0.12f))};
     const auto ref = emitting_absorber_reference(base, medium, ray);
-    auto run = [&](const auto& control, const std::string& name, int seed0) {
+    auto run = [&](const auto& control, const std::string& name, int first_seed) {
         const auto scene = Scene(medium, control, IsotropicPhase{}, Lights<S>{});
         EstimatorOptions off;  // the collision estimator alone on the camera ray
         off.emission_along_segments = false;
-        int seed = seed0;
+        int seed = first_seed;
         auto each = [&](const auto& est) {
             using E = std::remove_cvref_t<decltype(est)>;
+            const std::string label = combo_name<C>() + " " + name + " " + any_estimator_name<E>();
             const auto res = estimate_radiance(est, scene, ray, 20000, std::uint64_t(++seed));
-            check_channels(res, ref, S::channels, combo_name<C>() + " " + name + " " + estimator_name<E>());
+            check_channels(res, ref, S::channels, label);
             if constexpr (E::Strategy::combines) {
                 const auto r2 = estimate_radiance(E(off), scene, ray, 20000, std::uint64_t(++seed));
-                check_channels(r2, ref, S::channels,
-                               combo_name<C>() + " " + name + " " + estimator_name<E>() + " no segment technique");
+                check_channels(r2, ref, S::channels, label + " no segment technique");
             }
         };
-        std::apply([&](const auto&... e) { (each(e), ...); }, ControlEstimators<A>{});
+        for_each_estimator(each);
     };
-    for_each_control<std::is_same_v<M, HomogeneousMedium<S>>>(medium, box, 60, run);
+    for_each_control<std::is_same_v<M, HomogeneousMedium<S>>>(medium, box, seed0, run);
+}
+
+TEST_CASE_TEMPLATE_DEFINE("emitting absorber under a control = quadrature", C, ctl_absorber) {
+    check_emitting_absorber<C>(60, [](auto&& each) {
+        std::apply([&](const auto&... e) { (each(e), ...); }, ControlEstimators<typename C::Absorption>{});
+    });
 }
 TEST_CASE_TEMPLATE_APPLY(ctl_absorber, AnalyticMediaCombos);
 
@@ -360,12 +379,6 @@ namespace {
 // and the equiangular and emission techniques' nulls by residual ratio tracking. Every channel
 // policy that takes a grey majorant, against the same closed forms as PathEstimator above.
 
-/// "spectral-mis/null-scattering-mis/balance/absorb-weight" and the like.
-template <class E>
-std::string spectral_name() {
-    return std::string(E::Channels::name) + "/" + estimator_name<E>();
-}
-
 /// Runs `each(est)` over spectral MIS's three strategies and, under null-scattering MIS, the other
 /// channel policies with a grey majorant: independent tracking (each channel its own pdf, one
 /// estimated per path) and spectral tracking (one shared pdf: channel maxima, and the
@@ -397,7 +410,7 @@ TEST_CASE("spectral estimators under a control: albedo 1 under a unit environmen
             for (int r = 0; r < 2; ++r) {
                 const auto res = estimate_radiance(est, scene, rays[r], 4000, seed + std::uint64_t(r));
                 CHECK(res.lookups > 0);
-                check_channels(res, {1.0, 1.0, 1.0}, 3, "rgb " + name + " " + spectral_name<E>() + " ray " + std::to_string(r));
+                check_channels(res, {1.0, 1.0, 1.0}, 3, "rgb " + name + " " + any_estimator_name<E>() + " ray " + std::to_string(r));
             }
         };
         for_each_spectral<absorption::Weight>(each);
@@ -422,7 +435,7 @@ TEST_CASE_TEMPLATE_DEFINE("spectral estimators under a control: single scatterin
         auto each = [&](const auto& est) {
             using E = std::remove_cvref_t<decltype(est)>;
             const auto res = estimate_radiance(E(opts), scene, setup.ray, 100000, std::uint64_t(++seed));
-            check_channels(res, setup.ref, 3, combo_name<C>() + " " + name + " " + spectral_name<E>());
+            check_channels(res, setup.ref, 3, combo_name<C>() + " " + name + " " + any_estimator_name<E>());
         };
         each(SpectralPathEstimator<channels::SpectralMis, strategy::NextEvent, mis::None, A>{});
         each(SpectralPathEstimator<channels::SpectralMis, strategy::NullScatteringMis, mis::Balance, A>{});
@@ -438,32 +451,7 @@ TEST_CASE_TEMPLATE_APPLY(spectral_ctl_single, decltype(CombosOf<Rgb, Exponential
 TEST_CASE_TEMPLATE_DEFINE("spectral estimators under a control: emitting absorber = quadrature", C, spectral_ctl_absorber) {
     // PathEstimator's emitting absorber above, Rgb: the collision estimator at every control and
     // residual collision with every channel's pdfs, the segment technique and NEE toward the volume.
-    using S = Rgb;
-    using M = typename C::Medium;
-    using A = typename C::Absorption;
-    using EM = Emissive<M>;
-    const Box box{Vec3(-1.f), Vec3(1.f)};
-    const M base = make_medium<M>(box, 0.9f, spec<S>(0.8f, 0.4f, 1.5f), grey<S>(0.f));
-    const EM medium(base, make_emission(Box{Vec3(-1.f, -0.8f, -1.2f), Vec3(0.9f, 1.f, 1.f)}, {5, 3, 4}, 1.f, 77),
-                    spec<S>(2.f, 1.f, 0.5f), {6, 5, 4});
-    const Ray ray{Vec3(-3.f, 0.25f, -0.3f), glm::normalize(Vec3(1.f, -0.05f, 0.12f))};
-    const auto ref = emitting_absorber_reference(base, medium, ray);
-    for_each_control<false>(medium, box, 1060, [&](const auto& control, const std::string& name, int seed0) {
-        const auto scene = Scene(medium, control, IsotropicPhase{}, Lights<S>{});
-        EstimatorOptions off;
-        off.emission_along_segments = false;
-        int seed = seed0;
-        auto each = [&](const auto& est) {
-            using E = std::remove_cvref_t<decltype(est)>;
-            const auto res = estimate_radiance(est, scene, ray, 20000, std::uint64_t(++seed));
-            check_channels(res, ref, 3, combo_name<C>() + " " + name + " " + spectral_name<E>());
-            if constexpr (E::Strategy::combines) {
-                const auto r2 = estimate_radiance(E(off), scene, ray, 20000, std::uint64_t(++seed));
-                check_channels(r2, ref, 3, combo_name<C>() + " " + name + " " + spectral_name<E>() + " no segment technique");
-            }
-        };
-        for_each_spectral<A>(each);
-    });
+    check_emitting_absorber<C>(1060, [](auto&& each) { for_each_spectral<typename C::Absorption>(each); });
 }
 TEST_CASE_TEMPLATE_APPLY(spectral_ctl_absorber, decltype(CombosOf<Rgb, ExponentialMedium>{}));
 
@@ -491,7 +479,7 @@ TEST_CASE("spectral estimators under a control: the emissive furnace gives L_e")
             for (const bool roulette : {false, true}) {
                 const auto res = estimate_radiance(roulette ? E(rr) : est, scene, ray, 6000, seed++);
                 check_channels(res, {double(le[0]), double(le[1]), double(le[2])}, 3,
-                               name + " " + spectral_name<E>() + (roulette ? " roulette" : ""));
+                               name + " " + any_estimator_name<E>() + (roulette ? " roulette" : ""));
             }
         };
         each(SpectralPathEstimator<channels::SpectralMis, strategy::Unidirectional, mis::None, absorption::Weight>{});
