@@ -84,7 +84,20 @@ void furnace_controls(const Box& box, F&& run_all, int seed0, int step) {
             "exponential, global control above the density", std::uint64_t(seed0 + 3 * step));
 }
 
-TEST_CASE_TEMPLATE("furnace under a control: albedo 1 under a unit environment gives 1", S, Mono, Rgb) {
+/// "spectral-mis/uni-nee-mis/balance/absorb-weight" for a SpectralPathEstimator (its channel
+/// policy first), "uni-nee-mis/balance/absorb-weight" for a PathEstimator.
+template <class E>
+std::string any_estimator_name() {
+    if constexpr (requires { typename E::Channels; }) return std::string(E::Channels::name) + "/" + estimator_name<E>();
+    else return estimator_name<E>();
+}
+
+/// The albedo-1 furnace under a unit environment (L = 1, multiple scattering; every hit of the
+/// environment is weighed against NEE) in mode S, from outside the box and from inside, 4000
+/// paths each, under furnace_controls' media and controls (seeds seed0, seed0 + step, ...): every
+/// estimator that `for_each_estimator(each)` hands to `each`.
+template <SpectralMode S, class ForEach>
+void check_furnace(int seed0, int step, ForEach&& for_each_estimator) {
     const Box box{Vec3(-1.f), Vec3(1.f)};
     Lights<S> lights;
     lights.set(EnvironmentLight<S>{grey<S>(1.f)});
@@ -100,13 +113,20 @@ TEST_CASE_TEMPLATE("furnace under a control: albedo 1 under a unit environment g
                 const auto res = estimate_radiance(est, scene, rays[r], 4000, seed + std::uint64_t(r));
                 CHECK(res.lookups > 0);
                 check_channels(res, {1.0, 1.0, 1.0}, S::channels,
-                               std::string(S::name) + " " + name + " " + estimator_name<E>() + " ray " + std::to_string(r));
+                               std::string(S::name) + " " + name + " " + any_estimator_name<E>() + " ray " +
+                                   std::to_string(r));
             }
         };
+        for_each_estimator(each);
+    };
+    furnace_controls<S>(box, run_all, seed0, step);
+}
+
+TEST_CASE_TEMPLATE("furnace under a control: albedo 1 under a unit environment gives 1", S, Mono, Rgb) {
+    check_furnace<S>(40, 2, [](auto&& each) {
         std::apply([&](const auto&... e) { (each(e), ...); }, ControlEstimators<absorption::Weight>{});
         each(PathEstimator<strategy::NullScatteringMis, mis::Balance, absorption::Event>{});
-    };
-    furnace_controls<S>(box, run_all, 40, 2);
+    });
 }
 
 /// The media with a closed-form optical depth: {Mono, Rgb} x {homogeneous, exponential} x absorption.
@@ -165,14 +185,6 @@ TEST_CASE_TEMPLATE_APPLY(ctl_single, AnalyticMediaCombos);
 // exp(-tau_c) prod P_n,r (docs/theory.md 5.10); the segment technique and NEE toward the volume
 // ratio-track their nulls by residual ratio tracking. Every strategy's estimate and MIS among the
 // three techniques must stay unbiased.
-
-/// "spectral-mis/uni-nee-mis/balance/absorb-weight" for a SpectralPathEstimator (its channel
-/// policy first), "uni-nee-mis/balance/absorb-weight" for a PathEstimator.
-template <class E>
-std::string any_estimator_name() {
-    if constexpr (requires { typename E::Channels; }) return std::string(E::Channels::name) + "/" + estimator_name<E>();
-    else return estimator_name<E>();
-}
 
 /// An emitting absorber of combo C (no scattering: L_c = int T_c mu_a,c L_e,c dt along the ray,
 /// references.hpp, Simpson in double) under each control of for_each_control (seeds from seed0):
@@ -396,27 +408,10 @@ void for_each_spectral(F&& each) {
 TEST_CASE("spectral estimators under a control: albedo 1 under a unit environment gives 1") {
     // The furnace of PathEstimator's test above (multiple scattering, two rays, the same media
     // and controls), Rgb: every channel's own pdfs (spectral MIS, independent) or one shared one.
-    const Box box{Vec3(-1.f), Vec3(1.f)};
-    Lights<Rgb> lights;
-    lights.set(EnvironmentLight<Rgb>{grey<Rgb>(1.f)});
-    const Ray rays[] = {
-        {Vec3(-3.f, 0.2f, 0.1f), glm::normalize(Vec3(1.f, -0.05f, 0.02f))},
-        {Vec3(0.1f, -0.2f, 0.3f), glm::normalize(Vec3(0.3f, 0.9f, -0.2f))},
-    };
-    auto run_all = [&](const auto& medium, const auto& control, const std::string& name, std::uint64_t seed) {
-        const Scene scene(medium, control, HenyeyGreensteinPhase(0.5f), lights);
-        auto each = [&](const auto& est) {
-            using E = std::remove_cvref_t<decltype(est)>;
-            for (int r = 0; r < 2; ++r) {
-                const auto res = estimate_radiance(est, scene, rays[r], 4000, seed + std::uint64_t(r));
-                CHECK(res.lookups > 0);
-                check_channels(res, {1.0, 1.0, 1.0}, 3, "rgb " + name + " " + any_estimator_name<E>() + " ray " + std::to_string(r));
-            }
-        };
+    check_furnace<Rgb>(1040, 2, [](auto&& each) {
         for_each_spectral<absorption::Weight>(each);
         each(SpectralPathEstimator<channels::SpectralMis, strategy::NullScatteringMis, mis::Balance, absorption::Event>{});
-    };
-    furnace_controls<Rgb>(box, run_all, 1040, 2);
+    });
 }
 
 TEST_CASE_TEMPLATE_DEFINE("spectral estimators under a control: single scattering from a point light = quadrature", C,
