@@ -329,23 +329,23 @@ struct BdptEstimator<Mis, H, A, MaxDepth, Ch>::BdptSample {
         if constexpr (kPerChannel) camera[0].gamma = Spectrum::Ones();
         float camera_pdf = 0.f;  // the camera's density of the ray's direction (light tracing), else 0
         if constexpr (kLightTracing) camera_pdf = cam->pdf_dir(camera_ray.d);
-        auto on_hit = [this](V* path, int count, const SurfaceHit& hit, const Ray& ray, const P& nulls,
-                             const Spectrum& beta, const auto& gamma) {
+        auto on_hit = [&](V* path, int count, const SurfaceHit& hit, const Ray& ray, const P& nulls,
+                          const Spectrum& beta, const auto& gamma) {
             hit_emitter(path, count, hit, ray, nulls, beta, gamma);
         };
         auto on_segment = [this](V* path, int count, const Ray& ray, int medium, float pdf_dir, const Spectrum& beta) {
             equiangular(path, count, ray, medium, pdf_dir, beta);
         };
         if constexpr (kEmissive) {
-            auto on_emission = [this](const V* path, int count, int medium, const Vec3& y,
-                                      const Coefficients<typename Sc::Spectral>& c, const P& mu_bar, float mu_sample,
-                                      const Spectrum& beta, const P& nulls, float pdf_dir, const auto& gamma,
-                                      const P& nulls_before, float along) {
+            auto on_emission = [&](const V* path, int count, int medium, const Vec3& y,
+                                   const Coefficients<typename Sc::Spectral>& c, const P& mu_bar, float mu_sample,
+                                   const Spectrum& beta, const P& nulls, float pdf_dir, const auto& gamma,
+                                   const P& nulls_before, float along) {
                 emission_collision(path, count, medium, y, c, mu_bar, mu_sample, beta, nulls, pdf_dir, gamma,
                                    nulls_before, along);
             };
-            auto on_piece = [this](V* path, int count, const Ray& ray, int medium, float t_max, float pdf_dir,
-                                   const Spectrum& beta, const P& nulls_before, const auto& gamma) -> float {
+            auto on_piece = [&](V* path, int count, const Ray& ray, int medium, float t_max, float pdf_dir,
+                                const Spectrum& beta, const P& nulls_before, const auto& gamma) -> float {
                 return segment(path, count, ray, medium, t_max, pdf_dir, beta, nulls_before, gamma);
             };
             nc = subpath(camera, depth + 2, camera_ray, sc.camera_medium, camera_pdf, Spectrum::Ones(), true)
