@@ -277,14 +277,6 @@ inline auto make_cloud_surface_scene(LightSetup setup) {
     return make_empty_space_scene(std::move(cloud), majorant, kPhaseG, default_lights<nsp::Mono>(setup));
 }
 
-/// The same cloud under a grid control of `res`^3 cells (nsp::GridControl: each cell's density
-/// bounds from above and below; THEORY 5.10).
-inline auto make_cloud_surface_scene_controlled(LightSetup setup, int res) {
-    auto cloud = make_default_medium<nsp::Mono>();
-    nsp::GridControl<nsp::DenseGridMedium<nsp::Mono>> control(cloud, res);
-    return make_empty_space_scene(std::move(cloud), std::move(control), kPhaseG, default_lights<nsp::Mono>(setup));
-}
-
 /// The main job's camera (default_scene.hpp's camera_ray) as an nsp::PinholeCamera, square image.
 inline nsp::PinholeCamera cloud_pinhole() {
     const nsp::Vec3 eye(kEye[0], kEye[1], kEye[2]);

@@ -7,6 +7,7 @@
 #include <cstdio>
 
 #include "agreement.hpp"
+#include "combinations.hpp"
 #include "room_rows.hpp"
 
 namespace nsp_examples {
@@ -33,8 +34,10 @@ std::vector<RoomTable> cloud_tables(const RoomOptions& o) {
         rows.pinhole(cloud, camera, BdptEstimator<bdpt::NullScattering, mis::Balance>(BdptEstimator<>::default_options(), {}, 0.25f),
                      "bdpt_null-mis_balance_light-0.25");  // a light subpath on 1/4 of the samples
         rows.learned_bdpt(cloud, camera, "bdpt_null-mis_balance_learned", bdpt::Grey{});
-        // Under a grid control of 16^3 (decomposition tracking, residual ratio tracking: THEORY 5.10).
-        const auto controlled = share(make_cloud_surface_scene_controlled(setup, 16));
+        // Under a grid control of 16^3 (decomposition tracking, residual ratio tracking: THEORY 5.10),
+        // nsp_render's default grid resolution.
+        const auto controlled =
+            share(make_setup_surface_scene<Mono, DenseGridCloud, GridControlPolicy>(SceneChoice{SceneKind::Cloud, setup}));
         rows.pinhole(controlled, camera, PathEstimator<strategy::NullScatteringMis, mis::Balance>{},
                      "uni-nee-mis_balance_grid-control");
         rows.pinhole(controlled, camera, BdptEstimator<bdpt::NullScattering, mis::Balance>{},
