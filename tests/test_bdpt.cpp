@@ -1162,12 +1162,16 @@ auto with_medium(const Base& base, const Med& m, const Maj& maj, float g) {
 }
 
 /// Runs `check(scene, name)` on `base` with its medium `m` under a grid control of 4^3 (each cell's
-/// density lower bound: a minorant) and under a global control a fifth of the way from the
-/// density's lower bound to its upper bound over the box (above the density near its thin side:
-/// negative residuals, whose events and nulls are weighed by sign).
+/// density lower bound: a minorant), a tree control of 2^3 cells split into 2^3 wherever the bound
+/// varies (two levels, the control read at a point from the finest cell), and under a global
+/// control a fifth of the way from the density's lower bound to its upper bound over the box
+/// (above the density near its thin side: negative residuals, whose events and nulls are weighed
+/// by sign).
 template <class Med, class Base, class F>
 void for_each_control(const Base& base, const Med& m, float g, F check) {
     check(with_medium(base, m, GridControl<Med>(m, 4), g), "grid control");
+    check(with_medium(base, m, TreeControl<Med>(m, TreeLayout{m.bounds(), {2, 2, 2}, {2, 0, 0}, 0.f, 0.f}), g),
+          "tree control");
     const float lo = m.density_lower_bound(m.bounds()), hi = m.density_bound(m.bounds());
     const float above = lo + 0.2f * (hi - lo);
     check(with_medium(base, m, GlobalControl<Med>(m, scale(m.extinction_per_density(), above)), g),

@@ -135,6 +135,8 @@ TEST_CASE_TEMPLATE("decomposition and residual ratio tracking are unbiased on ex
     check_closed_forms<S>(medium, GridControl<M>(medium, 8), "grid control (8^3)", 21, &with_control);
     check_closed_forms<S>(medium, GridMajorant<M>(medium, 8), "grid majorant (8^3), no control", 21, &without);
     check_closed_forms<S>(medium, GlobalControl<M>(medium, box_control(medium, 0.9f)), "global control below", 22);
+    // The tree's cells (the adaptive layout: 16^3 coarse, split 4^3 twice where that pays), each with its minorant.
+    check_closed_forms<S>(medium, TreeControl<M>(medium), "tree control (adaptive layout)", 24);
     // A control above the density over part of the box: negative residuals there, signed null
     // weights (delta) and null factors above 1 (ratio), still unbiased.
     const float above = 0.5f * (medium.density_lower_bound(box) + medium.density_bound(box));

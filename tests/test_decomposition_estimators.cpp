@@ -67,7 +67,8 @@ typename M::Spectral::Coefficient box_control(const M& medium, float f) {
 /// density, and global a fifth of the way from the density's lower to its upper bound: above the
 /// density near the lower bound's side only. Further up, multiple scattering through negative
 /// residuals multiplies null weights above 1 over many nulls: at halfway the furnace's SEs were
-/// 20-100x the answer. Seeds seed0, seed0 + step, ...
+/// 20-100x the answer. And the noise grid under a tree control (its adaptive layout). Seeds seed0,
+/// seed0 + step, ...
 template <SpectralMode S, class F>
 void furnace_controls(const Box& box, F&& run_all, int seed0, int step) {
     using Exp = ExponentialMedium<S>;
@@ -82,6 +83,7 @@ void furnace_controls(const Box& box, F&& run_all, int seed0, int step) {
     const float above = lo + 0.2f * (exp_medium.density_bound(box) - lo);
     run_all(exp_medium, GlobalControl<Exp>(exp_medium, scale(exp_medium.extinction_per_density(), above)),
             "exponential, global control above the density", std::uint64_t(seed0 + 3 * step));
+    run_all(grid_medium, TreeControl<Grid>(grid_medium), "noise grid, tree control", std::uint64_t(seed0 + 4 * step));
 }
 
 /// "spectral-mis/uni-nee-mis/balance/absorb-weight" for a SpectralPathEstimator (its channel
@@ -135,15 +137,17 @@ using AnalyticMediaCombos = decltype(std::tuple_cat(CombosOf<Mono, HomogeneousMe
 
 /// Runs `run(control, name, seed)` under the controls of the analytic media: on a homogeneous
 /// medium (kHomogeneous) its extinction itself, no null anywhere and one lookup per real
-/// collision; else a grid control of 8^3, a global control below the density (0.9 of its lower
-/// bound) and one above it over part of the box (halfway between its bounds: negative residuals,
-/// whose real events and nulls are weighed by sign, THEORY 5.10). Seeds from seed0, 10 apart.
+/// collision; else a grid control of 8^3, a tree control (TreeControl's adaptive layout), a global
+/// control below the density (0.9 of its lower bound) and one above it over part of the box
+/// (halfway between its bounds: negative residuals, whose real events and nulls are weighed by
+/// sign, THEORY 5.10). Seeds from seed0, 10 apart.
 template <bool kHomogeneous, class M, class F>
 void for_each_control(const M& medium, const Box& box, int seed0, F&& run) {
     if constexpr (kHomogeneous) {
         run(GlobalControl<M>(medium, medium.coefficients(Vec3(0.f), {}).sigma_t()), "global control = extinction", seed0);
     } else {
         run(GridControl<M>(medium, 8), "grid control (8^3)", seed0);
+        run(TreeControl<M>(medium), "tree control (adaptive layout)", seed0 + 30);
         run(GlobalControl<M>(medium, box_control(medium, 0.9f)), "global control", seed0 + 10);
         const float above = 0.5f * (medium.density_lower_bound(box) + medium.density_bound(box));
         run(GlobalControl<M>(medium, scale(medium.extinction_per_density(), above)), "global control above the density",

@@ -64,10 +64,11 @@ using namespace nsp_test;
 TEST_CASE_TEMPLATE("stability: controls of 0, equal to the extinction and above the density, at densities 0 to 1e6", S,
                    nsp::Mono, nsp::Rgb) {
     // A constant medium (two equal voxels) under GlobalControl 0 (the plain trackers), the
-    // extinction itself (no residual: exact, no lookup for a shadow ray) and GridControl's
-    // minorants; a two-voxel ramp (d, d / 4) under a control above its thin end (signed residuals)
-    // against the plain global majorant in the same run. Every estimate finite, Ok, in [0, 1]
-    // under a minorant; means within 5 SE (+ 1e-6 for rounding) of exp(-tau) or of each other.
+    // extinction itself (no residual: exact, no lookup for a shadow ray) and GridControl's and
+    // TreeControl's minorants; a two-voxel ramp (d, d / 4) under a control above its thin end
+    // (signed residuals) against the plain global majorant in the same run. Every estimate finite,
+    // Ok, in [0, 1] under a minorant; means within 5 SE (+ 1e-6 for rounding) of exp(-tau) or of
+    // each other.
     using M = DenseGridMedium<S>;
     using Spec = typename S::Spectrum;
     const Box box{Vec3(-1.f), Vec3(1.f)};
@@ -106,6 +107,7 @@ TEST_CASE_TEMPLATE("stability: controls of 0, equal to the extinction and above 
         };
         check(GlobalControl<M>(flat, spec<S>(0.f, 0.f, 0.f)), "control 0", true);
         check(GridControl<M>(flat, 2), "grid control", true);
+        check(TreeControl<M>(flat, TreeLayout{box, {2, 1, 1}, {2, 0, 0}, 0.f, 0.f}), "tree control", true);
         const std::uint64_t exact = check(GlobalControl<M>(flat, scale(unit, d)), "control = extinction", true);
         if constexpr (S::channels == 1) CHECK(exact <= std::uint64_t(n));  // shadow rays none; flights one at a real collision
         // Above the density: control at half the dense end over a ramp whose thin end is a quarter.

@@ -356,4 +356,78 @@ TEST_CASE("GridControl: per-cell minorants bound the density from below") {
     CHECK(control.memory_bytes() == 2 * 216 * sizeof(float));
 }
 
+TEST_CASE("TreeControl: the tree majorant's cells, each with its minorant") {
+    // A TreeControl walks the cells of the TreeMajorant of its layout (the same stretches and
+    // majorants, draw for draw), every lookup inside a cell lies in [control, control + residual
+    // majorant], control_value_at is the control of the segment there, a medium without a lower
+    // bound gets a control of 0, and the cells cost two floats each.
+    const Box box{Vec3(-1.f), Vec3(1.f)};
+    using M = DenseGridMedium<Rgb>;
+    const auto medium = make_medium<M>(box, 1.f, spec<Rgb>(0.2f, 0.1f, 0.4f), spec<Rgb>(0.6f, 0.3f, 1.2f));
+    const TreeLayout layout{box, {4, 4, 4}, {4, 2, 0}, 0.f, 0.f};  // split wherever the bound varies
+    const TreeControl<M> control(medium, layout);
+    const TreeMajorant<M> majorant(medium, layout);
+    REQUIRE(control.split_cells(0) > 0);
+    REQUIRE(control.split_cells(1) > 0);
+    CHECK(control.memory_bytes() == 2 * majorant.memory_bytes());
+    Pcg32 rng(3, 4);
+    int checked = 0, positive = 0;
+    for (int i = 0; i < 200; ++i) {
+        const Vec3 o(-3.f, 2.f * rng.uniform() - 1.f, 2.f * rng.uniform() - 1.f);
+        const Ray ray{o, glm::normalize(Vec3(1.f, 0.4f * rng.uniform() - 0.2f, 0.4f * rng.uniform() - 0.2f))};
+        auto it = control.iterate(ray, 0.f, kInf, {});
+        auto plain = majorant.iterate(ray, 0.f, kInf, {});
+        while (auto seg = it.next()) {
+            const auto m = plain.next();
+            REQUIRE(m);
+            CHECK(seg->t0 == m->t0);
+            CHECK(seg->t1 == m->t1);
+            CHECK(seg->sigma_maj == m->sigma_maj);
+            positive += seg->sigma_ctl.minCoeff() > 0.f;
+            const Vec3 mid = ray.at(0.5f * (seg->t0 + seg->t1));
+            CHECK((control.control_value_at(mid, {}) == seg->sigma_ctl).all());
+            CHECK(control.value_at(mid, {}) == seg->sigma_maj);
+            for (int k = 0; k < 4; ++k) {
+                const float t = seg->t0 + (seg->t1 - seg->t0) * rng.uniform();
+                const auto mu = medium.coefficients(ray.at(t), {}).sigma_t();
+                const auto res = (mu - seg->sigma_ctl).eval();
+                REQUIRE((res >= -1e-6f * mu).all());
+                REQUIRE((res <= seg->sigma_res * (1.f + 1e-5f)).all());
+                REQUIRE((mu <= seg->sigma_maj * (1.f + 1e-5f)).all());
+                ++checked;
+            }
+        }
+        CHECK_FALSE(plain.next());
+        CHECK(it.steps() == plain.steps());
+    }
+    CHECK(checked > 1000);
+    MESSAGE("tree-control segments with a positive control: " << positive << " of " << checked / 4);
+    CHECK(positive > checked / 40);
+    // Outside the medium: no majorant, no control.
+    CHECK(control.value_at(Vec3(2.f), {}) == 0.f);
+    CHECK((control.control_value_at(Vec3(2.f), {}) == 0.f).all());
+
+    // A medium without a density lower bound: the tree's cells with a control of 0.
+    struct Unbounded : M {
+        explicit Unbounded(const M& m) : M(m) {}
+        float density_lower_bound(const Box&) const = delete;
+    };
+    static_assert(LowerBoundedMedium<M> && !LowerBoundedMedium<Unbounded> && CellBoundedMedium<Unbounded>);
+    const Unbounded unbounded(medium);
+    const TreeControl<Unbounded> zero(unbounded, layout);
+    const Ray ray{Vec3(-3.f, 0.1f, -0.2f), glm::normalize(Vec3(1.f, 0.05f, 0.1f))};
+    auto it = zero.iterate(ray, 0.f, kInf, {});
+    auto plain = majorant.iterate(ray, 0.f, kInf, {});
+    int segments = 0;
+    while (auto seg = it.next()) {
+        const auto m = plain.next();
+        REQUIRE(m);
+        CHECK(seg->sigma_maj == m->sigma_maj);
+        CHECK((seg->sigma_ctl == 0.f).all());
+        CHECK(seg->sigma_res == seg->sigma_maj);
+        ++segments;
+    }
+    CHECK(segments > 4);
+}
+
 }  // namespace

@@ -169,7 +169,7 @@ TEST_CASE("tree majorants over NanoVDB grids bound every lookup, dense cloud and
     CHECK(TreeMajorant<NM>(plume).empty_cells() > 0);
 }
 
-TEST_CASE("NanoVDB grids bound their density from below: a GridControl over them, and decomposition tracking") {
+TEST_CASE("NanoVDB grids bound their density from below: a GridControl and a TreeControl over them, and decomposition tracking") {
     // The lower bound is the dense grid's (the same voxels read, the same 2^-20 margin); every lookup
     // in a GridControl cell lies at or above its control; and uni + NEE MIS under the control (decomposition
     // and residual ratio tracking) agrees with the grid majorant's within 5 combined SE, with fewer
@@ -209,6 +209,18 @@ TEST_CASE("NanoVDB grids bound their density from below: a GridControl over them
     CAPTURE(lc.mean);
     CAPTURE(lg.mean);
     CHECK(lc.mean < lg.mean);
+    // The same under a TreeControl on the grid's own nodes (128 -> 32 -> 8 voxels) against the tree
+    // majorant of that layout: the same image within 5 combined SE, with fewer lookups.
+    const auto tree_with = render_stats(nano, TreeControl<NM>(nano, nano.tree_layout()), 5);
+    const auto tree_without = render_stats(nano, TreeMajorant<NM>(nano, nano.tree_layout()), 6);
+    const Stat &vt = tree_with.first, &lt = tree_with.second, &vm = tree_without.first, &lm = tree_without.second;
+    CAPTURE(vt.mean);
+    CAPTURE(vm.mean);
+    CHECK(std::abs(vt.mean - vm.mean) <= kSigmas * std::hypot(vt.se(), vm.se()));
+    CHECK(std::abs(vt.mean - vg.mean) <= kSigmas * std::hypot(vt.se(), vg.se()));
+    CAPTURE(lt.mean);
+    CAPTURE(lm.mean);
+    CHECK(lt.mean < lm.mean);
 }
 
 TEST_CASE(".nvdb files round-trip the grid to the bit, and bad ones are rejected with their problem") {

@@ -1143,8 +1143,8 @@ void run_unusable(Input& in, FuzzRng& rng, const M& medium, const std::array<int
 }
 
 /// The trackers under a control (THEORY 5.10) on the input's medium, with a local generator (no
-/// bytes read, so the corpus keeps its meaning): GridControl at the medium's resolution, and
-/// GlobalControl at 0 (today's trackers) and at half the extinction bound (above the density where
+/// bytes read, so the corpus keeps its meaning): GridControl at the medium's resolution, a
+/// TreeControl of its voxels (coarse 2^3 split wherever the bound varies), and GlobalControl at 0 (today's trackers) and at half the extinction bound (above the density where
 /// the medium is thin: negative residuals). Decomposition tracking (track_delta, VertexKernels::track),
 /// residual ratio tracking (track_ratio, VertexKernels::shadow, transmittance_residual_ratio) and
 /// ray marching under the grid majorant: statuses Ok, Aborted or NonFinite, estimates and null
@@ -1156,10 +1156,12 @@ void run_controls(const M& medium, const std::array<int, 3>& res, const Lambda& 
     const Box b = medium.bounds();
     if (!(medium.max_extinction() * glm::length(b.hi - b.lo) <= kBudget)) return;
     std::optional<GridControl<M>> grid;
+    std::optional<TreeControl<M>> tree;
     std::optional<GridMajorant<M>> gmaj;
     std::optional<GlobalControl<M>> zero, half;
     try {
         grid.emplace(medium, res);
+        tree.emplace(medium, TreeLayout{b, {2, 2, 2}, {2, 2, 0}, 0.f, 0.f});
         gmaj.emplace(medium, res);
         zero.emplace(medium, constant_coefficient<S>(0.f));
         half.emplace(medium, constant_coefficient<S>(0.5f * medium.max_extinction()));
@@ -1216,6 +1218,7 @@ void run_controls(const M& medium, const std::array<int, 3>& res, const Lambda& 
             NSP_FUZZ_CHECK((cr.uni >= 0.f).all() && (cr.nee >= 0.f).all());
         };
         drive(*grid, true);
+        drive(*tree, true);
         drive(*zero, true);
         drive(*half, false);
         const auto rm = transmittance_ray_marching(medium, *gmaj, ray, tmax, lambda, rng, counter);

@@ -15,7 +15,9 @@
 //
 // GridControl stores per cell the density's lower bound beside its upper bound (two floats per
 // cell; a medium without a lower-bound query, LowerBoundedMedium, gets a control of 0 and pays
-// for none). GlobalControl is one constant control and majorant over the medium's box.
+// for none). TreeControl does the same on TreeMajorant's cells (the same layout, walked by the
+// same hierarchical DDA), and GlobalControl is one constant control and majorant over the
+// medium's box.
 #pragma once
 
 #include <algorithm>
@@ -32,6 +34,7 @@
 #include "../media/validate.hpp"
 #include "../medium.hpp"
 #include "grid.hpp"
+#include "tree.hpp"
 
 namespace nsp {
 
@@ -245,6 +248,72 @@ private:
     typename Spectral::Coefficient unit_;
     float unit_max_;
     float unit_min_;
+};
+
+/// A tree of controls and majorants (THEORY 5.10): TreeMajorant's cells, each that is not split
+/// keeping the medium's density lower bound over it beside its upper bound (LowerBoundedMedium; 0
+/// for a medium without one), so that on a cell's stretch the control is d_min u_c and the majorant
+/// d_max max_c u_c, as GridControl's. The layout is the majorant's (the same cost model, which
+/// prices the full majorant's lookups, decides the splits), so a TreeControl and a TreeMajorant
+/// over one layout walk the same cells. Two floats per cell of every level.
+template <CellBoundedMedium M>
+class TreeControl {
+public:
+    using Spectral = typename M::Spectral;
+    using Spectrum = typename Spectral::Spectrum;
+
+    /// The adaptive layout over the medium's bounds (as TreeMajorant's default).
+    explicit TreeControl(const M& medium) : TreeControl(medium, detail::adaptive_layout(medium)) {}
+    /// Throws InvalidArgument as TreeMajorant does, and on a lower bound that is not finite, is
+    /// negative or exceeds the cell's upper bound.
+    TreeControl(const M& medium, const TreeLayout& layout)
+        : tree_(medium, layout, 1.f, "TreeControl", true), unit_(detail::CellBounds<M>(medium, "TreeControl").unit()),
+          unit_max_(max_value(unit_)) {}
+
+    class Iterator {
+    public:
+        Iterator(const detail::MajorantTree<M>* tree, const Ray& r, float tmin, float tmax, const Spectrum& unit,
+                 float unit_max) noexcept
+            : walk_(tree, r, tmin, tmax, 1.f), unit_(unit), unit_max_(unit_max) {}
+        std::optional<ControlSegment<Spectrum>> next() noexcept {
+            const auto s = walk_.next();
+            if (!s) return std::nullopt;
+            const float hi = s->sigma_maj, lo = walk_.lower();
+            return ControlSegment<Spectrum>{s->t0, s->t1, hi * unit_max_, unit_ * lo, (hi - lo) * unit_max_};
+        }
+        std::uint32_t steps() const noexcept { return walk_.steps(); }
+
+    private:
+        detail::TreeSegmentIterator<M, float, true> walk_;
+        Spectrum unit_;
+        float unit_max_;
+    };
+
+    Iterator iterate(const Ray& r, float tmin, float tmax, const typename Spectral::Wavelengths& l) const noexcept {
+        return {&tree_, r, tmin, tmax, Spectral::sample(unit_, l), unit_max_};
+    }
+
+    /// The majorant at point p (its finest cell's; 0 outside the medium's bounds).
+    float value_at(const Vec3& p, const typename Spectral::Wavelengths&) const noexcept {
+        return tree_.at_point(p) * unit_max_;
+    }
+    /// The control at point p, per channel (its finest cell's, 0 outside the bounds): the
+    /// sigma_ctl of the segment `iterate` gives there.
+    Spectrum control_value_at(const Vec3& p, const typename Spectral::Wavelengths& l) const noexcept {
+        return Spectral::sample(unit_, l) * tree_.lower_at_point(p);
+    }
+
+    TreeLayout layout() const noexcept { return tree_.layout(); }
+    std::size_t coarse_cells() const noexcept { return tree_.coarse_cells(); }
+    std::size_t split_cells(int l = 0) const noexcept { return tree_.split_cells(l); }
+    std::size_t empty_cells() const noexcept { return tree_.empty_cells(); }
+    /// Bytes of cell storage (two floats per cell).
+    std::size_t memory_bytes() const noexcept { return tree_.memory_bytes(); }
+
+private:
+    detail::MajorantTree<M> tree_;
+    typename Spectral::Coefficient unit_;
+    float unit_max_;
 };
 
 }  // namespace nsp

@@ -23,8 +23,10 @@
 #include <array>
 #include <bit>
 #include <cmath>
+#include <concepts>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -85,8 +87,11 @@ namespace detail {
 template <CellBoundedMedium M>
 class MajorantTree {
 public:
-    MajorantTree(const M& medium, const TreeLayout& layout, float scale, const char* what)
-        : bounds_(medium.bounds()), layout_(layout), levels_(layout.splits() + 1) {
+    /// With `lower`, every cell that is not split also keeps the medium's density lower bound over
+    /// it (LowerBoundedMedium's; 0 for a medium without that query), in arrays parallel to the
+    /// packed cells (TreeControl): the layout is the same either way.
+    MajorantTree(const M& medium, const TreeLayout& layout, float scale, const char* what, bool lower = false)
+        : bounds_(medium.bounds()), layout_(layout), levels_(layout.splits() + 1), with_lower_(lower) {
         std::size_t n = 1;
         for (int a = 0; a < 3; ++a) {
             if (layout.coarse[a] < 1 || layout.coarse[a] > 4096)
@@ -130,14 +135,18 @@ public:
         pad_ = kGridMajorantPad * scale;
         scale_ = scale;
         cells_[0].assign(n, 0u);
+        if (with_lower_) lower_[0].assign(n, 0.f);
         std::size_t i = 0;
         for (int z = 0; z < layout.coarse[2]; ++z)
             for (int y = 0; y < layout.coarse[1]; ++y)
                 for (int x = 0; x < layout.coarse[0]; ++x, ++i) {
                     const int c[3] = {x, y, z};
-                    cells_[0][i] = build(bounds, 0, cell_box(box, 0, c, layout.coarse), c, what).packed();
+                    const Built b = build(medium, bounds, 0, cell_box(box, 0, c, layout.coarse), c, what);
+                    cells_[0][i] = b.packed();
+                    if (with_lower_) lower_[0][i] = b.lower;
                 }
         for (auto& v : cells_) v.shrink_to_fit();
+        for (auto& v : lower_) v.shrink_to_fit();
         for (int l = 0; l < levels_; ++l) {
             res_[l] = res(l);
             stride_[l] = per_node(l);
@@ -174,10 +183,25 @@ public:
     }
     /// The cells per axis of level l's nodes (precomputed).
     const std::array<int, 3>& level_res(int l) const noexcept { return res_[l]; }
+    /// The density lower bounds of node `node`'s cells of level l, parallel to node_cells (0 for a
+    /// split cell); only on a tree built with `lower`.
+    const float* node_lower(int l, std::int32_t node) const noexcept {
+        return lower_[l].data() + std::size_t(node) * stride_[l];
+    }
+    bool has_lower() const noexcept { return with_lower_; }
 
     /// The value of the finest cell holding p (0 outside the medium's bounds).
-    float at_point(const Vec3& p) const noexcept {
-        if (!bounds_.contains(p)) return 0.f;
+    float at_point(const Vec3& p) const noexcept { return find(p).value; }
+    /// The density lower bound of the finest cell holding p (0 outside the medium's bounds, or on
+    /// a tree built without `lower`).
+    float lower_at_point(const Vec3& p) const noexcept { return find(p).lower; }
+
+private:
+    struct Found {
+        float value, lower;
+    };
+    Found find(const Vec3& p) const noexcept {
+        if (!bounds_.contains(p)) return {0.f, 0.f};
         Box b = layout_.box;
         std::int32_t node = 0;
         for (int l = 0;; ++l) {
@@ -186,11 +210,13 @@ public:
             for (int a = 0; a < 3; ++a) c[a] = std::clamp(int((p[a] - b.lo[a]) * inv_cell_[l][a]), 0, r[a] - 1);
             const std::size_t i = std::size_t(c[0]) + std::size_t(r[0]) * (std::size_t(c[1]) + std::size_t(r[1]) * std::size_t(c[2]));
             const std::uint32_t cell = node_cells(l, node)[i];
-            if (!(cell & kSplit)) return std::bit_cast<float>(cell);
+            if (!(cell & kSplit)) return {std::bit_cast<float>(cell), with_lower_ ? node_lower(l, node)[i] : 0.f};
             b = cell_box(b, l, c, r);
             node = std::int32_t(cell & ~kSplit);
         }
     }
+
+public:
 
     TreeLayout layout() const noexcept { return layout_; }
     std::size_t coarse_cells() const noexcept { return cells_[0].size(); }
@@ -201,10 +227,10 @@ public:
         for (const std::uint32_t c : cells_[0]) k += !(c & kSplit) && !(std::bit_cast<float>(c) > 0.f);
         return k;
     }
-    /// Bytes of storage: 4 per cell of every level.
+    /// Bytes of storage: 4 per cell of every level (8 with lower bounds).
     std::size_t memory_bytes() const noexcept {
         std::size_t b = 0;
-        for (int l = 0; l < levels_; ++l) b += cells_[l].size() * sizeof(std::uint32_t);
+        for (int l = 0; l < levels_; ++l) b += cells_[l].size() * sizeof(std::uint32_t) + lower_[l].size() * sizeof(float);
         return b;
     }
 
@@ -221,15 +247,28 @@ private:
         float value;
         std::int32_t node;
         double cost;
+        float lower = 0.f;  ///< the density lower bound of a cell that is not split (with_lower_)
         std::uint32_t packed() const noexcept { return node >= 0 ? kSplit | std::uint32_t(node) : std::bit_cast<std::uint32_t>(value); }
     };
 
     /// Builds cell `region` of level l: its bound and, where that pays, its split (children first).
-    Built build(const CellBounds<M>& bounds, int l, const Box& region, const int* c, const char* what) {
+    Built build(const M& medium, const CellBounds<M>& bounds, int l, const Box& region, const int* c, const char* what) {
         const float d = bounds.density(region);
         if (!std::isfinite(d) || d < 0.f)
             fail(what, " level-", l, " cell (", c[0], ", ", c[1], ", ", c[2], "): the medium's density bound = ", d,
                  " is not allowed: it must be finite and >= 0");
+        float lo = 0.f;
+        if constexpr (requires { { medium.density_lower_bound(region) } -> std::same_as<float>; }) {
+            if (with_lower_) {
+                lo = medium.density_lower_bound(region);
+                if (!std::isfinite(lo) || lo < 0.f)
+                    fail(what, " level-", l, " cell (", c[0], ", ", c[1], ", ", c[2], "): the medium's density lower bound = ",
+                         lo, " is not allowed: it must be finite and >= 0");
+                if (lo > d)
+                    fail(what, " level-", l, " cell (", c[0], ", ", c[1], ", ", c[2], "): the medium's density lower bound = ",
+                         lo, " exceeds its upper bound ", d);
+            }
+        }
         const float v = d * pad_;
         if (!std::isfinite(v * unit_))
             fail(what, " level-", l, " cell (", c[0], ", ", c[1], ", ", c[2], ") majorant = density bound ", d, " x scale ",
@@ -241,14 +280,15 @@ private:
         // As one cell: a step, and mu_bar times the mean chord tentative collisions.
         const double step = double(layout_.step_cost);
         const double as_leaf = step + double(v) * double(unit_) * mean_chord(region);
-        if (!(v > 0.f) || l + 1 >= levels_) return {v, -1, as_leaf};  // empty, or a finest cell
+        if (!(v > 0.f) || l + 1 >= levels_) return {v, -1, as_leaf, lo};  // empty, or a finest cell
         const auto r = res(l + 1);
         const std::size_t k = per_node(l + 1);
         // Nodes the children add below: dropped again if the cell stays whole.
         std::size_t mark[kMaxTreeSplits + 1];
         for (int m = l + 1; m < levels_; ++m) mark[m] = cells_[m].size();
         std::vector<std::uint32_t> parts(k);
-        float first = 0.f;
+        std::vector<float> part_lower(with_lower_ ? k : 0);
+        float first = 0.f, lowest = std::numeric_limits<float>::infinity();
         bool uniform = true;
         // The step into the cell and the descent into its node, then each child in proportion to
         // its surface.
@@ -260,30 +300,43 @@ private:
                 for (int x = 0; x < r[0]; ++x, ++j) {
                     const int g[3] = {x, y, z};
                     const Box part = cell_box(region, l + 1, g, r);
-                    const Built b = build(bounds, l + 1, part, g, what);
+                    const Built b = build(medium, bounds, l + 1, part, g, what);
                     parts[j] = b.packed();
+                    if (with_lower_) part_lower[j] = b.lower;
+                    lowest = std::min(lowest, b.lower);
                     if (j == 0) first = b.value;
                     as_split += box_surface(part) / area * b.cost;
                     uniform = uniform && b.node < 0 && b.value == first;
                 }
         if (uniform || !(as_split < as_leaf)) {  // a constant tile, or a split that does not pay
-            for (int m = l + 1; m < levels_; ++m) cells_[m].resize(mark[m]);
-            return uniform ? Built{first, -1, step + double(first) * double(unit_) * mean_chord(region)} : Built{v, -1, as_leaf};
+            for (int m = l + 1; m < levels_; ++m) {
+                cells_[m].resize(mark[m]);
+                if (with_lower_) lower_[m].resize(mark[m]);
+            }
+            // A constant tile's parts all bound it from below too: the tightest of them (or the
+            // cell's own lower bound, where that is tighter).
+            return uniform ? Built{first, -1, step + double(first) * double(unit_) * mean_chord(region),
+                                   std::min(first, std::max(lo, lowest))}
+                           : Built{v, -1, as_leaf, lo};
         }
         if (cells_[l + 1].size() / k >= std::size_t(kSplit))
             fail(what, ": more than 2^31 nodes at level ", l + 1, "; a coarser layout is needed");
         const auto node = std::int32_t(cells_[l + 1].size() / k);
         cells_[l + 1].insert(cells_[l + 1].end(), parts.begin(), parts.end());
+        if (with_lower_) lower_[l + 1].insert(lower_[l + 1].end(), part_lower.begin(), part_lower.end());
         return {v, node, as_split};
     }
 
     Box bounds_;
     TreeLayout layout_;
     int levels_;
+    bool with_lower_ = false;
     Vec3 cell_[kMaxTreeSplits + 1]{}, inv_cell_[kMaxTreeSplits + 1]{};
     float unit_ = 1.f, pad_ = 1.f, scale_ = 1.f;
     /// Per level, its nodes' cells one after another, packed (node_cells).
     std::vector<std::uint32_t> cells_[kMaxTreeSplits + 1];
+    /// Per level, parallel to cells_, each cell's density lower bound (only with_lower_).
+    std::vector<float> lower_[kMaxTreeSplits + 1];
     // What the walk reads per step, precomputed.
     std::array<int, 3> res_[kMaxTreeSplits + 1]{};
     std::size_t stride_[kMaxTreeSplits + 1]{};
@@ -294,8 +347,9 @@ private:
 /// The ray's part of every level's DDA (origin, direction, 1 / direction, steps) is stored once
 /// and the walk's t is shared: a level holds only its node's origin, cells and next crossings, so
 /// entering a node costs a few multiplications per axis (the walk held a full GridWalk per level
-/// before, and cost twice a grid's walk per step).
-template <CellBoundedMedium M, class V>
+/// before, and cost twice a grid's walk per step). With kLower (a tree built with lower bounds),
+/// `lower()` is the density lower bound of the cell of the segment `next` gave last (TreeControl).
+template <CellBoundedMedium M, class V, bool kLower = false>
 class TreeSegmentIterator {
 public:
     TreeSegmentIterator() = default;
@@ -324,6 +378,7 @@ public:
         L.t_end = in.t1;
         L.done = false;
         L.cells = tree->node_cells(0, 0);
+        if constexpr (kLower) L.lower = tree->node_lower(0, 0);
         depth_ = 0;
     }
 
@@ -357,13 +412,22 @@ public:
                 continue;
             }
             const float v = std::bit_cast<float>(cell);
-            if (v > 0.f && t1 > t0) return MajorantSegment<V>{t0, t1, V(unit_ * v)};
+            if (v > 0.f && t1 > t0) {
+                if constexpr (kLower) lower_ = L.lower[i];
+                return MajorantSegment<V>{t0, t1, V(unit_ * v)};
+            }
         }
         return std::nullopt;
     }
 
     /// DDA steps taken so far, at every level (empty cells included).
     std::uint32_t steps() const noexcept { return steps_; }
+    /// The density lower bound of the last segment's cell (kLower only).
+    float lower() const noexcept
+        requires kLower
+    {
+        return lower_;
+    }
 
 private:
     /// One level's walk: its node's origin, cell size and cells per axis, the cell the walk is in
@@ -374,6 +438,7 @@ private:
         float t_end;
         bool done;
         const std::uint32_t* cells;  ///< the node's cells, packed (MajorantTree::node_cells)
+        const float* lower;          ///< their density lower bounds (kLower only)
     };
 
     DdaAxis axis(const Level& L, int a) const noexcept { return {L.lo[a], L.h[a], o_[a], d_[a], inv_[a], L.res[a], step_[a]}; }
@@ -397,6 +462,7 @@ private:
         L.t_end = t1;
         L.done = false;
         L.cells = tree_->node_cells(l, node);
+        if constexpr (kLower) L.lower = tree_->node_lower(l, node);
         depth_ = l;
     }
 
@@ -407,6 +473,7 @@ private:
     float t_ = 0.f;
     int depth_ = -1;
     std::uint32_t steps_ = 0;
+    float lower_ = 0.f;  ///< kLower only
     /// Left uninitialised until the walk enters that level: an iterator is made per flight, and
     /// zeroing every level each time cost more than the walk (measured).
     Level level_[kMaxTreeSplits + 1];
