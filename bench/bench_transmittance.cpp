@@ -1,7 +1,7 @@
 // bench/bench_transmittance.cpp: one microbenchmark per transmittance estimator (THEORY 5.10,
 // nsp/transmittance.hpp) on the same random rays through the default cloud (Mono): ratio
 // tracking under the global and a 16^3 grid majorant, residual ratio tracking under a 16^3 grid
-// control, unbiased ray marching under the global and the grid majorant. Each iteration is two
+// control (and the loop on the tree majorant's cells without and with their minorants), unbiased ray marching under the global and the grid majorant. Each iteration is two
 // independent estimates along the same ray (the next of the set): the time is per 2 estimates, the
 // counters give lookups per estimate and the estimator's variance, the mean of (a - b)^2 / 2 over
 // the pairs (unbiased, and free of the spread between rays), so time x variance per estimator
@@ -109,6 +109,20 @@ void BM_Delta_GridControl(benchmark::State& state) {
     });
 }
 
+// The same loop on the tree's cells (the adaptive layout), without and with their minorants.
+template <class Maj, bool kRatio>
+void BM_Tree(benchmark::State& state) {
+    const Maj maj(cloud());
+    run(state, [&](const nsp::Ray& r, nsp::Pcg32& rng, nsp::LookupCount& c) {
+        if constexpr (kRatio) return nsp::transmittance_ratio(cloud(), maj, r, kTmax, {}, rng, c);
+        else return nsp::transmittance_delta(cloud(), maj, r, kTmax, {}, rng, c);
+    });
+}
+void BM_Ratio_Tree(benchmark::State& state) { BM_Tree<nsp::TreeMajorant<M>, true>(state); }
+void BM_Ratio_TreeControl(benchmark::State& state) { BM_Tree<nsp::TreeControl<M>, true>(state); }
+void BM_Delta_Tree(benchmark::State& state) { BM_Tree<nsp::TreeMajorant<M>, false>(state); }
+void BM_Delta_TreeControl(benchmark::State& state) { BM_Tree<nsp::TreeControl<M>, false>(state); }
+
 BENCHMARK(BM_Ratio_Global)->MinTime(kMinTime);
 BENCHMARK(BM_Ratio_Grid16)->MinTime(kMinTime);
 BENCHMARK(BM_ResidualRatio_GridControl16)->MinTime(kMinTime);
@@ -122,5 +136,9 @@ BENCHMARK(BM_Delta_Grid<16>)->MinTime(kMinTime);
 BENCHMARK(BM_Delta_Grid<64>)->MinTime(kMinTime);
 BENCHMARK(BM_Delta_GridControl<16>)->MinTime(kMinTime);
 BENCHMARK(BM_Delta_GridControl<64>)->MinTime(kMinTime);
+BENCHMARK(BM_Ratio_Tree)->MinTime(kMinTime);
+BENCHMARK(BM_Ratio_TreeControl)->MinTime(kMinTime);
+BENCHMARK(BM_Delta_Tree)->MinTime(kMinTime);
+BENCHMARK(BM_Delta_TreeControl)->MinTime(kMinTime);
 
 }  // namespace

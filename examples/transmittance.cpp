@@ -1,14 +1,16 @@
 // examples/transmittance.cpp: nsp_transmittance, the transmittance estimators side by side
 // (THEORY 5.10, nsp/transmittance.hpp): ratio tracking under a global and a grid majorant,
 // residual ratio tracking under a grid control (per-cell minorants), unbiased ray marching under
-// a global and a grid majorant. Two tables: a 1-D set of analytic extinction profiles along one
-// ray (constant, linear ramp, Gaussian bump, a hole, a step, a high-frequency cosine; optical depth
-// 2 each), each against its exact transmittance, and shadow rays through the example media (the
-// cloud, the sparse medium, the fog, the plume's smoke) and through any .nvdb or .vdb files given
-// with --volume (NanoVdbMedium: the sparse tree's lookups, its leaves' bounds for the grids). Per estimator: the variance of one
-// estimate, its lookups, their product LTUV (lookups x variance: the cost of a given error, machine
-// independent) and LTUV over the best ratio-tracking row's. Exits 0, or 1 when an estimate failed
-// or a 1-D mean is more than 5 standard errors from its exact value.
+// a global and a grid majorant, and on the media ratio tracking on the tree majorant's cells and
+// residual ratio tracking under the tree control of the same cells. Two tables: a 1-D set of
+// analytic extinction profiles along one ray (constant, linear ramp, Gaussian bump, a hole, a
+// step, a high-frequency cosine; optical depth 2 each), each against its exact transmittance, and
+// shadow rays through the example media (the cloud, the sparse medium, the fog, the plume's smoke)
+// and through any .nvdb or .vdb files given with --volume (NanoVdbMedium: the sparse tree's
+// lookups, its leaves' bounds for the grids). Per estimator: the variance of one estimate, its
+// lookups, their product LTUV (lookups x variance: the cost of a given error, machine
+// independent) and LTUV over the better of the global and grid ratio-tracking rows'. Exits 0, or
+// 1 when an estimate failed or a 1-D mean is more than 5 standard errors from its exact value.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -69,8 +71,10 @@ struct Estimators {
     std::vector<std::function<TransmittanceSample<Mono>(const Ray&, float, Pcg32&, LookupCount&)>> run;
 };
 
+/// With `tree`, also ratio tracking on the tree majorant's cells (its adaptive layout) and residual
+/// ratio tracking under the tree control of the same cells, after the others.
 template <class Med>
-Estimators estimators_for(const Med& medium, std::array<int, 3> res, const RayMarchingOptions& marching) {
+Estimators estimators_for(const Med& medium, std::array<int, 3> res, const RayMarchingOptions& marching, bool tree = false) {
     // Owned by the closures (shared_ptr: std::function copies them).
     auto global = std::make_shared<GlobalMajorant<Med>>(medium);
     auto grid = std::make_shared<GridMajorant<Med>>(medium, res);
@@ -94,6 +98,18 @@ Estimators estimators_for(const Med& medium, std::array<int, 3> res, const RayMa
     e.run.push_back([&medium, grid, marching](const Ray& r, float t, Pcg32& rng, LookupCount& n) {
         return transmittance_ray_marching(medium, *grid, r, t, {}, rng, n, marching);
     });
+    if (tree) {
+        auto majorant = std::make_shared<TreeMajorant<Med>>(medium);
+        auto tree_control = std::make_shared<TreeControl<Med>>(medium);
+        e.names.push_back("ratio, tree");
+        e.names.push_back("residual ratio, tree control");
+        e.run.push_back([&medium, majorant](const Ray& r, float t, Pcg32& rng, LookupCount& n) {
+            return transmittance_ratio(medium, *majorant, r, t, {}, rng, n);
+        });
+        e.run.push_back([&medium, tree_control](const Ray& r, float t, Pcg32& rng, LookupCount& n) {
+            return transmittance_residual_ratio(medium, *tree_control, r, t, {}, rng, n);
+        });
+    }
     return e;
 }
 
@@ -164,7 +180,7 @@ int media_rows(const char* name, const Med& medium, const Vec3& lamp, const Opti
         const Vec3 to = lamp - p;
         rays.push_back({Ray{p, glm::normalize(to)}, glm::length(to)});
     }
-    const Estimators e = estimators_for(medium, {o.grid, o.grid, o.grid}, o.marching);
+    const Estimators e = estimators_for(medium, {o.grid, o.grid, o.grid}, o.marching, true);
     std::vector<Result> results;
     for (std::size_t k = 0; k < e.run.size(); ++k) results.push_back(measure(e, k, rays, o.per_ray, o.seed));
     const double best = std::min(results[0].ltuv(), results[1].ltuv());

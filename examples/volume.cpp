@@ -137,8 +137,17 @@ nsp::TreeMajorant<M> tree_majorant(const M& m, const VolumeOptions& o, bool on_n
     return nsp::TreeMajorant<M>(m, l);
 }
 
+/// The tree control (nsp::TreeControl) of tree_majorant's adaptive layout: the same cells, each
+/// with the medium's density lower bound beside its upper bound.
+template <class M>
+nsp::TreeControl<M> tree_control(const M& m, const VolumeOptions& o) {
+    nsp::TreeLayout l = nsp::detail::adaptive_layout(m);
+    l.step_cost = o.tree_step_cost;
+    return nsp::TreeControl<M>(m, l);
+}
+
 /// Renders `medium` with uni + NEE MIS (balance) under the global majorant, grids of 16^3 and
-/// 64^3 and the tree majorant, and prints the comparison with each majorant's memory and build
+/// 64^3, the tree majorant and (for a medium with a density lower bound) the tree control, and prints the comparison with each majorant's memory and build
 /// time (z against the global majorant's row).
 template <class M>
 std::uint64_t compare_majorants(const M& medium, const VolumeOptions& o) {
@@ -160,6 +169,7 @@ std::uint64_t compare_majorants(const M& medium, const VolumeOptions& o) {
     if (model_row) names.push_back("grid " + std::to_string(picked) + "^3 (model)");
     if constexpr (TreeLayoutMedium<M>) names.push_back("tree on VDB nodes");
     names.push_back("tree");
+    if constexpr (LowerBoundedMedium<M>) names.push_back("tree-control");
     const double samples = double(o.res) * o.res * o.spp;
     nsp_examples::Progress progress;
     for (std::size_t i = 0; i < names.size() * std::size_t(o.runs); ++i) progress.add(samples);  // no pilots: by samples
@@ -222,6 +232,10 @@ std::uint64_t compare_majorants(const M& medium, const VolumeOptions& o) {
     auto [tree, tree_ms] = timed([&] { return tree_majorant(medium, o); });
     run(tree, tree_ms, tree.memory_bytes());
     describe("tree", tree);
+    if constexpr (LowerBoundedMedium<M>) {  // the tree's cells with their minorants: decomposition tracking
+        auto [ctl, ctl_ms] = timed([&] { return tree_control(medium, o); });
+        run(ctl, ctl_ms, ctl.memory_bytes());
+    }
     std::size_t i = 0;
     const std::uint64_t failed = print_rows(rows, 0, samples, "  majorant-KiB build-ms", [&](const Row&) {
         std::printf("  %12.1f %8.1f", double(cost[i].first) / 1024.0, cost[i].second);
@@ -253,6 +267,12 @@ int render(const M& medium, const VolumeOptions& o, const char* mode, const char
             throw nsp_examples::UsageError("--majorant grid-control takes a medium with a density lower bound");
     }
     else if (o.majorant == "tree") failed = run_strategies(medium, tree_majorant(medium, o), o);
+    else if (o.majorant == "tree-control") {
+        if constexpr (nsp::LowerBoundedMedium<M>)
+            failed = run_strategies(medium, tree_control(medium, o), o);
+        else
+            throw nsp_examples::UsageError("--majorant tree-control takes a medium with a density lower bound");
+    }
     else if (o.majorant == "tree-nodes") failed = run_strategies(medium, tree_majorant(medium, o, true), o);
     else failed = run_strategies(medium, nsp::GlobalMajorant<M>(medium), o);
     if (failed == 0) return nsp_examples::kExitOk;

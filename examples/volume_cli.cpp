@@ -40,8 +40,9 @@ VolumeOptions parse_volume_flags(int argc, char** argv) {
     app.add_option("--g", o.g, "Henyey-Greenstein asymmetry")->check(real_in(-0.99, 0.99));
     app.add_option("--majorant", o.majorant,
                    "global (one value), grid (a grid of cell maxima), grid-control (the grid with each cell's minimum beside it: "
-                   "decomposition tracking), tree (adaptive, hierarchical) or tree-nodes (on a VDB grid's nodes)")
-        ->check(CLI::IsMember({"global", "grid", "grid-control", "tree", "tree-nodes"}));
+                   "decomposition tracking), tree (adaptive, hierarchical), tree-control (the tree with each cell's minimum beside it) or "
+                   "tree-nodes (on a VDB grid's nodes)")
+        ->check(CLI::IsMember({"global", "grid", "grid-control", "tree", "tree-control", "tree-nodes"}));
     app.add_option("--grid-res", o.grid_res, "cells per axis of the grid majorant")->check(integer_in(1, 256));
     app.add_option("--tree-split", o.tree_split, "cells of the tree majorant per leaf (8 voxels) and axis")
         ->check(CLI::IsMember({1, 2, 4, 8}));
@@ -49,7 +50,8 @@ VolumeOptions parse_volume_flags(int argc, char** argv) {
         ->check(real_in(0.0, 100.0));
     app.add_option("--runs", o.runs, "with --compare-majorants: runs per row (other seeds); each column their median")
         ->check(integer_in(1, 99));
-    app.add_flag("--compare-majorants", o.compare, "render uni-nee-mis under the global, grid 16^3 and 64^3 and tree majorants");
+    app.add_flag("--compare-majorants", o.compare,
+                 "render uni-nee-mis under the global, grid 16^3 and 64^3 and tree majorants and the tree control");
     app.add_option("--res", o.res, "image width and height in pixels")->check(integer_in(1, 4096));
     app.add_option("--spp", o.spp, "samples per pixel")->check(integer_in(2, 1 << 20));
     app.add_option("--threads", o.threads, "worker threads")->check(integer_in(1, 256));
