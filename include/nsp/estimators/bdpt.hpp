@@ -213,11 +213,6 @@ private:
             static_assert(!is_per_channel_majorant_v<typename Sc::MajorantType, typename Sc::MediumType>,
                           "nsp::BdptEstimator<..., bdpt::Grey> drives every channel with one pdf and needs a grey "
                           "majorant (channels::SpectralMis: one per channel)");
-        else
-            static_assert(!is_control_v<typename Sc::MajorantType, typename Sc::MediumType>,
-                          "nsp::BdptEstimator<..., channels::SpectralMis> does not track under a control (GridControl, "
-                          "GlobalControl): its channel trackers walk the full majorant; use GridMajorant or "
-                          "GlobalMajorant, or the grey axis (bdpt::Grey)");
 
         static_assert(std::remove_cvref_t<decltype(std::declval<Sc>().lights)>::bidirectional_ready(),
                       "nsp::BdptEstimator: every light model must start light subpaths (EmittingLight: "
@@ -261,11 +256,22 @@ private:
         Spec* last_event;                     // its mu_bar_c P_s,c, should it scatter
         Spec* last_tbar;                      // its Tbar_c since the collision before
         bool* pending;
+        // Under a control (THEORY 5.10): the collision's residual majorant R, whose null factor
+        // P_n,r = mu_n,r / R (d.null is the residual's null density), and exp(-tau_c) so far.
+        bool controlled = false;
+        float rate = 0.f;
+        float control_transmittance = 1.f;
+        void under_control(float r, float e) noexcept {
+            controlled = true;
+            rate = r;
+            control_transmittance = e;
+        }
         template <class State>
         void operator()(float, const Coefficients<S>&, const Spec& mu, const Spec& tbar, const State&,
                         const ChannelEventDensities<Spec>& d) const {
             if (*pending) *nulls *= last_null->template cast<double>();
-            *last_null = (mu > 0.f).select(d.null / mu, 0.f);
+            if (controlled) *last_null = rate > 0.f ? Spec(d.null / rate) : Spec(Spec::Zero());
+            else *last_null = (mu > 0.f).select(d.null / mu, 0.f);
             *last_event = d.scatter;
             *last_tbar = tbar;
             *pending = true;
@@ -290,6 +296,7 @@ private:
         const Spec& nulls;  // the segment's null product before this piece
         float pdf_dir;
         float along;  // the segment technique's normaliser on this piece (0: it does not run)
+        void under_control(float r, float e) noexcept { null_visit.under_control(r, e); }
         template <class State>
         void operator()(float t, const Coefficients<S>& k, const Spec& mu, const Spec& tbar, const State& st,
                         const ChannelEventDensities<Spec>& d) const {
@@ -297,8 +304,9 @@ private:
             if constexpr (!std::is_same_v<F, NoEmission>) {
                 const float p_here = st.uni[channel] * tbar[channel];
                 if (!(p_here > 0.f)) return;
-                (*emission)(path, count, medium, ray.at(t), k, mu, mu[channel], Spec(beta0 * st.f * tbar / p_here),
-                            Spec(nulls * null_visit.nulls->template cast<float>()), pdf_dir,
+                // The nulls before y (under a control with exp(-tau_c) to y, as the state's f and uni).
+                const Spec before = nulls * null_visit.nulls->template cast<float>() * null_visit.control_transmittance;
+                (*emission)(path, count, medium, ray.at(t), k, mu, mu[channel], Spec(beta0 * st.f * tbar / p_here), before, pdf_dir,
                             relative_to_largest<Spec>(path[count - 1].gamma * st.nee * tbar), nulls, along);
             }
         }

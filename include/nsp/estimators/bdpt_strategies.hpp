@@ -182,9 +182,14 @@ void BdptEstimator<Mis, H, A, MaxDepth, Ch>::BdptSample<Sc, Cam, R, C, Splat, Ob
     // Tracking's event density mu_bar P_s at x (per channel, every channel's); under a control,
     // decomposition tracking's: the sum of its control and residual routes (THEORY 5.10), as the
     // walk's DeltaTrack::event_density.
-    if constexpr (kPerChannel)
+    if constexpr (kPerChannel) {
         x.event = channel_event_densities<A, typename Sc::Spectral>(c->k, majorants<P>(c->mu)).scatter;
-    else if (c->ctl > 0.f)
+        if constexpr (std::is_same_v<std::remove_cvref_t<decltype(c->mu)>, float>)  // a control's majorant is grey
+            if (c->ctl > 0.f)
+                x.event = nsp::detail::channel_decomposition_densities<Ch, A, typename Sc::Spectral>(
+                              c->k, c->ctl, c->mu, Spectrum::Ones())
+                              .scatter;
+    } else if (c->ctl > 0.f)
         x.event = nsp::detail::decomposition_event_densities<A>(c->k, c->ctl, c->mu).scatter;
     else
         x.event = c->mu * event_probabilities<A>(c->k, c->mu).scatter;

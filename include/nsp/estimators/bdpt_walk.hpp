@@ -172,6 +172,8 @@ struct BdptEstimator<Mis, H, A, MaxDepth, Ch>::SubpathWalk {
         }
         if (seg.end != SegmentEnd::Scattered && seg.end != SegmentEnd::Passed) return Step::End;  // absorbed, or no pdf left
         if (seg.end == SegmentEnd::Passed && pending) piece_nulls *= last_null.template cast<double>();
+        // Under a control the residual nulls' P_n,r and exp(-tau_c) to the end (THEORY 5.10).
+        piece_nulls *= double(seg.control_transmittance);
         nulls *= piece_nulls.template cast<float>();
         if (first && count == 1 && crossings > 0) first->later_nulls *= piece_nulls.template cast<float>();
         beta = beta0 * st.f / st.uni[channel];
