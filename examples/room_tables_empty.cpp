@@ -98,7 +98,7 @@ RoomTable grey_empty_table(std::shared_ptr<const Sc> sc, std::shared_ptr<const C
 }
 
 /// C1 (a white sky) or C2 (set-up A's sphere light): Rgb, per-channel majorants, the spectral path
-/// tracers against per-channel BDPT.
+/// tracers against per-channel BDPT; then both under a grid control.
 RoomTable chromatic_empty_table(const SceneChoice& c, const RoomOptions& o) {
     RoomTable t = empty_table(c, "rgb, per-channel majorants", 3, o);
     const auto sc = share(make_setup_surface_scene<Rgb, DenseGridCloud, ChannelMajorantPolicy>(c));
@@ -120,6 +120,14 @@ RoomTable chromatic_empty_table(const SceneChoice& c, const RoomOptions& o) {
                      "unidirectional_spectral-mis_no-rr");
         rows.learned_bdpt(sc, camera, "bdpt_spectral-mis_learned_no-rr", channels::SpectralMis{}, false);
     }
+    // Under a grid control of the medium's cells (a grey majorant with each cell's minorant; the
+    // loop's control is the smallest channel's): spectral MIS + NEE and per-channel BDPT by
+    // decomposition and residual ratio tracking (THEORY 5.10).
+    const auto controlled = share(make_setup_surface_scene<Rgb, DenseGridCloud, GridControlPolicy>(c));
+    rows.pinhole(controlled, camera,
+                 SpectralPathEstimator<channels::SpectralMis, strategy::NullScatteringMis, mis::Balance>(kDepth),
+                 "uni-nee-mis_spectral-mis_grid-control");
+    rows.pinhole(controlled, camera, SpectralBdptEstimator<mis::Balance>{}, "bdpt_spectral-mis_grid-control");
     return t;
 }
 
