@@ -204,9 +204,6 @@ typename S::Spectrum channel_scatter_densities(const Coefficients<S>& k, const V
 struct ChannelTrack {
     SegmentEnd end = SegmentEnd::Passed;  ///< Passed, Scattered, Absorbed, Terminated (weight 0), Overflowed or Aborted
     float t = 0.f;                        ///< the real collision, or tmax
-    /// Under a control, exp(-tau_c) from 0 to t (Passed, Scattered): the probability of no control
-    /// collision there, a factor of every channel's null product (already in the state's f and uni).
-    float control_transmittance = 1.f;
 };
 
 /// Delta tracking with channel c's sampling and every channel's pdf (THEORY 5.3): updates the
@@ -231,8 +228,9 @@ struct ChannelTrack {
 /// ratio tracking's pdf of the nulls is the residual's alone). The visitor is then called from
 /// before_event at every collision with the medium's own lookup, the full majorant and the state
 /// with exp(-tau_c) so far; a visitor with `under_control(R, e)` is told first the collision's
-/// residual majorant R and e = exp(-tau_c) so far (per-channel BDPT's null products are the
-/// residual's P_n,r = mu_n,r / R times e, THEORY 5.10).
+/// residual majorant R and e = exp(-tau_c) so far, and one with `control_end(e)` the segment's
+/// exp(-tau_c) to its end (Passed or Scattered) when the tracking is done (per-channel BDPT's null
+/// products are the residual's P_n,r = mu_n,r / R times exp(-tau_c), THEORY 5.10).
 template <ChannelPolicy CP, AbsorptionPolicy A, SpectralMode S, UniformRng R, class Rec, bool kEq = false,
           class Visit = NoVisit, bool kControlled = false>
 struct ChannelDeltaCollision {
@@ -401,18 +399,18 @@ ChannelTrack track_channels_delta_visiting(const M& medium, const Maj& majorant,
                                                                          std::move(visit)};
     const auto f = free_flight(medium, majorant, ray, 0.f, tmax, lambda, rng, counter, cb, kDefaultMaxCollisions, c);
     if (f.aborted) return {aborted_end(f), f.t};
-    float e_ctl = 1.f;
     if constexpr (kControlled) {
         // No control collision before the end: exp(-tau_c) in f and uni (THEORY 5.10).
         if (f.tau_ctl > 0.0 && (f.stopped ? cb.out.end == SegmentEnd::Scattered : true)) {
-            e_ctl = float(std::exp(-f.tau_ctl));
-            st.f *= e_ctl;
-            st.uni *= e_ctl;
+            const float e = float(std::exp(-f.tau_ctl));
+            st.f *= e;
+            st.uni *= e;
+            if constexpr (requires { cb.visit.control_end(e); }) cb.visit.control_end(e);
             if (const StateScale r = st.template renormalize<CP>(c); r != StateScale::Ok)
                 return {detail::segment_end(r), f.stopped ? cb.out.t : tmax};
         }
     }
-    if (f.stopped) return {cb.out.end, cb.out.t, e_ctl};
+    if (f.stopped) return cb.out;
     if constexpr (is_per_channel_majorant_v<Maj, M>) {
         const auto tb = detail::relative_transmittance(f.tau_tail, c);
         st.f *= tb;
@@ -426,7 +424,7 @@ ChannelTrack track_channels_delta_visiting(const M& medium, const Maj& majorant,
             return {detail::segment_end(r), tmax};
     }
     if constexpr (RecT::enabled) rec.log_pdf -= double(channel_of(f.tau_tail, c));
-    return {SegmentEnd::Passed, tmax, e_ctl};
+    return {SegmentEnd::Passed, tmax};
 }
 
 /// Delta-tracks `ray` over [0, tmax] with sampling channel c, updating `st` (see

@@ -247,7 +247,7 @@ private:
     /// Per channel: every channel's null probabilities P_n,c over a tracked piece and its event
     /// density mu_bar_c P_s,c at the piece's real collision, from the coefficients at each
     /// tentative collision (all but a scattering end are nulls).
-    template <SpectralMode S>
+    template <SpectralMode S, bool kControlled = false>
     struct ChannelNullVisit {
         static constexpr bool enabled = true;
         using Spec = typename S::Spectrum;
@@ -256,22 +256,29 @@ private:
         Spec* last_event;                     // its mu_bar_c P_s,c, should it scatter
         Spec* last_tbar;                      // its Tbar_c since the collision before
         bool* pending;
-        // Under a control (THEORY 5.10): the collision's residual majorant R, whose null factor
-        // P_n,r = mu_n,r / R (d.null is the residual's null density), and exp(-tau_c) so far.
-        bool controlled = false;
-        float rate = 0.f;
-        float control_transmittance = 1.f;
-        void under_control(float r, float e) noexcept {
-            controlled = true;
-            rate = r;
-            control_transmittance = e;
+        // Under a control (kControlled, THEORY 5.10): the collision's residual majorant R, whose
+        // null factor P_n,r = mu_n,r / R (d.null is the residual's null density), and exp(-tau_c)
+        // so far.
+        struct Control {
+            float rate = 0.f;
+            float transmittance = 1.f;
+        };
+        [[no_unique_address]] std::conditional_t<kControlled, Control, detail::Empty> control{};
+        void under_control(float r, float e) noexcept
+            requires kControlled
+        {
+            control = {r, e};
         }
+        /// The piece's exp(-tau_c) to its end, into its null product (tracking is done).
+        void control_end(float e) const noexcept { *nulls *= double(e); }
         template <class State>
         void operator()(float, const Coefficients<S>&, const Spec& mu, const Spec& tbar, const State&,
                         const ChannelEventDensities<Spec>& d) const {
             if (*pending) *nulls *= last_null->template cast<double>();
-            if (controlled) *last_null = rate > 0.f ? Spec(d.null / rate) : Spec(Spec::Zero());
-            else *last_null = (mu > 0.f).select(d.null / mu, 0.f);
+            if constexpr (kControlled)
+                *last_null = control.rate > 0.f ? Spec(d.null / control.rate) : Spec(Spec::Zero());
+            else
+                *last_null = (mu > 0.f).select(d.null / mu, 0.f);
             *last_event = d.scatter;
             *last_tbar = tbar;
             *pending = true;
@@ -282,12 +289,12 @@ private:
     /// emissive medium, the collision estimator at every tentative collision y (THEORY 5.7 with
     /// 5.3): the throughput up to y over the sampling channel's density of reaching it, every
     /// channel's null product before y and the subpath's shared factors up to y.
-    template <class Sc, class F>
+    template <class Sc, class F, bool kControlled = false>
     struct ChannelWalkVisit {
         static constexpr bool enabled = true;
         using S = typename Sc::Spectral;
         using Spec = typename S::Spectrum;
-        ChannelNullVisit<S> null_visit;
+        ChannelNullVisit<S, kControlled> null_visit;
         F* emission;  // the walk's emission callback (NoEmission: none)
         const VertexT<Sc>* path;
         int count, medium, channel;
@@ -296,7 +303,12 @@ private:
         const Spec& nulls;  // the segment's null product before this piece
         float pdf_dir;
         float along;  // the segment technique's normaliser on this piece (0: it does not run)
-        void under_control(float r, float e) noexcept { null_visit.under_control(r, e); }
+        void under_control(float r, float e) noexcept
+            requires kControlled
+        {
+            null_visit.under_control(r, e);
+        }
+        void control_end(float e) const noexcept { null_visit.control_end(e); }
         template <class State>
         void operator()(float t, const Coefficients<S>& k, const Spec& mu, const Spec& tbar, const State& st,
                         const ChannelEventDensities<Spec>& d) const {
@@ -305,7 +317,8 @@ private:
                 const float p_here = st.uni[channel] * tbar[channel];
                 if (!(p_here > 0.f)) return;
                 // The nulls before y (under a control with exp(-tau_c) to y, as the state's f and uni).
-                const Spec before = nulls * null_visit.nulls->template cast<float>() * null_visit.control_transmittance;
+                Spec before = nulls * null_visit.nulls->template cast<float>();
+                if constexpr (kControlled) before *= null_visit.control.transmittance;
                 (*emission)(path, count, medium, ray.at(t), k, mu, mu[channel], Spec(beta0 * st.f * tbar / p_here), before, pdf_dir,
                             relative_to_largest<Spec>(path[count - 1].gamma * st.nee * tbar), nulls, along);
             }

@@ -161,19 +161,17 @@ struct BdptEstimator<Mis, H, A, MaxDepth, Ch>::SubpathWalk {
         detail::DoubleSpectrum<Spectrum> piece_nulls = detail::DoubleSpectrum<Spectrum>::Ones();
         Spectrum last_null = Spectrum::Ones(), last_event = Spectrum::Ones(), last_tbar = Spectrum::Ones();
         bool pending = false;
+        using Visit = ChannelWalkVisit<Sc, OnEmission, is_control_v<typename Sc::MajorantType, typename Sc::MediumType>>;
         const ChannelTrack seg = track_channels_delta_visiting<Ch, A>(
             m.medium, m.majorant, ray, hit.t, lambda, channel, st, true, rng, counter,
-            ChannelWalkVisit<Sc, OnEmission>{{&piece_nulls, &last_null, &last_event, &last_tbar, &pending},
-                                             &on_emission, path, count, medium, channel, ray, beta0, nulls,
-                                             pdf_dir, along});
+            Visit{{&piece_nulls, &last_null, &last_event, &last_tbar, &pending},
+                  &on_emission, path, count, medium, channel, ray, beta0, nulls, pdf_dir, along});
         if (const Status fs = flight_status(seg.end); fs != Status::Ok) {
             status = fs;
             return Step::End;
         }
         if (seg.end != SegmentEnd::Scattered && seg.end != SegmentEnd::Passed) return Step::End;  // absorbed, or no pdf left
         if (seg.end == SegmentEnd::Passed && pending) piece_nulls *= last_null.template cast<double>();
-        // Under a control the residual nulls' P_n,r and exp(-tau_c) to the end (THEORY 5.10).
-        piece_nulls *= double(seg.control_transmittance);
         nulls *= piece_nulls.template cast<float>();
         if (first && count == 1 && crossings > 0) first->later_nulls *= piece_nulls.template cast<float>();
         beta = beta0 * st.f / st.uni[channel];
