@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "common.hpp"
+#include "control_scenes.hpp"
 #include "grey_surface_scenes.hpp"
 #include "null_lobe_scenes.hpp"
 #include "shading_scenes.hpp"
@@ -1150,32 +1151,6 @@ Exp ramp(const Box& box, float sigma_a, float sigma_s) {
 EExp emitting_ramp(const Box& box, float sigma_a, float sigma_s, float le) {
     return EExp(ramp(box, sigma_a, sigma_s), EmissionGrid(box, {2, 2, 2}, std::vector<float>(8, 1.f)),
                 Spectrum::Constant(le), {4, 4, 4});
-}
-
-/// `base` with its one medium replaced by `m` under majorant (control) `maj`, HG phase `g`.
-template <class Med, class Maj, class Base>
-auto with_medium(const Base& base, const Med& m, const Maj& maj, float g) {
-    using L = std::remove_cvref_t<decltype(base.lights)>;
-    using Out = SurfaceScene<Shapes, Med, Maj, HenyeyGreensteinPhase, Mats, L>;
-    return Out(base.geometry, {SceneMedium<Med, Maj, HenyeyGreensteinPhase>{m, maj, HenyeyGreensteinPhase(g)}},
-               base.materials, base.lights, base.camera_medium);
-}
-
-/// Runs `check(scene, name)` on `base` with its medium `m` under a grid control of 4^3 (each cell's
-/// density lower bound: a minorant), a tree control of 2^3 cells split into 2^3 wherever the bound
-/// varies (two levels, the control read at a point from the finest cell), and under a global
-/// control a fifth of the way from the density's lower bound to its upper bound over the box
-/// (above the density near its thin side: negative residuals, whose events and nulls are weighed
-/// by sign).
-template <class Med, class Base, class F>
-void for_each_control(const Base& base, const Med& m, float g, F check) {
-    check(with_medium(base, m, GridControl<Med>(m, 4), g), "grid control");
-    check(with_medium(base, m, TreeControl<Med>(m, TreeLayout{m.bounds(), {2, 2, 2}, {2, 0, 0}, 0.f, 0.f}), g),
-          "tree control");
-    const float lo = m.density_lower_bound(m.bounds()), hi = m.density_bound(m.bounds());
-    const float above = lo + 0.2f * (hi - lo);
-    check(with_medium(base, m, GlobalControl<Med>(m, scale(m.extinction_per_density(), above)), g),
-          "global control above the density");
 }
 
 TEST_CASE("bdpt under a control: the furnace of six emitting walls around a medium of albedo 1 (L = 2)" *

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "common.hpp"
+#include "control_scenes.hpp"
 #include "host/shapes.hpp"
 #include "null_lobe_scenes.hpp"
 #include "spectral.hpp"
@@ -762,14 +763,11 @@ SceneMedium<EM<Rgb>, ChannelMajorant<EM<Rgb>>, HenyeyGreensteinPhase> emitting_c
     return {m, ChannelMajorant<EM<Rgb>>(m, 1.5f), HenyeyGreensteinPhase(g)};
 }
 
-TEST_CASE("spectral bdpt: an emitting chromatic medium in the furnace: L = L_e in every channel") {
-    // Walls of albedo 0.5 emitting (1 - 0.5) L_e around a medium that absorbs (0.6, 1.2, 0.3),
-    // scatters (1, 0.5, 2) and emits L_e = (2, 1, 0.5): L_e is the equilibrium in every channel
-    // (walls L_e / 2 + 0.5 L_e, the medium mu_a (L_e - L) = 0). Light subpaths from the volume and
-    // the walls, NEE to both, the camera subpath's collision estimator; radiance() and the image
-    // with light tracing, balance and power (5 SE per channel).
+/// The emitting furnace: walls of albedo 0.5 emitting (1 - 0.5) L_e around a medium that absorbs
+/// (0.6, 1.2, 0.3), scatters (1, 0.5, 2) and emits `le`: L_e is the equilibrium in every channel
+/// (walls L_e / 2 + 0.5 L_e, the medium mu_a (L_e - L) = 0).
+EmittingScene<Rgb> emitting_furnace(const Rgb::Spectrum& le) {
     using Spectrum = Rgb::Spectrum;
-    const Spectrum le(2.f, 1.f, 0.5f);
     Shapes shapes;
     std::vector<QuadLight<Rgb>> walls;
     for (const CubeFace& f : inward_cube_faces()) {
@@ -777,10 +775,17 @@ TEST_CASE("spectral bdpt: an emitting chromatic medium in the furnace: L = L_e i
         walls.push_back({f.corner, f.u, f.v, Spectrum(0.5f * le)});
         shapes.quads.push_back({f.corner, f.u, f.v, {0, index, -1, 0}});
     }
-    const EmittingScene<Rgb> sc(shapes, {emitting_cube(Spectrum(0.6f, 1.2f, 0.3f), Spectrum(1.f, 0.5f, 2.f), le, false, 0.3f)},
-                                Mats<Rgb>({LambertianBsdf<Rgb>(Spectrum::Constant(0.5f))}, {}),
-                                Ls<Rgb>(LightSelection::Uniform, 2.f, walls, {}), 0);
-    check_furnace(sc, le, 17);
+    return EmittingScene<Rgb>(shapes, {emitting_cube(Spectrum(0.6f, 1.2f, 0.3f), Spectrum(1.f, 0.5f, 2.f), le, false, 0.3f)},
+                              Mats<Rgb>({LambertianBsdf<Rgb>(Spectrum::Constant(0.5f))}, {}),
+                              Ls<Rgb>(LightSelection::Uniform, 2.f, walls, {}), 0);
+}
+
+TEST_CASE("spectral bdpt: an emitting chromatic medium in the furnace: L = L_e in every channel") {
+    // The emitting furnace with L_e = (2, 1, 0.5). Light subpaths from the volume and the walls,
+    // NEE to both, the camera subpath's collision estimator; radiance() and the image with light
+    // tracing, balance and power (5 SE per channel).
+    const Rgb::Spectrum le(2.f, 1.f, 0.5f);
+    check_furnace(emitting_furnace(le), le, 17);
 }
 
 /// The chromatic cube over the floor under the lamp (chromatic_cube(false)), the cube also
@@ -915,51 +920,14 @@ EXM emitting_chromatic_ramp(const Box& box, const Rgb::Spectrum& sigma_a, const 
     return EXM(chromatic_ramp(box, sigma_a, sigma_s), EmissionGrid(box, {2, 2, 2}, cells), le, {4, 4, 4});
 }
 
-/// `base` with its one medium replaced by `m` under control `maj`, HG phase `g`.
-template <class Med, class Maj, class Base>
-auto with_medium(const Base& base, const Med& m, const Maj& maj, float g) {
-    using Mt = std::remove_cvref_t<decltype(base.materials)>;
-    using L = std::remove_cvref_t<decltype(base.lights)>;
-    using Out = SurfaceScene<Shapes, Med, Maj, HenyeyGreensteinPhase, Mt, L>;
-    return Out(base.geometry, {SceneMedium<Med, Maj, HenyeyGreensteinPhase>{m, maj, HenyeyGreensteinPhase(g)}},
-               base.materials, base.lights, base.camera_medium);
-}
-
-/// Runs `check(scene, name)` on `base` with its medium `m` under a grid control of 4^3, a tree
-/// control of 2^3 cells split into 2^3 wherever the bound varies, and a global control a fifth of
-/// the way from the density's lower bound to its upper bound over the box. The loop's control is
-/// the smallest channel's: the denser channels keep residual nulls even where a cell's control is
-/// tight, and under the global control the smallest channel's residual is negative near the
-/// ramp's thin side (its events and nulls weighed by sign).
-template <class Med, class Base, class F>
-void for_each_control(const Base& base, const Med& m, float g, F check) {
-    check(with_medium(base, m, GridControl<Med>(m, 4), g), "grid control");
-    check(with_medium(base, m, TreeControl<Med>(m, TreeLayout{m.bounds(), {2, 2, 2}, {2, 0, 0}, 0.f, 0.f}), g),
-          "tree control");
-    const float lo = m.density_lower_bound(m.bounds()), hi = m.density_bound(m.bounds());
-    const float above = lo + 0.2f * (hi - lo);
-    check(with_medium(base, m, GlobalControl<Med>(m, scale(m.extinction_per_density(), above)), g),
-          "global control above the density");
-}
-
 TEST_CASE("spectral bdpt under a control: an emitting chromatic medium in the furnace: L = L_e in every channel") {
     // The emitting furnace above with the medium an emitting chromatic ramp (mu_a (0.6, 1.2, 0.3),
     // mu_s (1, 0.5, 2) at the centre, L_e = (2, 1, 0.5)) under each control: L_e in every channel and
     // direction, radiance() and the image with light tracing, balance and power (5 SE per channel).
     using Spectrum = Rgb::Spectrum;
     const Spectrum le(2.f, 1.f, 0.5f);
-    Shapes shapes;
-    std::vector<QuadLight<Rgb>> walls;
-    for (const CubeFace& f : inward_cube_faces()) {
-        const int index = int(walls.size());
-        walls.push_back({f.corner, f.u, f.v, Spectrum(0.5f * le)});
-        shapes.quads.push_back({f.corner, f.u, f.v, {0, index, -1, 0}});
-    }
-    const EmittingScene<Rgb> base(shapes, {emitting_cube(Spectrum(0.6f, 1.2f, 0.3f), Spectrum(1.f, 0.5f, 2.f), le, false, 0.3f)},
-                                  Mats<Rgb>({LambertianBsdf<Rgb>(Spectrum::Constant(0.5f))}, {}),
-                                  Ls<Rgb>(LightSelection::Uniform, 2.f, walls, {}), 0);
     const Box box{Vec3(-1.f), Vec3(1.f)};
-    for_each_control(base, emitting_chromatic_ramp(box, Spectrum(0.6f, 1.2f, 0.3f), Spectrum(1.f, 0.5f, 2.f), le, false),
+    for_each_control(emitting_furnace(le), emitting_chromatic_ramp(box, Spectrum(0.6f, 1.2f, 0.3f), Spectrum(1.f, 0.5f, 2.f), le, false),
                      0.3f, [&](const auto& sc, const char* control) {
                          CAPTURE(std::string(control));
                          check_furnace(sc, le, 19);
