@@ -244,26 +244,32 @@ struct ChannelDeltaCollision {
     Visit visit{};
     ChannelTrack out{};
     std::uint32_t nulls = 0;
-    /// Under a control, the current collision's own lookup and every channel's densities of a real
-    /// event there over both routes (before_event).
+    /// Under a control, the current collision's own lookup, grey control and majorant
+    /// (before_event), from which a real event's densities over both routes are formed: at every
+    /// collision for a visitor (which sees them), else once, at the real event.
     struct Kept {
         Coefficients<S> k{};
+        float ctl = 0.f;
+        float mu_bar = 0.f;
         ChannelEventDensities<Spec> d{};
     };
     [[no_unique_address]] std::conditional_t<kControlled, Kept, detail::Empty> kept{};
 
     /// Under a control, the loop's call at every collision y, control or residual, before its
-    /// coefficients become the route's: keeps the medium's own lookup `k` and every channel's
-    /// densities of a real event at y over both routes, the control's ctl P_x,c(control) plus the
-    /// residual's R P_x,c(residual), R = mu_bar - ctl (nulls: the residual's), and calls the
-    /// visitor with them, the full majorant `mu_bar` and the state with exp(-tau_ctl) in f and uni.
+    /// coefficients become the route's: keeps the medium's own lookup `k`, `ctl` and `mu_bar`. With
+    /// a visitor it forms every channel's densities of a real event at y over both routes, the
+    /// control's ctl P_x,c(control) plus the residual's R P_x,c(residual), R = mu_bar - ctl (nulls:
+    /// the residual's), and calls the visitor with them, the full majorant `mu_bar` and the state
+    /// with exp(-tau_ctl) in f and uni.
     void before_event(float t, const Coefficients<S>& k, float mu_bar, float ctl, double tau_ctl)
         requires kControlled
     {
         kept.k = k;
-        kept.d = detail::channel_decomposition_densities<CP, A, S>(k, ctl, mu_bar, st.f);
-        const ChannelEventDensities<Spec>& d = kept.d;
+        kept.ctl = ctl;
+        kept.mu_bar = mu_bar;
         if constexpr (Visit::enabled) {
+            kept.d = detail::channel_decomposition_densities<CP, A, S>(k, ctl, mu_bar, st.f);
+            const ChannelEventDensities<Spec>& d = kept.d;
             ChannelPathState<S, kEq> here = st;
             const float e = tau_ctl > 0.0 ? float(std::exp(-tau_ctl)) : 1.f;
             if (tau_ctl > 0.0) {
@@ -301,6 +307,11 @@ struct ChannelDeltaCollision {
         if (u < pa) event = SegmentEnd::Absorbed;
         else if (u < pa + ps || !(d.null[c] > 0.f)) event = SegmentEnd::Scattered;  // never a null of probability 0
         else event = SegmentEnd::Passed;  // a null
+        // Under a control, a real event's densities over both routes (a visitor's before_event
+        // formed them already), from the state before this collision as the event's own were.
+        if constexpr (kControlled && !Visit::enabled)
+            if (event != SegmentEnd::Passed)
+                kept.d = detail::channel_decomposition_densities<CP, A, S>(kept.k, kept.ctl, kept.mu_bar, st.f);
         if constexpr (Rec::enabled) {
             // Under a control, a real vertex's density is the routes' sum (a null's the residual's).
             const ChannelEventDensities<Spec>& dv = [&]() -> const ChannelEventDensities<Spec>& {
