@@ -419,6 +419,172 @@ TEST_CASE_TEMPLATE("a path state whose f / p leaves float's range ends Overflowe
     run(SpectralPathEstimator<CP, strategy::NullScatteringMis, mis::Balance>{});
 }
 
+/// log of channel c's residual-ratio-tracking pdf of nulls at `nulls` on [0, tmax] under a
+/// per-channel control (ChannelGridControl): prod_j R_c(n_j) exp(-int R_c), R_c = mu_bar_c -
+/// mu_c,c, from the control's segments in double.
+template <class M, class Ctl>
+double channel_residual_ratio_log_pdf(const Ctl& control, const Ray& ray, float tmax,
+                                      const typename M::Spectral::Wavelengths& lambda, int c,
+                                      std::span<const float> nulls) {
+    double lp = 0.0;
+    for (const float t : nulls)
+        lp += std::log(double(control.value_at(ray.at(t), lambda)[c]) -
+                       double(control.control_value_at(ray.at(t), lambda)[c]));
+    auto segments = control.iterate(ray, 0.f, tmax, lambda);
+    while (auto seg = segments.next())
+        lp -= (double(seg->sigma_maj[c]) - double(seg->sigma_ctl[c])) * (double(seg->t1) - double(seg->t0));
+    return lp;
+}
+
+/// The relative error in channel k's product of null factors mu_bar - mu_t at `nulls` that float's
+/// rounding of mu_t (the trackers sum mu_a + mu_s in float, as the majorants bound them) may give:
+/// 4 ulps of mu_t over each factor. A lookup within 1e-4 of its majorant makes the factor's
+/// relative rounding 1e-3 or more (seen on one ray of these suites).
+template <class M, class Maj>
+double null_rounding(const M& medium, const Maj& maj, const Ray& ray, const typename M::Spectral::Wavelengths& lambda,
+                     int k, std::span<const float> nulls) {
+    double e = 0.0;
+    for (const float t : nulls) {
+        const double mu_t = double(medium.coefficients(ray.at(t), lambda).sigma_t()[k]);
+        const double n = std::abs(double(majorant_at<M>(maj, ray, t, lambda, k)) - mu_t);
+        if (n > 0.0) e += 4.0 * std::ldexp(mu_t, -23) / n;
+    }
+    return e;
+}
+
+// A per-channel majorant's control (ChannelGridControl, THEORY 5.10 with 5.3): under a minorant
+// every channel's decomposition-tracking pdf of a segment is its delta-tracking pdf under its own
+// majorant (pdf.hpp's evaluation, which sees the control as a majorant), and its residual ratio
+// tracking pdf prod R_c exp(-int R_c). The trackers must report exactly these, and the
+// contributions of the medium (unchanged by the control), for each sampling channel.
+TEST_CASE_TEMPLATE("per-channel control: channel trackers report every channel's decomposition and residual ratio pdfs",
+                   A, absorption::Event, absorption::Weight) {
+    using S = Rgb;
+    using M = DenseGridMedium<S>;
+    using CP = channels::SpectralMis;
+    const M medium = chromatic_grid<S>(3);
+    const ChannelGridControl<M> ctl(medium, kTestGridRes);
+    Pcg32 rng(17, 4);
+    NoLookupCount none;
+    int with_nulls = 0, scattered = 0, ratio_nulls = 0;
+    for (int i = 0; i < 600; ++i) {
+        CAPTURE(i);
+        const auto lambda = draw_wavelengths<S>(rng);
+        const Ray ray{random_point(rng, kBox), random_direction(rng)};
+        const float tmax = 0.3f + 2.5f * rng.uniform();
+        const int c = std::min(int(rng.uniform() * S::channels), S::channels - 1);
+        if (!channel_has_majorant<M>(ctl, ray, tmax, lambda, c)) continue;
+        {  // decomposition tracking
+            ChannelPathState<S> st;
+            st.nee.setOnes();
+            SegmentRecord rec;
+            const ChannelTrack tr = track_channels_delta<CP, A>(medium, ctl, ray, tmax, lambda, c, st, true, rng, none, rec);
+            if (tr.end != SegmentEnd::Absorbed) {
+                REQUIRE((tr.end == SegmentEnd::Passed || tr.end == SegmentEnd::Scattered));
+                std::vector<float> nulls = rec.t;
+                if (tr.end != SegmentEnd::Passed) nulls.pop_back();
+                with_nulls += !nulls.empty();
+                scattered += tr.end == SegmentEnd::Scattered;
+                const double lp_c = channel_delta_segment_log_pdf<A>(medium, ctl, ray, tmax, lambda, c, nulls, tr.end, tr.t);
+                CHECK(rec.log_pdf == doctest::Approx(lp_c).epsilon(1e-4).scale(1.0));
+                const double base = std::log(double(st.uni[c]));
+                for (int k = 0; k < S::channels; ++k) {
+                    CAPTURE(k);
+                    CAPTURE(c);
+                    const double tol = kLogTol + null_rounding(medium, ctl, ray, lambda, k, nulls);
+                    const double lp_k = channel_delta_segment_log_pdf<A>(medium, ctl, ray, tmax, lambda, k, nulls, tr.end, tr.t);
+                    check_log(log_or_ninf(st.uni[k]) - base, lp_k - lp_c, tol, base);
+                    const double f_k = channel_contribution(medium, ctl, ray, tmax, lambda, k, nulls, tr.end, tr.t);
+                    CHECK(double(st.f[k]) / double(st.uni[c]) ==
+                          doctest::Approx(f_k / std::exp(lp_c)).epsilon(tol).scale(1e-12));
+                    if (tr.end == SegmentEnd::Passed) {
+                        const double lr_k = channel_residual_ratio_log_pdf<M>(ctl, ray, tmax, lambda, k, nulls);
+                        check_log(log_or_ninf(st.nee[k]) - base, lr_k - lp_c, kLogTol, base);
+                    }
+                }
+            }
+        }
+        {  // residual ratio tracking
+            SegmentRecord rec;
+            const auto sh = track_channels_ratio<CP, A>(medium, ctl, ray, tmax, lambda, c, S::Spectrum::Ones().eval(), true,
+                                                        rng, none, rec);
+            if (sh.end != SegmentEnd::Passed) continue;
+            const std::span<const float> nulls(rec.t);
+            ratio_nulls += !nulls.empty();
+            const double lr_c = channel_residual_ratio_log_pdf<M>(ctl, ray, tmax, lambda, c, nulls);
+            CHECK(rec.log_pdf == doctest::Approx(lr_c).epsilon(1e-4).scale(1.0));
+            const double base = std::log(double(sh.nee[c]));
+            for (int k = 0; k < S::channels; ++k) {
+                CAPTURE(k);
+                CAPTURE(c);
+                const double lr_k = channel_residual_ratio_log_pdf<M>(ctl, ray, tmax, lambda, k, nulls);
+                const double lu_k =
+                    channel_delta_segment_log_pdf<A>(medium, ctl, ray, tmax, lambda, k, nulls, SegmentEnd::Passed, tmax);
+                const double tol = kLogTol + null_rounding(medium, ctl, ray, lambda, k, nulls);
+                check_log(log_or_ninf(sh.nee[k]) - base, lr_k - lr_c, kLogTol, base);
+                check_log(log_or_ninf(sh.uni[k]) - base, lu_k - lr_c, tol, base);
+                const double f_k = channel_contribution(medium, ctl, ray, tmax, lambda, k, nulls, SegmentEnd::Passed, tmax);
+                CHECK(double(sh.f[k]) / double(sh.nee[c]) == doctest::Approx(f_k / std::exp(lr_c)).epsilon(tol).scale(1e-12));
+            }
+        }
+    }
+    MESSAGE("per-channel control: " << with_nulls << " decomposition segments with nulls, " << scattered
+                                    << " scattered, " << ratio_nulls << " residual ratio segments with nulls");
+    CHECK(with_nulls > 50);
+    CHECK(scattered > 20);
+    CHECK(ratio_nulls > 50);
+}
+
+TEST_CASE("per-channel control on a homogeneous chromatic medium: no lookups, exact transmittance") {
+    // A grid of one constant density: every cell's lower bound is its upper bound, every channel's
+    // residual 0, so residual ratio tracking looks nothing up and returns exp(-mu_t,c L) per
+    // channel, and the sampling channel's decomposition tracking draws only control collisions
+    // (real, one lookup each).
+    using S = Rgb;
+    using M = DenseGridMedium<S>;
+    const M medium(kBox, {2, 2, 2}, std::vector<float>(8, 1.f), spec<S>(0.3f, 0.05f, 1.2f), spec<S>(0.5f, 0.1f, 2.f));
+    const ChannelGridControl<M> ctl(medium, 4);
+    const Ray ray{Vec3(-3.f, 0.1f, 0.2f), glm::normalize(Vec3(1.f, 0.1f, -0.05f))};
+    const Interval in = kBox.clip(ray, 0.f, kInf);
+    const typename S::Spectrum tau = (spec<S>(0.3f, 0.05f, 1.2f) + spec<S>(0.5f, 0.1f, 2.f)) * (in.t1 - in.t0);
+    // The control is the density's lower bound less rounding (a few ulps below mu_t,c): the
+    // residual, a few ulps of mu_t,c, is tracked at a rate too small to draw a collision here.
+    const typename S::Spectrum lo = ctl.control_value_at(Vec3(0.f), {});
+    CHECK(((lo / ((spec<S>(0.3f, 0.05f, 1.2f) + spec<S>(0.5f, 0.1f, 2.f))) - 1.f).abs() < 1e-5f).all());
+    const typename S::Spectrum tau_c = lo * (in.t1 - in.t0);
+    Pcg32 rng(5, 1);
+    for (int c = 0; c < 3; ++c) {
+        LookupCount n;
+        const auto sh = track_channels_ratio<channels::SpectralMis, absorption::Weight>(
+            medium, ctl, ray, kInf, {}, c, S::Spectrum::Ones().eval(), true, rng, n);
+        REQUIRE(sh.end == SegmentEnd::Passed);
+        CHECK(n.n == 0);
+        for (int k = 0; k < 3; ++k) {
+            CAPTURE(k);
+            // No nulls: f_k / nee_k = exp(-tau_c,k) (channel k's residual ratio estimate), within
+            // 1e-4 of exp(-mu_t,k L); uni_k / nee_k the same (decomposition's exp(-mu_bar,k L) over
+            // residual ratio tracking's exp(-R_k L)).
+            CHECK(double(sh.f[k]) / double(sh.nee[k]) == doctest::Approx(std::exp(-double(tau_c[k]))).epsilon(1e-5));
+            CHECK(double(sh.uni[k]) / double(sh.nee[k]) == doctest::Approx(std::exp(-double(tau_c[k]))).epsilon(1e-5));
+            CHECK(double(sh.f[k]) / double(sh.nee[k]) == doctest::Approx(std::exp(-double(tau[k]))).epsilon(1e-4));
+        }
+        int real = 0, lookups = 0, flights = 2000;
+        for (int i = 0; i < flights; ++i) {
+            LookupCount m;
+            ChannelPathState<S> st;
+            const ChannelTrack tr = track_channels_delta<channels::SpectralMis, absorption::Weight>(
+                medium, ctl, ray, kInf, {}, c, st, true, rng, m);
+            real += tr.end == SegmentEnd::Scattered;
+            lookups += int(m.n);
+            CHECK(int(m.n) == (tr.end == SegmentEnd::Scattered ? 1 : 0));
+        }
+        // The sampling channel scatters with probability 1 - exp(-tau_c): 2000 flights, 5 sd.
+        const double p = 1.0 - std::exp(-double(tau[c]));
+        CHECK(std::abs(real - flights * p) <= 5.0 * std::sqrt(flights * p * (1.0 - p)) + 1.0);
+        CHECK(lookups == real);
+    }
+}
+
 TEST_CASE("ChannelSelection: probabilities, sampling frequencies (chi-square) and rejected weights") {
     const ChannelSelection<Rgb> uniform;
     CHECK(uniform.probabilities().isApprox(Rgb::Spectrum::Constant(1.f / 3.f)));

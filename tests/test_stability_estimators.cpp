@@ -73,13 +73,22 @@ struct ControlRep {
     static type make(const M& m) { return type(m, std::array<int, 3>{3, 4, 2}); }
 };
 
-/// One estimator in one mode (under a grid control with kControl).
-template <class E, SpectralMode S, bool kControl = false>
+/// A per-channel grid control of the same cells (ChannelGridControl: every channel's own majorant
+/// and control), for the SpectralPathEstimator cases with own pdfs.
+template <class M>
+struct ChannelControlRep {
+    using type = ChannelGridControl<M>;
+    static type make(const M& m) { return type(m, std::array<int, 3>{3, 4, 2}); }
+};
+
+/// One estimator in one mode (kControl: 1 under a grid control, 2 under a per-channel grid control).
+template <class E, SpectralMode S, int kControl = 0>
 struct EstCase {
     using Estimator = E;
     using Spectral = S;
     using Medium = DenseGridMedium<S>;
-    using Rep = std::conditional_t<kControl, ControlRep<Medium>, RepMajorant<E, S, Medium>>;
+    using Rep = std::conditional_t<kControl == 2, ChannelControlRep<Medium>,
+                                   std::conditional_t<kControl == 1, ControlRep<Medium>, RepMajorant<E, S, Medium>>>;
     static constexpr bool spectral = requires { typename E::Channels; };
     /// Independent tracking estimates the sampled channel as f_c / (q_c p_c) and the others as 0:
     /// exact in the mean only.
@@ -90,7 +99,7 @@ struct EstCase {
     static std::string name() {
         std::string n = spectral ? std::string("spectral ") : std::string();
         if constexpr (requires { typename E::Channels; }) n += std::string(E::Channels::name) + "/";
-        return n + (kControl ? "grid-control/" : "") + E::Strategy::name + "/" + E::HeuristicType::name + "/" +
+        return n + (kControl == 2 ? "channel-grid-control/" : kControl == 1 ? "grid-control/" : "") + E::Strategy::name + "/" + E::HeuristicType::name + "/" +
                E::Absorption::name + "/" + S::name;
     }
 };
@@ -123,26 +132,38 @@ using AllPathCases = decltype(std::tuple_cat(PathEstimatorsIn<Mono>{}, PathEstim
 /// the smallest channel's: Rgb's channels 1e8 apart put the others' residuals far above it).
 template <class S>
 using ControlEstimatorsIn =
-    std::tuple<EstCase<PathEstimator<strategy::Unidirectional, mis::None, absorption::Weight>, S, true>,
-               EstCase<PathEstimator<strategy::NextEvent, mis::None, absorption::Weight>, S, true>,
-               EstCase<PathEstimator<strategy::DirectionalMis, mis::Balance, absorption::Weight>, S, true>,
-               EstCase<PathEstimator<strategy::NullScatteringMis, mis::Power, absorption::Event>, S, true>,
-               EstCase<PathEstimator<strategy::EquiangularNextEvent, mis::None, absorption::Weight>, S, true>,
-               EstCase<PathEstimator<strategy::EquiangularMis, mis::Balance, absorption::Weight>, S, true>>;
+    std::tuple<EstCase<PathEstimator<strategy::Unidirectional, mis::None, absorption::Weight>, S, 1>,
+               EstCase<PathEstimator<strategy::NextEvent, mis::None, absorption::Weight>, S, 1>,
+               EstCase<PathEstimator<strategy::DirectionalMis, mis::Balance, absorption::Weight>, S, 1>,
+               EstCase<PathEstimator<strategy::NullScatteringMis, mis::Power, absorption::Event>, S, 1>,
+               EstCase<PathEstimator<strategy::EquiangularNextEvent, mis::None, absorption::Weight>, S, 1>,
+               EstCase<PathEstimator<strategy::EquiangularMis, mis::Balance, absorption::Weight>, S, 1>>;
 using AllControlCases = decltype(std::tuple_cat(ControlEstimatorsIn<Mono>{}, ControlEstimatorsIn<Rgb>{}));
 /// Every SpectralPathEstimator case under a grid control, in Rgb (every channel's pdfs over both of
 /// decomposition tracking's routes).
 template <class S>
 using SpectralControlEstimatorsIn =
-    std::tuple<EstCase<Spectral<channels::Independent, strategy::NullScatteringMis, mis::Balance>, S, true>,
-               EstCase<Spectral<channels::SpectralTrackingMax, strategy::NullScatteringMis, mis::Balance>, S, true>,
-               EstCase<Spectral<channels::SpectralTrackingAverage, strategy::NullScatteringMis, mis::Balance>, S, true>,
-               EstCase<Spectral<channels::SpectralMis, strategy::NullScatteringMis, mis::Balance>, S, true>,
-               EstCase<Spectral<channels::SpectralMis, strategy::Unidirectional>, S, true>,
-               EstCase<Spectral<channels::SpectralMis, strategy::NextEvent>, S, true>,
-               EstCase<Spectral<channels::SpectralMis, strategy::EquiangularNextEvent>, S, true>,
-               EstCase<Spectral<channels::SpectralMis, strategy::EquiangularMis, mis::Balance>, S, true>>;
-using AllSpectralControlCases = SpectralControlEstimatorsIn<Rgb>;
+    std::tuple<EstCase<Spectral<channels::Independent, strategy::NullScatteringMis, mis::Balance>, S, 1>,
+               EstCase<Spectral<channels::SpectralTrackingMax, strategy::NullScatteringMis, mis::Balance>, S, 1>,
+               EstCase<Spectral<channels::SpectralTrackingAverage, strategy::NullScatteringMis, mis::Balance>, S, 1>,
+               EstCase<Spectral<channels::SpectralMis, strategy::NullScatteringMis, mis::Balance>, S, 1>,
+               EstCase<Spectral<channels::SpectralMis, strategy::Unidirectional>, S, 1>,
+               EstCase<Spectral<channels::SpectralMis, strategy::NextEvent>, S, 1>,
+               EstCase<Spectral<channels::SpectralMis, strategy::EquiangularNextEvent>, S, 1>,
+               EstCase<Spectral<channels::SpectralMis, strategy::EquiangularMis, mis::Balance>, S, 1>>;
+/// And the own-pdf cases under a per-channel grid control, in Rgb and Hero<4> (each channel's own
+/// control and residual, channels 1e8 apart).
+template <class S>
+using SpectralChannelControlEstimatorsIn =
+    std::tuple<EstCase<Spectral<channels::Independent, strategy::NullScatteringMis, mis::Balance>, S, 2>,
+               EstCase<Spectral<channels::SpectralMis, strategy::NullScatteringMis, mis::Balance>, S, 2>,
+               EstCase<Spectral<channels::SpectralMis, strategy::Unidirectional>, S, 2>,
+               EstCase<Spectral<channels::SpectralMis, strategy::NextEvent>, S, 2>,
+               EstCase<Spectral<channels::SpectralMis, strategy::EquiangularNextEvent>, S, 2>,
+               EstCase<Spectral<channels::SpectralMis, strategy::EquiangularMis, mis::Balance>, S, 2>>;
+using AllSpectralControlCases =
+    decltype(std::tuple_cat(SpectralControlEstimatorsIn<Rgb>{}, SpectralChannelControlEstimatorsIn<Rgb>{},
+                            SpectralChannelControlEstimatorsIn<Hero<4>>{}));
 using AllSpectralCases = decltype(std::tuple_cat(SpectralEstimatorsIn<Rgb>{}, SpectralEstimatorsIn<Hero<4>>{}));
 
 }  // namespace nsp_test::stab
@@ -160,12 +181,12 @@ using AllSpectralCases = decltype(std::tuple_cat(SpectralEstimatorsIn<Rgb>{}, Sp
     NSP_STAB_NAME(nsp_test::stab::EstCase<nsp::PathEstimator<nsp::strategy::EquiangularNextEvent, nsp::mis::None, nsp::absorption::Weight>, S>) \
     NSP_STAB_NAME(nsp_test::stab::EstCase<nsp::PathEstimator<nsp::strategy::EquiangularMis, nsp::mis::Balance, nsp::absorption::Weight>, S>)
 #define NSP_STAB_CONTROL_NAMES(S)                                                                                      \
-    NSP_STAB_NAME(nsp_test::stab::EstCase<nsp::PathEstimator<nsp::strategy::Unidirectional, nsp::mis::None, nsp::absorption::Weight>, S, true>) \
-    NSP_STAB_NAME(nsp_test::stab::EstCase<nsp::PathEstimator<nsp::strategy::NextEvent, nsp::mis::None, nsp::absorption::Weight>, S, true>) \
-    NSP_STAB_NAME(nsp_test::stab::EstCase<nsp::PathEstimator<nsp::strategy::DirectionalMis, nsp::mis::Balance, nsp::absorption::Weight>, S, true>) \
-    NSP_STAB_NAME(nsp_test::stab::EstCase<nsp::PathEstimator<nsp::strategy::NullScatteringMis, nsp::mis::Power, nsp::absorption::Event>, S, true>) \
-    NSP_STAB_NAME(nsp_test::stab::EstCase<nsp::PathEstimator<nsp::strategy::EquiangularNextEvent, nsp::mis::None, nsp::absorption::Weight>, S, true>) \
-    NSP_STAB_NAME(nsp_test::stab::EstCase<nsp::PathEstimator<nsp::strategy::EquiangularMis, nsp::mis::Balance, nsp::absorption::Weight>, S, true>)
+    NSP_STAB_NAME(nsp_test::stab::EstCase<nsp::PathEstimator<nsp::strategy::Unidirectional, nsp::mis::None, nsp::absorption::Weight>, S, 1>) \
+    NSP_STAB_NAME(nsp_test::stab::EstCase<nsp::PathEstimator<nsp::strategy::NextEvent, nsp::mis::None, nsp::absorption::Weight>, S, 1>) \
+    NSP_STAB_NAME(nsp_test::stab::EstCase<nsp::PathEstimator<nsp::strategy::DirectionalMis, nsp::mis::Balance, nsp::absorption::Weight>, S, 1>) \
+    NSP_STAB_NAME(nsp_test::stab::EstCase<nsp::PathEstimator<nsp::strategy::NullScatteringMis, nsp::mis::Power, nsp::absorption::Event>, S, 1>) \
+    NSP_STAB_NAME(nsp_test::stab::EstCase<nsp::PathEstimator<nsp::strategy::EquiangularNextEvent, nsp::mis::None, nsp::absorption::Weight>, S, 1>) \
+    NSP_STAB_NAME(nsp_test::stab::EstCase<nsp::PathEstimator<nsp::strategy::EquiangularMis, nsp::mis::Balance, nsp::absorption::Weight>, S, 1>)
 #define NSP_STAB_SPECTRAL_NAMES(S)                                                                                     \
     NSP_STAB_NAME(nsp_test::stab::EstCase<nsp_test::stab::Spectral<nsp::channels::Independent, nsp::strategy::NullScatteringMis, nsp::mis::Balance>, S>) \
     NSP_STAB_NAME(nsp_test::stab::EstCase<nsp_test::stab::Spectral<nsp::channels::SpectralTrackingMax, nsp::strategy::NullScatteringMis, nsp::mis::Balance>, S>) \

@@ -187,17 +187,64 @@ ChannelEventDensities<typename S::Spectrum> channel_decomposition_densities(cons
 }
 }  // namespace detail
 
+namespace detail {
+/// Every channel's densities under its own control ctl_c and majorant mu_c (a per-channel
+/// majorant's control, ChannelGridControl; own pdfs): channel_decomposition_densities per channel,
+/// a real event's the sum over the control route (ctl_c) and the residual route (mu_c - ctl_c), a
+/// null's the residual's. Under a minorant, delta tracking's densities under mu_c.
+template <AbsorptionPolicy A, SpectralMode S>
+ChannelEventDensities<typename S::Spectrum> channel_control_densities(const Coefficients<S>& k,
+                                                                      const typename S::Spectrum& ctl,
+                                                                      const typename S::Spectrum& mu) noexcept {
+    using Spec = typename S::Spectrum;
+    const Spec rate = (mu - ctl).max(0.f);
+    Coefficients<S> r = k;
+    to_residual(r, ctl, rate);
+    ChannelEventDensities<Spec> d = channel_event_densities<A, S>(r, rate);
+    Coefficients<S> q = k;
+    to_control(q, ctl);
+    const ChannelEventDensities<Spec> dc = channel_event_densities<A, S>(q, ctl);
+    d.absorb += dc.absorb;
+    d.scatter += dc.scatter;
+    return d;
+}
+
+/// A null's contribution mu_c - mu_t,c and density R_c P_n,c(residual) under every channel's own
+/// control (channel_control_densities' null, `d_null`), from the lookup's own mu_t (`t`): where
+/// ctl_c <= mu_t,c <= mu_c the density is delta tracking's mu_c - mu_t,c, formed as it is there,
+/// not through the residual's coefficients, whose extra roundings, relative to a difference near 0,
+/// reached 1e-3 where a lookup came close to its majorant.
+template <class Arr>
+struct ControlNulls {
+    Arr f, density;
+};
+template <class T, class Spec>
+ControlNulls<Eigen::Array<T, Spec::RowsAtCompileTime, 1>> channel_control_nulls(const Spec& t, const Spec& mu,
+                                                                                const Spec& ctl,
+                                                                                const Spec& d_null) noexcept {
+    using Arr = Eigen::Array<T, Spec::RowsAtCompileTime, 1>;
+    const Arr n = mu.template cast<T>() - t.template cast<T>();
+    return {n, ((t >= ctl) && (t <= mu)).select(n, d_null.template cast<T>())};
+}
+}  // namespace detail
+
 /// Every channel's tracking density mu_bar_c P_s,c of a real scattering vertex with coefficients
 /// k under majorant mu_v (a Spectrum per channel, or a grey float): the channel's own (channel
 /// policies with own pdfs) or the one spectral tracking shares, from the throughput w there. What
 /// an equiangular vertex's tracking pdf needs (THEORY 5.4 with 5.3). Under a grey control `ctl` > 0
-/// (mu_v grey), decomposition tracking's: the sum over its two routes (THEORY 5.10).
-template <ChannelPolicy CP, AbsorptionPolicy A, SpectralMode S, class V>
+/// (mu_v grey), decomposition tracking's: the sum over its two routes (THEORY 5.10); under a
+/// per-channel majorant's control (`ctl` a Spectrum), every channel's own two routes.
+template <ChannelPolicy CP, AbsorptionPolicy A, SpectralMode S, class V, class Ctl = float>
 typename S::Spectrum channel_scatter_densities(const Coefficients<S>& k, const V& mu_v, const typename S::Spectrum& w,
-                                               float ctl = 0.f) noexcept {
-    if constexpr (std::is_same_v<V, float>)
-        if (ctl > 0.f) return detail::channel_decomposition_densities<CP, A, S>(k, ctl, mu_v, w).scatter;
-    return detail::channel_densities<CP, A, S>(k, mu_v, w).scatter;
+                                               const Ctl& ctl = 0.f) noexcept {
+    if constexpr (!std::is_same_v<Ctl, float>) {
+        static_assert(CP::own_pdfs && !std::is_same_v<V, float>, "a per-channel control goes with own pdfs and a per-channel majorant");
+        return detail::channel_control_densities<A, S>(k, ctl, mu_v).scatter;
+    } else {
+        if constexpr (std::is_same_v<V, float>)
+            if (ctl > 0.f) return detail::channel_decomposition_densities<CP, A, S>(k, ctl, mu_v, w).scatter;
+        return detail::channel_densities<CP, A, S>(k, mu_v, w).scatter;
+    }
 }
 
 /// How a per-channel delta-tracked segment ended, and where.
@@ -231,11 +278,24 @@ struct ChannelTrack {
 /// residual majorant R and e = exp(-tau_c) so far, and one with `control_end(e)` the segment's
 /// exp(-tau_c) to its end (Passed or Scattered) when the tracking is done (per-channel BDPT's null
 /// products are the residual's P_n,r = mu_n,r / R times exp(-tau_c), THEORY 5.10).
+///
+/// Under a per-channel majorant's control (`kChannelControl`, ChannelGridControl), each channel
+/// has its own control ctl_c and residual majorant R_c: the loop hands over every channel's route
+/// coefficients and rates with its residual depths, and before_event the lookup, majorants,
+/// controls and each channel's control depth since the last collision. The sampling channel's route
+/// chooses the event; each channel's pdfs are its own decomposition tracking's
+/// (detail::channel_control_densities); f and uni take each channel's exp(-tau_c,c) step by step,
+/// nee and the equiangular slots (residual ratio tracking's pdfs) do not. A visitor sees the state
+/// with exp(-tau_c,c) of the step in f and uni and the residual's Tbar; per-channel BDPT's
+/// visitor (`under_control`) does not take one.
 template <ChannelPolicy CP, AbsorptionPolicy A, SpectralMode S, UniformRng R, class Rec, bool kEq = false,
-          class Visit = NoVisit, bool kControlled = false>
+          class Visit = NoVisit, bool kControlled = false, bool kChannelControl = false>
 struct ChannelDeltaCollision {
     using Spec = typename S::Spectrum;
     static constexpr ControlUse control_use = ControlUse::Collide;
+    static_assert(!kChannelControl || (kControlled && CP::own_pdfs),
+                  "nsp: a per-channel majorant's control (ChannelGridControl) needs a channel policy with own pdfs "
+                  "(channels::SpectralMis or channels::Independent)");
     R& rng;
     Rec& rec;
     ChannelPathState<S, kEq>& st;
@@ -253,7 +313,34 @@ struct ChannelDeltaCollision {
         float mu_bar = 0.f;
         ChannelEventDensities<Spec> d{};
     };
-    [[no_unique_address]] std::conditional_t<kControlled, Kept, detail::Empty> kept{};
+    /// Under a per-channel majorant's control, the collision's lookup, every channel's majorant and
+    /// control, exp(-tau_c,c) of the step and the sampling channel's control depth of the step.
+    struct KeptChannels {
+        Coefficients<S> k{};
+        Spec mu{}, ctl{}, ec{};
+        float tau_c = 0.f;
+        ChannelEventDensities<Spec> d{};
+        Spec tail{};  ///< every channel's control depth from the last collision to tmax (control_tail)
+    };
+    [[no_unique_address]] std::conditional_t<kChannelControl, KeptChannels,
+                                             std::conditional_t<kControlled, Kept, detail::Empty>> kept{};
+
+    /// Under a per-channel majorant's control, the loop's call at every collision before its
+    /// coefficients become the route's (see the struct's comment).
+    void before_event(float, const Coefficients<S>& k, const Spec& mu, const Spec& ctl, const Spec& tau_c, bool)
+        requires kChannelControl
+    {
+        kept.k = k;
+        kept.mu = mu;
+        kept.ctl = ctl;
+        kept.ec = (-tau_c).exp();
+        kept.tau_c = tau_c[c];
+    }
+    void control_tail(const Spec& tau_c) noexcept
+        requires kChannelControl
+    {
+        kept.tail = tau_c;
+    }
 
     /// Under a control, the loop's call at every collision y, control or residual, before its
     /// coefficients become the route's: keeps the medium's own lookup `k`, `ctl` and `mu_bar`. With
@@ -262,7 +349,7 @@ struct ChannelDeltaCollision {
     /// the residual's), and calls the visitor with them, the full majorant `mu_bar` and the state
     /// with exp(-tau_ctl) in f and uni.
     void before_event(float t, const Coefficients<S>& k, float mu_bar, float ctl, double tau_ctl)
-        requires kControlled
+        requires(kControlled && !kChannelControl)
     {
         kept.k = k;
         kept.ctl = ctl;
@@ -286,7 +373,7 @@ struct ChannelDeltaCollision {
     template <class V>
     bool operator()(float t, const Coefficients<S>& k, const V& mu_v, const V& tau_v) {
         constexpr bool grey = std::is_same_v<V, float>;
-        static_assert(grey || !kControlled, "a control's segments carry a grey majorant");
+        static_assert(kChannelControl ? !grey : (!kControlled || grey), "a grey majorant's control is grey; ChannelGridControl's per channel");
         const Spec mu = detail::broadcast_majorant<Spec>(mu_v);
         Spec tb;  // every channel's Tbar since the last tentative collision (a grey one cancels)
         if constexpr (!grey) tb = detail::relative_transmittance(tau_v, c);
@@ -294,6 +381,18 @@ struct ChannelDeltaCollision {
         // shared by all channels (spectral tracking). The sampling channel's picks the event
         // (under a control: the route's).
         const ChannelEventDensities<Spec> d = detail::channel_densities<CP, A, S>(k, mu_v, st.f);
+        // Under a per-channel control: f and uni's Tbar of the step, the residual's times exp(-tau_c,c).
+        [[maybe_unused]] Spec tbf;
+        if constexpr (kChannelControl) {
+            tbf = tb * kept.ec;
+            if constexpr (Visit::enabled) {
+                kept.d = detail::channel_control_densities<A, S>(kept.k, kept.ctl, kept.mu);
+                ChannelPathState<S, kEq> here = st;
+                here.f *= kept.ec;
+                here.uni *= kept.ec;
+                visit(t, kept.k, kept.mu, tb, here, kept.d);
+            }
+        }
         if constexpr (Visit::enabled && !kControlled) {
             if constexpr (grey) visit(t, k, mu, Spec(Spec::Ones()), st, d);
             else visit(t, k, mu, tb, st, d);
@@ -310,8 +409,10 @@ struct ChannelDeltaCollision {
         // Under a control, a real event's densities over both routes (a visitor's before_event
         // formed them already), from the state before this collision as the event's own were.
         if constexpr (kControlled && !Visit::enabled)
-            if (event != SegmentEnd::Passed)
-                kept.d = detail::channel_decomposition_densities<CP, A, S>(kept.k, kept.ctl, kept.mu_bar, st.f);
+            if (event != SegmentEnd::Passed) {
+                if constexpr (kChannelControl) kept.d = detail::channel_control_densities<A, S>(kept.k, kept.ctl, kept.mu);
+                else kept.d = detail::channel_decomposition_densities<CP, A, S>(kept.k, kept.ctl, kept.mu_bar, st.f);
+            }
         if constexpr (Rec::enabled) {
             // Under a control, a real vertex's density is the routes' sum (a null's the residual's).
             const ChannelEventDensities<Spec>& dv = [&]() -> const ChannelEventDensities<Spec>& {
@@ -321,7 +422,9 @@ struct ChannelDeltaCollision {
             const float p_c = event == SegmentEnd::Absorbed    ? dv.absorb[c]
                               : event == SegmentEnd::Scattered ? dv.scatter[c]
                                                                : d.null[c];
-            rec.vertex(t, std::log(double(p_c)) - double(channel_of(tau_v, c)));
+            double tau_c = 0.0;  // the sampling channel's control depth of the step (per-channel control)
+            if constexpr (kChannelControl) tau_c = double(kept.tau_c);
+            rec.vertex(t, std::log(double(p_c)) - double(channel_of(tau_v, c)) - tau_c);
         }
         if (event == SegmentEnd::Absorbed) {  // the path ends without a contribution
             out = {event, t};
@@ -335,8 +438,16 @@ struct ChannelDeltaCollision {
         }
         if (event == SegmentEnd::Passed) {
             if (++nulls <= detail::kFloatNulls) {
-                Spec fn = mu - k.sigma_t(), pn = d.null;
-                if constexpr (!grey) {
+                Spec fn, pn;
+                if constexpr (kChannelControl) {
+                    const auto cn = detail::channel_control_nulls<float>(Spec(kept.k.sigma_t()), kept.mu, kept.ctl, d.null);
+                    fn = cn.f * tbf;
+                    pn = cn.density * tbf;
+                } else {
+                    fn = mu - k.sigma_t();
+                    pn = d.null;
+                }
+                if constexpr (!grey && !kChannelControl) {
                     fn *= tb;
                     pn *= tb;
                 }
@@ -349,7 +460,11 @@ struct ChannelDeltaCollision {
                 // grows with the number of nulls; see detail::kFloatNulls).
                 using D = detail::DoubleSpectrum<Spec>;
                 D fd, pd;
-                if constexpr (CP::own_pdfs) {
+                if constexpr (kChannelControl) {
+                    const auto cn = detail::channel_control_nulls<double>(Spec(kept.k.sigma_t()), kept.mu, kept.ctl, d.null);
+                    fd = cn.f;
+                    pd = cn.density;
+                } else if constexpr (CP::own_pdfs) {
                     const auto nf = detail::channel_null_factors<S>(k, mu);
                     fd = nf.f;
                     pd = nf.density;
@@ -359,7 +474,7 @@ struct ChannelDeltaCollision {
                                                         A, CP::throughput_weighted, double>(k, mu_v, st.f)[2]);
                 }
                 if constexpr (!grey) {
-                    const D tbd = tb.template cast<double>();
+                    const D tbd = (kChannelControl ? tbf : tb).template cast<double>();
                     fd *= tbd;
                     pd *= tbd;
                 }
@@ -372,7 +487,10 @@ struct ChannelDeltaCollision {
             }
             if constexpr (kEq) st.eq.vertex *= nee_factor;
         } else {  // a real scattering vertex: mu_s,c Tbar_c and mu_bar_c P_s,c Tbar_c
-            if constexpr (kControlled) {  // the medium's own mu_s,c, and both routes' densities
+            if constexpr (kChannelControl) {  // the medium's own mu_s,c, and each channel's routes' densities
+                st.f *= kept.k.sigma_s * tbf;
+                st.uni *= kept.d.scatter * tbf;
+            } else if constexpr (kControlled) {  // the medium's own mu_s,c, and both routes' densities
                 st.f *= kept.k.sigma_s;
                 st.uni *= kept.d.scatter;
             } else if constexpr (grey) {
@@ -406,8 +524,10 @@ ChannelTrack track_channels_delta_visiting(const M& medium, const Maj& majorant,
     using RecT = std::remove_reference_t<Rec>;
     constexpr bool kControlled =
         detail::has_control_v<std::remove_cvref_t<decltype(*majorant.iterate(ray, 0.f, tmax, lambda).next())>>;
-    ChannelDeltaCollision<CP, A, S, R, RecT, kEq, Visit, kControlled> cb{rng, rec, st, c, nee_alternative,
-                                                                         std::move(visit)};
+    constexpr bool kChannelControl = kControlled && is_per_channel_majorant_v<Maj, M>;
+    ChannelDeltaCollision<CP, A, S, R, RecT, kEq, Visit, kControlled, kChannelControl> cb{rng, rec, st, c,
+                                                                                          nee_alternative,
+                                                                                          std::move(visit)};
     const auto f = free_flight(medium, majorant, ray, 0.f, tmax, lambda, rng, counter, cb, kDefaultMaxCollisions, c);
     if (f.aborted) return {aborted_end(f), f.t};
     if constexpr (kControlled) {
@@ -424,6 +544,11 @@ ChannelTrack track_channels_delta_visiting(const M& medium, const Maj& majorant,
     if (f.stopped) return cb.out;
     if constexpr (is_per_channel_majorant_v<Maj, M>) {
         const auto tb = detail::relative_transmittance(f.tau_tail, c);
+        if constexpr (kChannelControl) {  // each channel's exp(-tau_c,c) of the tail in f and uni
+            const typename S::Spectrum ec = (-cb.kept.tail).exp();
+            st.f *= ec;
+            st.uni *= ec;
+        }
         st.f *= tb;
         st.uni *= tb;
         st.nee *= tb;
@@ -434,7 +559,10 @@ ChannelTrack track_channels_delta_visiting(const M& medium, const Maj& majorant,
         if (const StateScale r = st.template renormalize<CP>(c); r != StateScale::Ok)
             return {detail::segment_end(r), tmax};
     }
-    if constexpr (RecT::enabled) rec.log_pdf -= double(channel_of(f.tau_tail, c));
+    if constexpr (RecT::enabled) {
+        rec.log_pdf -= double(channel_of(f.tau_tail, c));
+        if constexpr (kChannelControl) rec.log_pdf -= double(cb.kept.tail[c]);
+    }
     return {SegmentEnd::Passed, tmax};
 }
 
@@ -468,9 +596,19 @@ struct ChannelShadow {
 /// `weights` is the path throughput at the segment's start (for throughput-weighted spectral
 /// tracking's null probabilities in `uni`). After detail::kFloatNulls nulls the products continue
 /// in double; `finish` rounds them.
-template <ChannelPolicy CP, AbsorptionPolicy A, SpectralMode S, class Rec>
+///
+/// Under a per-channel majorant's control (`kChannelControl`, ChannelGridControl): the loop hands
+/// over residual collisions at the sampling channel's rate R_c* with every channel's residual
+/// coefficients, residual majorant R_c and residual depth, and before_event each channel's control
+/// depth since the last collision: f gets (R_c - r_c) Tbar_r,c exp(-tau_c,c), nee R_c Tbar_r,c and
+/// uni R_c P_n,c(residual) Tbar_r,c exp(-tau_c,c) per null (each channel's own residual ratio and
+/// decomposition tracking, THEORY 5.10 with 5.3).
+template <ChannelPolicy CP, AbsorptionPolicy A, SpectralMode S, class Rec, bool kChannelControl = false>
 struct ChannelRatioCollision {
     using Spec = typename S::Spectrum;
+    static_assert(!kChannelControl || CP::own_pdfs,
+                  "nsp: a per-channel majorant's control (ChannelGridControl) needs a channel policy with own pdfs "
+                  "(channels::SpectralMis or channels::Independent)");
     /// Under a control, residual ratio tracking (THEORY 5.10): the loop hands over residual
     /// collisions at rate R with the residual's coefficients, so that f gets R - r_c = mu_bar -
     /// mu_t,c, nee R and uni R P_n,c(residual) per null; track_channels_ratio multiplies f and uni
@@ -493,6 +631,26 @@ struct ChannelRatioCollision {
     /// residual nulls (R times its length) for an estimate that rounds to 0.
     void control_depth(double tau) noexcept { control_floor = std::exp(tau); }
 
+    /// Under a per-channel majorant's control, exp(-tau_c,c) of the step to the next collision.
+    /// and the lookup's mu_t, the majorant and the control there.
+    struct KeptChannels {
+        Spec ec, t, mu, ctl, tail;
+    };
+    [[no_unique_address]] std::conditional_t<kChannelControl, KeptChannels, detail::Empty> kept{};
+    void before_event(float, const Coefficients<S>& k, const Spec& mu, const Spec& ctl, const Spec& tau_c, bool) noexcept
+        requires kChannelControl
+    {
+        kept.ec = (-tau_c).exp();
+        kept.t = k.sigma_t();
+        kept.mu = mu;
+        kept.ctl = ctl;
+    }
+    void control_tail(const Spec& tau_c) noexcept
+        requires kChannelControl
+    {
+        kept.tail = tau_c;
+    }
+
     template <class V>
     bool operator()(float t, const Coefficients<S>& k, const V& mu_v, const V& tau_v) {
         if constexpr (Rec::enabled) rec.vertex(t, std::log(double(channel_of(mu_v, c))) - double(channel_of(tau_v, c)));
@@ -506,17 +664,19 @@ struct ChannelRatioCollision {
     }
 
     /// Multiplies every channel's Tbar over the flight's tail (per-channel majorants).
-    void multiply_tail(const Spec& tb) {
+    void multiply_tail(const Spec& tb) { multiply_tail(tb, tb); }
+    /// The same with f's and uni's Tbar `tbf` apart (a per-channel control's: tb exp(-tau_c,c)).
+    void multiply_tail(const Spec& tb, const Spec& tbf) {
         if (nulls <= detail::kFloatNulls) {
-            out.f *= tb;
+            out.f *= tbf;
             out.nee *= tb;
-            out.uni *= tb;
+            out.uni *= tbf;
             normalize(out.f, out.nee, out.uni);
         } else {
-            const D tbd = tb.template cast<double>();
-            f_d *= tbd;
+            const D tbd = tb.template cast<double>(), tbfd = tbf.template cast<double>();
+            f_d *= tbfd;
             nee_d *= tbd;
-            uni_d *= tbd;
+            uni_d *= tbfd;
             normalize(f_d, nee_d, uni_d);
         }
     }
@@ -541,7 +701,12 @@ private:
         Arr nee_factor = mu.template cast<T>();
         Arr f_factor = nee_factor - k.sigma_t().template cast<T>();
         Arr uni_factor = Arr::Ones();
-        if (uni_alternative) {
+        if constexpr (kChannelControl) {  // mu is R_c here: the medium's mu_bar_c - mu_t,c, and the residual's density
+            const auto cn = detail::channel_control_nulls<T>(kept.t, kept.mu, kept.ctl,
+                                                             channel_event_densities<A, S>(k, mu).null);
+            f_factor = cn.f;
+            uni_factor = cn.density;
+        } else if (uni_alternative) {
             if constexpr (CP::own_pdfs) {
                 if constexpr (std::is_same_v<T, float>) uni_factor = channel_event_densities<A, S>(k, mu).null;
                 else uni_factor = detail::channel_null_factors<S>(k, mu).density;
@@ -553,9 +718,15 @@ private:
         }
         if constexpr (!grey) {
             const Arr tb = detail::relative_transmittance(tau_v, c).template cast<T>();
-            f_factor *= tb;
             nee_factor *= tb;
-            if (uni_alternative) uni_factor *= tb;
+            if constexpr (kChannelControl) {  // f's and uni's Tbar take the control's exp(-tau_c,c) too
+                const Arr tbf = tb * kept.ec.template cast<T>();
+                f_factor *= tbf;
+                if (uni_alternative) uni_factor *= tbf;
+            } else {
+                f_factor *= tb;
+                if (uni_alternative) uni_factor *= tb;
+            }
         }
         f *= f_factor;
         nee *= nee_factor;
@@ -632,7 +803,10 @@ ChannelShadow<typename M::Spectral> track_channels_ratio(const M& medium, const 
                                                          bool uni_alternative, R& rng, C& counter, Rec&& rec = Rec{}) {
     using S = typename M::Spectral;
     using RecT = std::remove_reference_t<Rec>;
-    ChannelRatioCollision<CP, A, S, RecT> cb{rec, c, uni_alternative, weights};
+    constexpr bool kChannelControl =
+        detail::has_control_v<std::remove_cvref_t<decltype(*majorant.iterate(ray, 0.f, tmax, lambda).next())>> &&
+        is_per_channel_majorant_v<Maj, M>;
+    ChannelRatioCollision<CP, A, S, RecT, kChannelControl> cb{rec, c, uni_alternative, weights};
     const auto f = free_flight(medium, majorant, ray, 0.f, tmax, lambda, rng, counter, cb, kDefaultMaxCollisions, c);
     if (f.aborted) {
         ChannelShadow<S> out = cb.finish();
@@ -641,7 +815,12 @@ ChannelShadow<typename M::Spectral> track_channels_ratio(const M& medium, const 
         return out;
     }
     if (f.stopped) return cb.finish();
-    if constexpr (is_per_channel_majorant_v<Maj, M>) cb.multiply_tail(detail::relative_transmittance(f.tau_tail, c));
+    if constexpr (kChannelControl) {
+        const typename S::Spectrum tb = detail::relative_transmittance(f.tau_tail, c);
+        cb.multiply_tail(tb, typename S::Spectrum(tb * (-cb.kept.tail).exp()));
+    } else if constexpr (is_per_channel_majorant_v<Maj, M>) {
+        cb.multiply_tail(detail::relative_transmittance(f.tau_tail, c));
+    }
     if constexpr (RecT::enabled) rec.log_pdf -= double(channel_of(f.tau_tail, c));
     ChannelShadow<S> out = cb.finish();
     if (f.tau_ctl > 0.0 && out.end == SegmentEnd::Passed) {

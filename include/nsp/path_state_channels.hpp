@@ -188,9 +188,9 @@ public:
 
     /// An equiangular vertex drawn on the current piece (see the grey state's): every channel's
     /// equiangular and tracking pdfs of it, and the survival tracking would give it.
-    template <class Coeff, class Mu>
+    template <class Coeff, class Mu, class Ctl = float>
     std::optional<VertexRecord<P, S>> equiangular_vertex(const ShadowPiece<P, S>& w, const Coeff& k, const Mu& mu,
-                                                         float eq_pdf, int depth, float ctl = 0.f) const noexcept {
+                                                         float eq_pdf, int depth, const Ctl& ctl = 0.f) const noexcept {
         VertexRecord<P, S> x;
         x.f = st_.f * w.f * k.sigma_s;
         if (!(x.f != 0.f).any()) return std::nullopt;
@@ -199,7 +199,8 @@ public:
         x.eq_drawn = true;
         if constexpr (St::combines) {
             // Every channel's tracking pdf of the same nulls and of a real scattering vertex at x.
-            // Under a control (ctl > 0), decomposition tracking's: both routes' (THEORY 5.10).
+            // Under a control (ctl > 0), decomposition tracking's: both routes' (THEORY 5.10); per
+            // channel under a per-channel majorant's.
             const Spectrum scatter = channel_scatter_densities<CP, A, S>(k, mu, Spectrum(st_.f * w.f), ctl);
             x.p_track = st_.uni * w.uni * scatter;
             // The survival tracking would give x: a function of the path (its f and tracking pdfs).

@@ -172,7 +172,7 @@ struct FlightEnd {
     V tau_tail{};           ///< majorant optical depth from the last collision to tmax if passed
     bool invalid = false;   ///< the ray was not usable_ray or tmin / tmax NaN: nothing was tracked (`aborted` is set too)
     /// The control's optical depth over the flight (up to `t` where it stopped), where the
-    /// callback took a control (ControlUse::ClosedForm or Collide); 0 otherwise.
+    /// callback took a grey majorant's control (ControlUse::ClosedForm or Collide); 0 otherwise.
     double tau_ctl = 0.0;
 };
 
@@ -224,6 +224,12 @@ template <class Spec>
 float grey_control(const Spec& ctl, float mu_bar) noexcept {
     return std::min(std::max(ctl.minCoeff(), 0.f), mu_bar);
 }
+/// Under a per-channel majorant mu_bar (ChannelGridControl), every channel's own control, kept
+/// within [0, mu_bar,c].
+template <class Spec>
+Spec channel_controls(const Spec& ctl, const Spec& mu_bar) noexcept {
+    return ctl.max(0.f).min(mu_bar.max(0.f));
+}
 
 /// Scales coefficients `k` (after the bound policy) to extinction mu_t,c - `ctl` in every channel,
 /// albedo kept (ControlUse): where mu_t,c = 0 the residual -ctl is all absorption. mu_s is scaled
@@ -245,10 +251,29 @@ void to_residual(Coefficients<S>& k, float ctl, float rate) noexcept {
         k.sigma_a = (over > 0.f).select(k.sigma_a - over, k.sigma_a);
 }
 
-/// Scales coefficients `k` to extinction `ctl` in every channel, albedo kept (a control collision,
-/// ControlUse::Collide): where mu_t,c = 0 it is all absorption.
+/// to_residual with every channel's own control `ctl` and residual majorant `rate` (a per-channel
+/// majorant's control): channel c as to_residual with ctl_c and rate_c; a channel whose control is
+/// 0 keeps its lookup.
 template <SpectralMode S>
-void to_control(Coefficients<S>& k, float ctl) noexcept {
+void to_residual(Coefficients<S>& k, const typename S::Spectrum& ctl, const typename S::Spectrum& rate) noexcept {
+    using Spec = typename S::Spectrum;
+    const auto on = (ctl > 0.f).eval();
+    if (!on.any()) return;
+    const Spec t = k.sigma_t();
+    const Spec r = t - ctl;
+    const Spec s = (t > 0.f).select(r * (k.sigma_s / t), 0.f);
+    k.sigma_s = on.select(s, k.sigma_s);
+    k.sigma_a = on.select(r - s, k.sigma_a);
+    const Spec over = k.sigma_t() - rate;
+    const auto fix = (on && over > 0.f).eval();
+    if (fix.any()) [[unlikely]]
+        k.sigma_a = fix.select(k.sigma_a - over, k.sigma_a);
+}
+
+/// Scales coefficients `k` to extinction `ctl` in every channel, albedo kept (a control collision,
+/// ControlUse::Collide): where mu_t,c = 0 it is all absorption. `ctl` is grey or per channel.
+template <SpectralMode S, class Ctl>
+void to_control(Coefficients<S>& k, const Ctl& ctl) noexcept {
     using Spec = typename S::Spectrum;
     const Spec t = k.sigma_t();
     k.sigma_s = (t > 0.f).select(ctl * (k.sigma_s / t), 0.f).min(ctl);  // the albedo first, as to_residual
@@ -353,7 +378,18 @@ FlightEnd<MajorantValue<Maj, M>> free_flight(const M& medium, const Maj& majoran
     constexpr ControlUse use = detail::has_control_v<Seg> ? detail::control_use_of<F>() : ControlUse::Ignore;
     constexpr bool residual = use != ControlUse::Ignore;
     constexpr bool collide = use == ControlUse::Collide;
-    static_assert(!residual || grey, "a control's segments carry a grey majorant");
+    // Under a per-channel majorant's control (ChannelGridControl), the sampling channel tracks its
+    // own residual and control; the callback sees every channel's residual coefficients, residual
+    // majorant and depth, and first, in before_event, the lookup, majorants, controls and control
+    // depths since the last collision (THEORY 5.10 with 5.3).
+    constexpr bool channel_ctl = residual && !grey;
+    // At the end of a flight that passed tmax the callback is told every channel's control depth
+    // from the last collision (control_tail); `tau_tail` is then the residual's.
+    if constexpr (channel_ctl)
+        static_assert(requires(const Coefficients<typename M::Spectral>& k, const V& v) {
+            on_collision.before_event(0.f, k, v, v, v, false);
+            on_collision.control_tail(v);
+        }, "nsp: this collision policy does not take a per-channel majorant's control (ChannelGridControl)");
     if (!usable_ray(ray) || tmin != tmin || tmax != tmax) [[unlikely]] {  // NaN != NaN
         FlightEnd<V> bad{false, true, false, 0.f, V{}, true};
         if constexpr (!grey) bad.tau_tail.setZero();
@@ -376,10 +412,23 @@ FlightEnd<MajorantValue<Maj, M>> free_flight(const M& medium, const Maj& majoran
     float e = -1.f;
     [[maybe_unused]] double tau_ctl = 0.0;  // the control's optical depth so far (ControlUse)
     [[maybe_unused]] float e_ctl = -1.f;    // the control depth left to the next control collision (Collide)
+    // Per-channel controls: every channel's control depth since the last collision, and the
+    // segment's controls and residual majorants.
+    [[maybe_unused]] V tau_c{}, ctl_v{}, res_v{};
+    if constexpr (channel_ctl) tau_c.setZero();
+    auto add_ctl_depth = [&](float len) {
+        if constexpr (channel_ctl) tau_c += (ctl_v > 0.f).select(ctl_v * len, 0.f);
+        else (void)len;
+    };
     while (auto seg = segments.next()) {
         float mu_bar = channel_of(seg->sigma_maj, channel);
         [[maybe_unused]] float ctl = 0.f;
-        if constexpr (residual) {
+        if constexpr (channel_ctl) {
+            ctl_v = detail::channel_controls(seg->sigma_ctl, seg->sigma_maj);
+            res_v = (seg->sigma_maj - ctl_v).max(0.f);
+            ctl = ctl_v[channel];
+            mu_bar = res_v[channel];  // the sampling channel's residual majorant
+        } else if constexpr (residual) {
             ctl = detail::grey_control(seg->sigma_ctl, mu_bar);
             mu_bar -= ctl;  // the residual majorant
             if constexpr (!collide) {
@@ -388,7 +437,13 @@ FlightEnd<MajorantValue<Maj, M>> free_flight(const M& medium, const Maj& majoran
                     if (tau_ctl > 20.0) on_collision.control_depth(tau_ctl);
             }
         }
-        if constexpr (collide) {
+        if constexpr (channel_ctl) {
+            if (!(mu_bar > 0.f) && (!collide || !(ctl > 0.f))) {  // the other channels' depths only
+                add_depth(res_v, seg->t1 - seg->t0);
+                add_ctl_depth(seg->t1 - seg->t0);
+                continue;
+            }
+        } else if constexpr (collide) {
             if (!(mu_bar > 0.f) && !(ctl > 0.f)) continue;
         } else if (!(mu_bar > 0.f)) {  // nothing to collide with on this segment
             if constexpr (!grey) add_depth(seg->sigma_maj, seg->t1 - seg->t0);
@@ -420,7 +475,13 @@ FlightEnd<MajorantValue<Maj, M>> free_flight(const M& medium, const Maj& majoran
             }
             if (!(dt < seg->t1 - t)) {  // the step leaves the segment (also catches inf)
                 const float len = seg->t1 - t;
-                if constexpr (collide) {
+                if constexpr (channel_ctl) {
+                    if (mu_bar > 0.f) e -= mu_bar * len;  // <= 0 after rounding at the boundary: draw anew
+                    if constexpr (collide)
+                        if (ctl > 0.f) e_ctl -= ctl * len;
+                    add_depth(res_v, len);
+                    add_ctl_depth(len);
+                } else if constexpr (collide) {
                     if (mu_bar > 0.f) e -= mu_bar * len;  // <= 0 after rounding at the boundary: draw anew
                     if (ctl > 0.f) e_ctl -= ctl * len;
                     tau += (mu_bar + ctl) * len;
@@ -434,7 +495,21 @@ FlightEnd<MajorantValue<Maj, M>> free_flight(const M& medium, const Maj& majoran
             }
             t += dt;
             [[maybe_unused]] float rate = mu_bar;  // the callback's majorant under a control
-            if constexpr (collide) {
+            if constexpr (channel_ctl) {
+                add_depth(res_v, dt);
+                add_ctl_depth(dt);
+                if constexpr (collide) {
+                    if (control_first) {
+                        if (mu_bar > 0.f && e > 0.f) e -= mu_bar * dt;
+                        e_ctl = -1.f;
+                    } else {
+                        if (ctl > 0.f && e_ctl > 0.f) e_ctl -= ctl * dt;
+                        e = -1.f;
+                    }
+                } else {
+                    e = -1.f;
+                }
+            } else if constexpr (collide) {
                 tau += (mu_bar + ctl) * dt;
                 tau_ctl += double(ctl) * double(dt);
                 if (control_first) {  // a control collision: real (THEORY 5.10)
@@ -461,7 +536,14 @@ FlightEnd<MajorantValue<Maj, M>> free_flight(const M& medium, const Maj& majoran
             } else if constexpr (std::is_same_v<B, bound::Reject>) {
                 if (detail::exceeds_majorant(coeff, seg->sigma_maj)) return {false, true, true, t, V{}};
             }
-            if constexpr (collide) {
+            if constexpr (channel_ctl) {
+                // Every channel's lookup, majorant, control and control depth since the last
+                // collision, then the route's coefficients (a control collision's under Collide).
+                on_collision.before_event(t, coeff, seg->sigma_maj, ctl_v, tau_c, control_first);
+                tau_c.setZero();
+                if (control_first) detail::to_control(coeff, ctl_v);
+                else detail::to_residual(coeff, ctl_v, res_v);
+            } else if constexpr (collide) {
                 // The callback may keep the medium's own coefficients (a real vertex's density, a
                 // visitor's estimate) before they become the control's or the residual's.
                 if constexpr (requires { on_collision.before_event(t, coeff, 0.f, 0.f, 0.0); })
@@ -474,7 +556,10 @@ FlightEnd<MajorantValue<Maj, M>> free_flight(const M& medium, const Maj& majoran
             const V tau_step = tau;
             if constexpr (grey) tau = 0.f;
             else tau.setZero();
-            if constexpr (residual) {
+            if constexpr (channel_ctl) {
+                if (!on_collision(t, coeff, control_first ? ctl_v : res_v, tau_step))
+                    return {true, false, false, t, V{}};
+            } else if constexpr (residual) {
                 if (!on_collision(t, coeff, rate, tau_step)) {
                     FlightEnd<V> end{true, false, false, t, 0.f};
                     end.tau_ctl = tau_ctl;
@@ -485,7 +570,10 @@ FlightEnd<MajorantValue<Maj, M>> free_flight(const M& medium, const Maj& majoran
             }
         }
     }
-    if constexpr (residual) {
+    if constexpr (channel_ctl) {
+        on_collision.control_tail(tau_c);
+        return {false, false, false, tmax, tau};
+    } else if constexpr (residual) {
         FlightEnd<V> end{false, false, false, tmax, tau};
         end.tau_ctl = tau_ctl;
         return end;

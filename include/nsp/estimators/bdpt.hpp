@@ -213,6 +213,10 @@ private:
             static_assert(!is_per_channel_majorant_v<typename Sc::MajorantType, typename Sc::MediumType>,
                           "nsp::BdptEstimator<..., bdpt::Grey> drives every channel with one pdf and needs a grey "
                           "majorant (channels::SpectralMis: one per channel)");
+        static_assert(!(is_control_v<typename Sc::MajorantType, typename Sc::MediumType> &&
+                        is_per_channel_majorant_v<typename Sc::MajorantType, typename Sc::MediumType>),
+                      "nsp::BdptEstimator takes a grey majorant's control (GridControl, TreeControl, GlobalControl), "
+                      "not a per-channel one (ChannelGridControl)");
 
         static_assert(std::remove_cvref_t<decltype(std::declval<Sc>().lights)>::bidirectional_ready(),
                       "nsp::BdptEstimator: every light model must start light subpaths (EmittingLight: "

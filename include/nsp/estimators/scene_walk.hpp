@@ -146,7 +146,11 @@ template <Medium M, class Maj>
 struct UntrackedVertex {
     Coefficients<typename M::Spectral> k;  ///< the lookup, clamped to the majorant under bound::Clamp
     MajorantValue<Maj, M> mu;              ///< the majorant there (grey or per channel)
-    float ctl = 0.f;                       ///< under a control, the grey control there (free_flight's); else 0
+    /// Under a control, the control there as free_flight takes it: grey (the smallest channel's), or
+    /// every channel's own under a per-channel majorant (ChannelGridControl); else 0.
+    std::conditional_t<is_control_v<Maj, M> && is_per_channel_majorant_v<Maj, M>, typename M::Spectral::Spectrum,
+                       float>
+        ctl{};
 };
 
 /// Path state st's piece of a shadow walk through medium m of SurfaceScene sc (State::shadow_piece
@@ -172,8 +176,10 @@ std::optional<UntrackedVertex<M, Maj>> lookup_untracked(const M& medium, const M
     using B = bound_policy_t<Maj>;
     counter.lookup();
     UntrackedVertex<M, Maj> v{medium.coefficients(ray.at(t), lambda), majorant_value_at_point<M>(majorant, ray, t, lambda)};
-    if constexpr (requires { majorant.control_value_at(ray.at(t), lambda); })
-        v.ctl = grey_control(majorant.control_value_at(ray.at(t), lambda), float(v.mu));
+    if constexpr (requires { majorant.control_value_at(ray.at(t), lambda); }) {
+        if constexpr (is_per_channel_majorant_v<Maj, M>) v.ctl = channel_controls(majorant.control_value_at(ray.at(t), lambda), v.mu);
+        else v.ctl = grey_control(majorant.control_value_at(ray.at(t), lambda), float(v.mu));
+    }
     if constexpr (std::is_same_v<B, bound::Clamp>) {
         clamp_to_majorant(v.k, v.mu);
     } else if constexpr (std::is_same_v<B, bound::Reject>) {

@@ -45,12 +45,13 @@ concept LowerBoundedMedium = RegionBoundedMedium<M> && requires(const M& m, cons
     { m.density_lower_bound(b) } -> std::same_as<float>;
 };
 
-/// A stretch [t0, t1) of a ray with its grey majorant and its control per channel (see the header).
-template <class Spectrum>
+/// A stretch [t0, t1) of a ray with its majorant, grey (Maj = float) or per channel (Maj =
+/// Spectrum, ChannelGridControl), and its control per channel (see the header).
+template <class Spectrum, class Maj = float>
 struct ControlSegment {
     float t0 = 0.f;
     float t1 = 0.f;
-    float sigma_maj = 0.f;  ///< mu_bar: the majorant, >= mu_t,c in every channel on the stretch
+    Maj sigma_maj{};        ///< mu_bar: the majorant, >= mu_t,c in every channel (per channel: in its channel) on the stretch
     Spectrum sigma_ctl{};   ///< mu_c per channel, finite, >= 0 and <= mu_bar (below mu_t,c unless the caller chose otherwise)
     /// The residual majorant of a per-channel control: mu_t,c - mu_c,c <= sigma_res in every channel
     /// (transmittance_residual_ratio); at most mu_bar - min_c mu_c,c, which the loop's grey control uses.
@@ -58,12 +59,12 @@ struct ControlSegment {
 };
 
 namespace detail {
-template <class S>
-struct is_majorant_segment<ControlSegment<S>> : std::true_type {};  // a majorant segment with a control
+template <class S, class V>
+struct is_majorant_segment<ControlSegment<S, V>> : std::true_type {};  // a majorant segment with a control
 template <class T>
 struct is_control_segment : std::false_type {};
-template <class S>
-struct is_control_segment<ControlSegment<S>> : std::true_type {};
+template <class S, class V>
+struct is_control_segment<ControlSegment<S, V>> : std::true_type {};
 }  // namespace detail
 
 /// A control policy for medium M: a majorant policy whose `iterate(ray, tmin, tmax, lambda)`
@@ -141,21 +142,21 @@ private:
     float majorant_;
 };
 
-/// A grid of controls and majorants over the medium's box (THEORY 5.10): per cell the medium's
-/// density bounds from below (LowerBoundedMedium; 0 for a medium without one) and from above,
-/// d_min <= d <= d_max; on a cell's stretch the control is d_min times each channel's extinction
-/// per density u_c and the majorant d_max max_c u_c (GridMajorant's), so the residual majorant is
-/// d_max max_c u_c - d_min min_c u_c ((d_max - d_min) u on a grey medium). Walked by the same DDA as GridMajorant. Two floats per cell.
-template <RegionBoundedMedium M>
-class GridControl {
+namespace detail {
+/// GridControl (kChannels false) and ChannelGridControl (true): the same cells, walked alike; the
+/// majorant is grey (d_max max_c u_c) or per channel (d_max u_c).
+template <RegionBoundedMedium M, bool kChannels>
+class BasicGridControl {
+    static constexpr const char* kName = kChannels ? "ChannelGridControl" : "GridControl";
+
 public:
     using Spectral = typename M::Spectral;
     using Spectrum = typename Spectral::Spectrum;
 
     /// Throws InvalidArgument as GridMajorant does (resolution, box, bounds), and on a lower bound
     /// that is not finite, is negative or exceeds the cell's upper bound.
-    GridControl(const M& medium, std::array<int, 3> resolution)
-        : upper_(medium, resolution, 1.f, "GridControl"), unit_(medium.extinction_per_density()),
+    BasicGridControl(const M& medium, std::array<int, 3> resolution)
+        : upper_(medium, resolution, 1.f, kName), unit_(medium.extinction_per_density()),
           unit_max_(max_value(unit_)), unit_min_(min_value(unit_)) {
         const std::array<int, 3> res = upper_.resolution();
         lower_.assign(std::size_t(res[0]) * std::size_t(res[1]) * std::size_t(res[2]), 0.f);
@@ -166,36 +167,40 @@ public:
                     for (int x = 0; x < res[0]; ++x, ++i) {
                         const float d = medium.density_lower_bound(upper_.region(x, y, z));
                         if (!std::isfinite(d) || d < 0.f)
-                            detail::fail("GridControl cell (", x, ", ", y, ", ", z, "): the medium's density lower bound = ",
+                            detail::fail(kName, " cell (", x, ", ", y, ", ", z, "): the medium's density lower bound = ",
                                          d, " is not allowed: it must be finite and >= 0");
                         if (d > upper_.at(x, y, z))
-                            detail::fail("GridControl cell (", x, ", ", y, ", ", z, "): the medium's density lower bound = ",
+                            detail::fail(kName, " cell (", x, ", ", y, ", ", z, "): the medium's density lower bound = ",
                                          d, " exceeds its upper bound ", upper_.at(x, y, z));
                         lower_[i] = d;
                     }
         }
     }
-    GridControl(const M& medium, int resolution) : GridControl(medium, {resolution, resolution, resolution}) {}
+    BasicGridControl(const M& medium, int resolution) : BasicGridControl(medium, {resolution, resolution, resolution}) {}
+
+    /// A stretch's segment: grey or per-channel majorant.
+    using Segment = ControlSegment<Spectrum, std::conditional_t<kChannels, Spectrum, float>>;
 
     class Iterator {
     public:
-        Iterator(const GridControl& g, detail::GridWalk walk, const Spectrum& unit) noexcept
+        Iterator(const BasicGridControl& g, detail::GridWalk walk, const Spectrum& unit) noexcept
             : g_(&g), walk_(walk), unit_(unit) {}
-        std::optional<ControlSegment<Spectrum>> next() noexcept {
+        std::optional<Segment> next() noexcept {
             std::size_t i;
             float t0, t1;
             while (walk_.next(i, t0, t1)) {
                 const float hi = g_->upper_.data()[i];
                 if (!(hi > 0.f) || !(t1 > t0)) continue;
                 const float lo = g_->lower_[i];
-                return ControlSegment<Spectrum>{t0, t1, hi * g_->unit_max_, unit_ * lo, (hi - lo) * g_->unit_max_};
+                if constexpr (kChannels) return Segment{t0, t1, unit_ * hi, unit_ * lo, (hi - lo) * g_->unit_max_};
+                else return Segment{t0, t1, hi * g_->unit_max_, unit_ * lo, (hi - lo) * g_->unit_max_};
             }
             return std::nullopt;
         }
         std::uint32_t steps() const noexcept { return walk_.steps(); }
 
     private:
-        const GridControl* g_;
+        const BasicGridControl* g_;
         detail::GridWalk walk_;
         Spectrum unit_;
     };
@@ -204,9 +209,11 @@ public:
         return {*this, upper_.walk(r, tmin, tmax), Spectral::sample(unit_, l)};
     }
 
-    /// The majorant at point p (its cell's, 0 outside the box): one lookup, no walk.
-    float value_at(const Vec3& p, const typename Spectral::Wavelengths&) const noexcept {
-        return upper_.at_point(p) * unit_max_;
+    /// The majorant at point p (its cell's, 0 outside the box): one lookup, no walk; grey, or per
+    /// channel for ChannelGridControl.
+    auto value_at(const Vec3& p, const typename Spectral::Wavelengths& l) const noexcept {
+        if constexpr (kChannels) return Spectrum(Spectral::sample(unit_, l) * upper_.at_point(p));
+        else return (void)l, upper_.at_point(p) * unit_max_;
     }
     /// The control at point p, per channel (its cell's, 0 outside the box): the sigma_ctl of the
     /// segment `iterate` gives there.
@@ -232,11 +239,12 @@ public:
     /// The sum over the cells of the residual majorant that tracking under this control pays
     /// lookups for: the majorant d_max max_c u_c less the grey control d_min min_c u_c (the
     /// free-flight loop's, tracking.hpp), per unit volume of a cell (the cost model's, choose.hpp).
+    /// Per channel (ChannelGridControl) the densest channel's: (d_max - d_min) max_c u_c.
     double residual_sum() const noexcept {
         double sum = 0.0;
         const float* up = upper_.data();
         for (std::size_t i = 0; i < lower_.size(); ++i)
-            sum += double(up[i]) * unit_max_ - double(lower_[i]) * unit_min_;
+            sum += double(up[i]) * unit_max_ - double(lower_[i]) * (kChannels ? unit_max_ : unit_min_);
         return sum;
     }
     /// Bytes of cell storage (two floats per cell).
@@ -248,6 +256,34 @@ private:
     typename Spectral::Coefficient unit_;
     float unit_max_;
     float unit_min_;
+};
+}  // namespace detail
+
+/// A grid of controls and majorants over the medium's box (THEORY 5.10): per cell the medium's
+/// density bounds from below (LowerBoundedMedium; 0 for a medium without one) and from above,
+/// d_min <= d <= d_max; on a cell's stretch the control is d_min times each channel's extinction
+/// per density u_c and the majorant d_max max_c u_c (GridMajorant's), so the residual majorant is
+/// d_max max_c u_c - d_min min_c u_c ((d_max - d_min) u on a grey medium). Walked by the same DDA
+/// as GridMajorant. Two floats per cell. Throws InvalidArgument as GridMajorant does (resolution,
+/// box, bounds), and on a lower bound that is not finite, is negative or exceeds the cell's upper
+/// bound.
+template <RegionBoundedMedium M>
+class GridControl : public detail::BasicGridControl<M, false> {
+public:
+    using detail::BasicGridControl<M, false>::BasicGridControl;
+};
+
+/// GridControl's cells with ChannelGridMajorant's per-channel majorant (THEORY 5.10 with 5.3): on
+/// a cell's stretch channel c's majorant is d_max u_c and its control d_min u_c, so a chromatic
+/// medium's channels each track their own residual (d_max - d_min) u_c. The per-channel trackers
+/// (channel_tracking.hpp) take it with own pdfs (spectral MIS, independent tracking): the sampling
+/// channel draws decomposition tracking's control and residual collisions with its own control,
+/// and every channel's pdfs are its own decomposition tracking's. Two floats per cell; throws as
+/// GridControl.
+template <RegionBoundedMedium M>
+class ChannelGridControl : public detail::BasicGridControl<M, true> {
+public:
+    using detail::BasicGridControl<M, true>::BasicGridControl;
 };
 
 /// A tree of controls and majorants (THEORY 5.10): TreeMajorant's cells, each that is not split
