@@ -197,6 +197,7 @@ ChannelEventDensities<typename S::Spectrum> channel_control_densities(const Coef
                                                                       const typename S::Spectrum& ctl,
                                                                       const typename S::Spectrum& mu) noexcept {
     using Spec = typename S::Spectrum;
+    if (!(ctl > 0.f).any()) return channel_event_densities<A, S>(k, mu);  // no control here: delta tracking's
     const Spec rate = (mu - ctl).max(0.f);
     Coefficients<S> r = k;
     to_residual(r, ctl, rate);
@@ -333,7 +334,7 @@ struct ChannelDeltaCollision {
         kept.k = k;
         kept.mu = mu;
         kept.ctl = ctl;
-        kept.ec = (-tau_c).exp();
+        kept.ec = (tau_c > 0.f).any() ? Spec((-tau_c).exp()) : Spec(Spec::Ones());  // no control since the last collision: 1
         kept.tau_c = tau_c[c];
     }
     void control_tail(const Spec& tau_c) noexcept
@@ -640,7 +641,7 @@ struct ChannelRatioCollision {
     void before_event(float, const Coefficients<S>& k, const Spec& mu, const Spec& ctl, const Spec& tau_c, bool) noexcept
         requires kChannelControl
     {
-        kept.ec = (-tau_c).exp();
+        kept.ec = (tau_c > 0.f).any() ? Spec((-tau_c).exp()) : Spec(Spec::Ones());
         kept.t = k.sigma_t();
         kept.mu = mu;
         kept.ctl = ctl;
@@ -702,10 +703,11 @@ private:
         Arr f_factor = nee_factor - k.sigma_t().template cast<T>();
         Arr uni_factor = Arr::Ones();
         if constexpr (kChannelControl) {  // mu is R_c here: the medium's mu_bar_c - mu_t,c, and the residual's density
-            const auto cn = detail::channel_control_nulls<T>(kept.t, kept.mu, kept.ctl,
-                                                             channel_event_densities<A, S>(k, mu).null);
-            f_factor = cn.f;
-            uni_factor = cn.density;
+            f_factor = kept.mu.template cast<T>() - kept.t.template cast<T>();
+            if (uni_alternative)
+                uni_factor = detail::channel_control_nulls<T>(kept.t, kept.mu, kept.ctl,
+                                                              channel_event_densities<A, S>(k, mu).null)
+                                 .density;
         } else if (uni_alternative) {
             if constexpr (CP::own_pdfs) {
                 if constexpr (std::is_same_v<T, float>) uni_factor = channel_event_densities<A, S>(k, mu).null;
