@@ -137,18 +137,11 @@ TEST_CASE("per-channel control: emitting absorber = quadrature") {
 }
 
 TEST_CASE("per-channel control: the emissive furnace gives L_e, with and without roulette") {
-    // L_e equal to the environment inside the box: L = L_e after many scatterings, for any
-    // density and albedo; every technique's contributions are weighed against the others'.
-    using S = Rgb;
-    const Box box{Vec3(-1.f), Vec3(1.f)};
-    const auto le = spec<S>(0.7f, 0.4f, 1.1f);
-    Lights<S> lights;
-    lights.set(EnvironmentLight<S>{le});
-    const Ray ray{Vec3(-3.f, 0.15f, -0.1f), glm::normalize(Vec3(1.f, 0.02f, 0.03f))};
-    using EM = Emissive<ExponentialMedium<S>>;
-    const EM medium(make_medium<ExponentialMedium<S>>(box, 1.f, spec<S>(0.5f, 0.2f, 1.2f), spec<S>(0.6f, 0.4f, 0.9f)),
-                    make_emission(box, {3, 2, 4}, 1.f, 0), le, {4, 4, 4});
-    const Scene scene(medium, ChannelGridControl<EM>(medium, 8), HenyeyGreensteinPhase(0.3f), lights);
+    // EmissiveFurnace (references.hpp): L = L_e after many scatterings, for any density and
+    // albedo; every technique's contributions are weighed against the others'.
+    const EmissiveFurnace setup;
+    using EM = EmissiveFurnace::Medium;
+    const Scene scene(setup.medium, ChannelGridControl<EM>(setup.medium, 8), HenyeyGreensteinPhase(0.3f), setup.lights);
     EstimatorOptions rr;
     rr.rr_start_depth = 1;
     rr.rr_max_survival = 0.6f;
@@ -156,9 +149,8 @@ TEST_CASE("per-channel control: the emissive furnace gives L_e, with and without
     auto each = [&](const auto& est) {
         using E = std::remove_cvref_t<decltype(est)>;
         for (const bool roulette : {false, true}) {
-            const auto res = estimate_radiance(roulette ? E(rr) : est, scene, ray, 6000, ++seed);
-            check_channels(res, {double(le[0]), double(le[1]), double(le[2])},
-                           name_of<E>() + (roulette ? " roulette" : ""));
+            const auto res = estimate_radiance(roulette ? E(rr) : est, scene, setup.ray, 6000, ++seed);
+            check_channels(res, setup.ref(), name_of<E>() + (roulette ? " roulette" : ""));
         }
     };
     each(SpectralPathEstimator<channels::SpectralMis, strategy::Unidirectional, mis::None, absorption::Weight>{});

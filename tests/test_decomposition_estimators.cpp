@@ -457,15 +457,13 @@ TEST_CASE_TEMPLATE_APPLY(spectral_ctl_absorber, decltype(CombosOf<Rgb, Exponenti
 TEST_CASE("spectral estimators under a control: the emissive furnace gives L_e") {
     // PathEstimator's emissive furnace above (L_e equal to the environment: L = L_e after many
     // scatterings), Rgb, spectral MIS with and without roulette.
-    using S = Rgb;
-    const Box box{Vec3(-1.f), Vec3(1.f)};
-    const auto le = spec<S>(0.7f, 0.4f, 1.1f);
-    Lights<S> lights;
-    lights.set(EnvironmentLight<S>{le});
-    const Ray ray{Vec3(-3.f, 0.15f, -0.1f), glm::normalize(Vec3(1.f, 0.02f, 0.03f))};
-    using Exp = Emissive<ExponentialMedium<S>>;
-    const Exp medium(make_medium<ExponentialMedium<S>>(box, 1.f, spec<S>(0.5f, 0.3f, 0.8f), spec<S>(0.6f, 0.9f, 0.3f)),
-                     make_emission(box, {3, 2, 4}, 1.f, 0), le, {4, 4, 4});
+    const EmissiveFurnace setup;
+    using Exp = EmissiveFurnace::Medium;
+    const Box& box = setup.box;
+    const auto& le = setup.le;
+    const auto& lights = setup.lights;
+    const Ray& ray = setup.ray;
+    const Exp& medium = setup.medium;
     const float lo = medium.density_lower_bound(box);
     const float above = lo + 0.2f * (medium.density_bound(box) - lo);
     auto run = [&](const auto& control, const std::string& name, std::uint64_t seed) {

@@ -96,4 +96,24 @@ struct PointLightSingleScatter {
     std::array<double, 3> ref = single_scatter_reference(medium, ray, light, 2.f);
 };
 
+/// The chromatic emissive furnace of the control suites: an exponential medium over [-1, 1]^3
+/// (density 1 at the centre, mu_a (0.5, 0.3, 0.8), mu_s (0.6, 0.9, 0.3) per unit density) emitting
+/// L_e = (0.7, 0.4, 1.1) everywhere, under an environment of the same radiance: L = L_e along `ray`
+/// for any density and albedo, after many scatterings.
+struct EmissiveFurnace {
+    using S = Rgb;
+    using Medium = Emissive<ExponentialMedium<S>>;
+    Box box{Vec3(-1.f), Vec3(1.f)};
+    S::Spectrum le = spec<S>(0.7f, 0.4f, 1.1f);
+    Lights<S> lights = [this] {
+        Lights<S> l;
+        l.set(EnvironmentLight<S>{le});
+        return l;
+    }();
+    Ray ray{Vec3(-3.f, 0.15f, -0.1f), glm::normalize(Vec3(1.f, 0.02f, 0.03f))};
+    Medium medium{make_medium<ExponentialMedium<S>>(box, 1.f, spec<S>(0.5f, 0.3f, 0.8f), spec<S>(0.6f, 0.9f, 0.3f)),
+                  make_emission(box, {3, 2, 4}, 1.f, 0), le, {4, 4, 4}};
+    std::array<double, 3> ref() const { return {double(le[0]), double(le[1]), double(le[2])}; }
+};
+
 }  // namespace nsp_test
