@@ -150,7 +150,7 @@ Options parse_command_line(int argc, char** argv) {
                   if (!t.empty()) o.estimators.emplace_back(t);
               if (o.estimators.empty()) throw UsageError("--estimators needs at least one name", true);
           });
-    value("--majorant", "LIST", "global, per-channel, grid, channel-grid, grid-control, grid-signed, ..., all",
+    value("--majorant", "LIST", "global, per-channel, grid, channel-grid, grid-control, channel-grid-control, grid-signed, ..., all",
           [&](std::string_view v) { parse_majorants(o, v); });
     value("--grid-res", "N", "cells per axis of the grid majorants (default 16)",
           [&](std::string_view v) { o.majorant.grid_res = parse_number<int>("--grid-res", v, 1, 1024); });

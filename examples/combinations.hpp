@@ -136,6 +136,20 @@ struct GridControlPolicy {
     static type<M> make(const M& medium, const MajorantSettings& s) { return type<M>(medium, s.grid_res); }
 };
 
+/// A per-channel voxel-grid majorant with a control beside it (nsp::ChannelGridControl, THEORY 5.10
+/// with 5.3): the grid control's cells with each channel's own majorant d_max u_c and control
+/// d_min u_c. SpectralPathEstimator's own-pdf channel policies (spectral MIS, independent tracking)
+/// track each channel's own residual.
+struct ChannelGridControlPolicy {
+    static constexpr const char* name = "channel-grid-control";
+    static constexpr bool per_channel = true;
+    static constexpr bool bounding = true;
+    template <nsp::Medium M>
+    using type = nsp::ChannelGridControl<M>;
+    template <nsp::Medium M>
+    static type<M> make(const M& medium, const MajorantSettings& s) { return type<M>(medium, s.grid_res); }
+};
+
 /// The channel policy of nsp::PathEstimator: one pdf driven by the channel means, grey majorant.
 struct Grey {
     static constexpr const char* name = "grey";
@@ -147,7 +161,7 @@ using ChannelPolicies = tl::list<Grey, nsp::channels::Independent, nsp::channels
 using Majorants = tl::list<GlobalMajorantPolicy<>, ChannelMajorantPolicy, GridMajorantPolicy<>, ChannelGridMajorantPolicy,
                            GlobalMajorantPolicy<nsp::bound::Signed>, GlobalMajorantPolicy<nsp::bound::Clamp>,
                            GridMajorantPolicy<nsp::bound::Signed>, GridMajorantPolicy<nsp::bound::Clamp>,
-                           GridControlPolicy>;
+                           GridControlPolicy, ChannelGridControlPolicy>;
 using Strategies = tl::list<nsp::strategy::Unidirectional, nsp::strategy::NextEvent,
                             nsp::strategy::DirectionalMis, nsp::strategy::NullScatteringMis,
                             nsp::strategy::EquiangularNextEvent, nsp::strategy::EquiangularMis>;
@@ -193,7 +207,9 @@ using MediumKinds = tl::list<DenseGridCloud, EmissivePlume>;
 ///   its other rows; the equiangular strategies: Mono, as under the other majorants), absorb-weight:
 ///   what PathEstimator takes under a control, without the Hero<4> points the grey axis does not need;
 ///   and with SpectralPathEstimator in Rgb on the cloud (spectral MIS and spectral tracking, which
-///   take a grey majorant; no equiangular or emissive points, as under the other majorants).
+///   take a grey majorant; no equiangular or emissive points, as under the other majorants). The
+///   channel grid control (ChannelGridControlPolicy) likewise with spectral MIS and independent
+///   tracking (the own-pdf policies it takes) in Rgb on the cloud, absorb-weight.
 template <class Tuple>
 struct is_valid;
 template <class S, class CP, class Maj, class St, class H, class A, class Med>
@@ -214,7 +230,9 @@ struct is_valid<tl::list<S, CP, Maj, St, H, A, Med>> {
     }();
     static constexpr bool estimator_fits = grey || (S::channels > 1 && (St::null_pdfs || !St::combines));
     static constexpr bool build_fits = [] {
-        if constexpr (std::is_same_v<Maj, GridControlPolicy>) {
+        if constexpr (std::is_same_v<Maj, ChannelGridControlPolicy>)
+            return !grey && weight && std::is_same_v<S, nsp::Rgb> && !Med::emissive && !St::equiangular;
+        else if constexpr (std::is_same_v<Maj, GridControlPolicy>) {
             if constexpr (!grey)  // spectral MIS and spectral tracking on the cloud, in Rgb
                 return weight && std::is_same_v<S, nsp::Rgb> && !Med::emissive && !St::equiangular;
             else
@@ -307,9 +325,10 @@ using CombinationsOf = tl::transform<
 // spectral MIS grid and channel-grid). The emissive medium, in Rgb: the 6 grey rows with global and
 // grid, absorb-weight. The grid control, absorb-weight: in Mono the 9 grey rows, in Rgb the 6
 // without equiangular sampling, 6 more on the emissive medium, and 3 channel policies (spectral
-// tracking max and average, spectral MIS) x the 3 spectral strategies.
+// tracking max and average, spectral MIS) x the 3 spectral strategies. The channel grid control,
+// absorb-weight, in Rgb: 2 channel policies (independent, spectral MIS) x the 3 spectral strategies.
 static_assert(tl::size<CombinationsOf<nsp::Mono>> == 9 * 2 + (9 + 3) + 9 * 4 + 9);
-static_assert(tl::size<CombinationsOf<nsp::Rgb>> == 6 * 2 + 6 + 5 * 3 * 2 + 5 * 3 + 6 * 3 + 6 + 3 * 3);
+static_assert(tl::size<CombinationsOf<nsp::Rgb>> == 6 * 2 + 6 + 5 * 3 * 2 + 5 * 3 + 6 * 3 + 6 + 3 * 3 + 2 * 3);
 static_assert(tl::size<CombinationsOf<Hero4>> == 6 * 2 + 6 + 5 * 3 * 2 + 5 * 3);
 
 /// What the driver knows of one combination at run time: its names and traits as plain data, so

@@ -69,6 +69,9 @@ void print_majorant_notes(const Options& o, const std::vector<Row>& rows) {
         std::printf("grid-control (nsp::GridControl): the grid majorant with each cell's density lower bound beside "
                     "it (two floats per cell); segments by decomposition tracking, shadow rays by residual ratio "
                     "tracking: lookups only for the density above each cell's minorant.\n");
+    if (any([](const Row& r) { return r.c.majorant == "channel-grid-control"; }))
+        std::printf("channel-grid-control (nsp::ChannelGridControl): the same cells with each channel's own majorant "
+                    "and control; each channel tracks its own residual.\n");
     if (any([](const Row& r) { return !r.c.bounding; }))
         std::printf("non-bounding majorants (*-signed, *-clamp): %g x the bound (--majorant-scale), below the "
                     "extinction where the medium is dense. signed (bound::Signed): negative null weights, "

@@ -98,7 +98,8 @@ RoomTable grey_empty_table(std::shared_ptr<const Sc> sc, std::shared_ptr<const C
 }
 
 /// C1 (a white sky) or C2 (set-up A's sphere light): Rgb, per-channel majorants, the spectral path
-/// tracers against per-channel BDPT; then both under a grid control.
+/// tracers against per-channel BDPT; then both under a grid control, and spectral MIS + NEE under
+/// the per-channel grid and the per-channel grid control.
 RoomTable chromatic_empty_table(const SceneChoice& c, const RoomOptions& o) {
     RoomTable t = empty_table(c, "rgb, per-channel majorants", 3, o);
     const auto sc = share(make_setup_surface_scene<Rgb, DenseGridCloud, ChannelMajorantPolicy>(c));
@@ -128,6 +129,17 @@ RoomTable chromatic_empty_table(const SceneChoice& c, const RoomOptions& o) {
                  SpectralPathEstimator<channels::SpectralMis, strategy::NullScatteringMis, mis::Balance>(kDepth),
                  "uni-nee-mis_spectral-mis_grid-control");
     rows.pinhole(controlled, camera, SpectralBdptEstimator<mis::Balance>{}, "bdpt_spectral-mis_grid-control");
+    // Under each channel's own majorant and control over the same cells (ChannelGridControl): the
+    // per-channel grid alone, then with its control (spectral MIS + NEE; per-channel BDPT takes a
+    // grey majorant's control only).
+    const auto channel_grid = share(make_setup_surface_scene<Rgb, DenseGridCloud, ChannelGridMajorantPolicy>(c));
+    rows.pinhole(channel_grid, camera,
+                 SpectralPathEstimator<channels::SpectralMis, strategy::NullScatteringMis, mis::Balance>(kDepth),
+                 "uni-nee-mis_spectral-mis_channel-grid");
+    const auto channel_controlled = share(make_setup_surface_scene<Rgb, DenseGridCloud, ChannelGridControlPolicy>(c));
+    rows.pinhole(channel_controlled, camera,
+                 SpectralPathEstimator<channels::SpectralMis, strategy::NullScatteringMis, mis::Balance>(kDepth),
+                 "uni-nee-mis_spectral-mis_channel-grid-control");
     return t;
 }
 
