@@ -16,8 +16,9 @@
 // GridControl stores per cell the density's lower bound beside its upper bound (two floats per
 // cell; a medium without a lower-bound query, LowerBoundedMedium, gets a control of 0 and pays
 // for none). TreeControl does the same on TreeMajorant's cells (the same layout, walked by the
-// same hierarchical DDA), and GlobalControl is one constant control and majorant over the
-// medium's box.
+// same hierarchical DDA), ChannelGridControl gives each channel of GridControl's cells its own
+// majorant and control (the per-channel trackers take it with own pdfs), and GlobalControl is one
+// constant control and majorant over the medium's box.
 #pragma once
 
 #include <algorithm>
