@@ -720,13 +720,14 @@ private:
         }
         if constexpr (!grey) {
             const Arr tb = detail::relative_transmittance(tau_v, c).template cast<T>();
-            nee_factor *= tb;
             if constexpr (kChannelControl) {  // f's and uni's Tbar take the control's exp(-tau_c,c) too
                 const Arr tbf = tb * kept.ec.template cast<T>();
                 f_factor *= tbf;
+                nee_factor *= tb;
                 if (uni_alternative) uni_factor *= tbf;
             } else {
                 f_factor *= tb;
+                nee_factor *= tb;
                 if (uni_alternative) uni_factor *= tb;
             }
         }
