@@ -58,7 +58,8 @@ TEST_CASE_TEMPLATE("per-channel control: albedo 1 under a unit environment gives
                    absorption::Event) {
     // Multiple scattering from outside and from inside the box, 4000 paths each, on an
     // exponential medium and a noise grid, channels 1 : 0.4 : 2.5 (each channel's own control and
-    // residual differ), under a ChannelGridControl of 8^3.
+    // residual differ), under a ChannelGridControl of 8^3, and the noise grid under a
+    // ChannelTreeControl (its adaptive layout).
     using S = Rgb;
     const Box box{Vec3(-1.f), Vec3(1.f)};
     Lights<S> lights;
@@ -68,9 +69,8 @@ TEST_CASE_TEMPLATE("per-channel control: albedo 1 under a unit environment gives
         {Vec3(0.1f, -0.2f, 0.3f), glm::normalize(Vec3(0.3f, 0.9f, -0.2f))},
     };
     std::uint64_t seed = std::is_same_v<A, absorption::Event> ? 2100 : 2000;
-    auto run = [&](const auto& medium, const std::string& name) {
-        using M = std::remove_cvref_t<decltype(medium)>;
-        const Scene scene(medium, ChannelGridControl<M>(medium, 8), HenyeyGreensteinPhase(0.5f), lights);
+    auto run = [&](const auto& medium, const auto& control, const std::string& name) {
+        const Scene scene(medium, control, HenyeyGreensteinPhase(0.5f), lights);
         for_each_own_pdfs<A>([&](const auto& est) {
             using E = std::remove_cvref_t<decltype(est)>;
             for (int r = 0; r < 2; ++r) {
@@ -80,8 +80,13 @@ TEST_CASE_TEMPLATE("per-channel control: albedo 1 under a unit environment gives
             }
         });
     };
-    run(make_medium<ExponentialMedium<S>>(box, 1.5f, spec<S>(0.f, 0.f, 0.f), spec<S>(1.f, 0.4f, 2.5f)), "exponential");
-    run(make_medium<DenseGridMedium<S>>(box, 1.5f, spec<S>(0.f, 0.f, 0.f), spec<S>(1.f, 0.4f, 2.5f)), "noise grid");
+    using Exp = ExponentialMedium<S>;
+    using Grid = DenseGridMedium<S>;
+    const auto exp_medium = make_medium<Exp>(box, 1.5f, spec<S>(0.f, 0.f, 0.f), spec<S>(1.f, 0.4f, 2.5f));
+    const auto grid_medium = make_medium<Grid>(box, 1.5f, spec<S>(0.f, 0.f, 0.f), spec<S>(1.f, 0.4f, 2.5f));
+    run(exp_medium, ChannelGridControl<Exp>(exp_medium, 8), "exponential, channel grid control");
+    run(grid_medium, ChannelGridControl<Grid>(grid_medium, 8), "noise grid, channel grid control");
+    run(grid_medium, ChannelTreeControl<Grid>(grid_medium), "noise grid, channel tree control");
 }
 
 TEST_CASE_TEMPLATE("per-channel control: single scattering from a point light = quadrature", A, absorption::Weight,
@@ -91,20 +96,24 @@ TEST_CASE_TEMPLATE("per-channel control: single scattering from a point light = 
     // over its own two routes.
     const PointLightSingleScatter<ExponentialMedium<Rgb>> setup;
     using M = ExponentialMedium<Rgb>;
-    const auto scene = Scene(setup.medium, ChannelGridControl<M>(setup.medium, 8), IsotropicPhase{}, setup.lights);
     EstimatorOptions opts;
     opts.max_depth = 1;
     std::uint64_t seed = std::is_same_v<A, absorption::Event> ? 2300 : 2200;
-    auto each = [&](const auto& est) {
-        using E = std::remove_cvref_t<decltype(est)>;
-        const auto res = estimate_radiance(E(opts), scene, setup.ray, 100000, ++seed);
-        check_channels(res, setup.ref, name_of<E>());
+    auto run = [&](const auto& control, const std::string& name) {
+        const auto scene = Scene(setup.medium, control, IsotropicPhase{}, setup.lights);
+        auto each = [&](const auto& est) {
+            using E = std::remove_cvref_t<decltype(est)>;
+            const auto res = estimate_radiance(E(opts), scene, setup.ray, 100000, ++seed);
+            check_channels(res, setup.ref, name + " " + name_of<E>());
+        };
+        each(SpectralPathEstimator<channels::SpectralMis, strategy::NextEvent, mis::None, A>{});
+        each(SpectralPathEstimator<channels::SpectralMis, strategy::NullScatteringMis, mis::Balance, A>{});
+        each(SpectralPathEstimator<channels::Independent, strategy::NullScatteringMis, mis::Balance, A>{});
+        each(SpectralPathEstimator<channels::SpectralMis, strategy::EquiangularNextEvent, mis::None, A>{});
+        each(SpectralPathEstimator<channels::SpectralMis, strategy::EquiangularMis, mis::Balance, A>{});
     };
-    each(SpectralPathEstimator<channels::SpectralMis, strategy::NextEvent, mis::None, A>{});
-    each(SpectralPathEstimator<channels::SpectralMis, strategy::NullScatteringMis, mis::Balance, A>{});
-    each(SpectralPathEstimator<channels::Independent, strategy::NullScatteringMis, mis::Balance, A>{});
-    each(SpectralPathEstimator<channels::SpectralMis, strategy::EquiangularNextEvent, mis::None, A>{});
-    each(SpectralPathEstimator<channels::SpectralMis, strategy::EquiangularMis, mis::Balance, A>{});
+    run(ChannelGridControl<M>(setup.medium, 8), "channel grid control");
+    run(ChannelTreeControl<M>(setup.medium, TreeLayout{setup.box, {2, 2, 2}, {2, 0, 0}, 0.f, 0.f}), "channel tree control");
 }
 
 TEST_CASE("per-channel control: emitting absorber = quadrature") {

@@ -457,13 +457,11 @@ double null_rounding(const M& medium, const Maj& maj, const Ray& ray, const type
 // majorant (pdf.hpp's evaluation, which sees the control as a majorant), and its residual ratio
 // tracking pdf prod R_c exp(-int R_c). The trackers must report exactly these, and the
 // contributions of the medium (unchanged by the control), for each sampling channel.
-TEST_CASE_TEMPLATE("per-channel control: channel trackers report every channel's decomposition and residual ratio pdfs",
-                   A, absorption::Event, absorption::Weight) {
+template <AbsorptionPolicy A, class Ctl>
+void check_channel_control_pdfs(const DenseGridMedium<Rgb>& medium, const Ctl& ctl) {
     using S = Rgb;
     using M = DenseGridMedium<S>;
     using CP = channels::SpectralMis;
-    const M medium = chromatic_grid<S>(3);
-    const ChannelGridControl<M> ctl(medium, kTestGridRes);
     Pcg32 rng(17, 4);
     NoLookupCount none;
     int with_nulls = 0, scattered = 0, ratio_nulls = 0;
@@ -533,6 +531,15 @@ TEST_CASE_TEMPLATE("per-channel control: channel trackers report every channel's
     CHECK(with_nulls > 50);
     CHECK(scattered > 20);
     CHECK(ratio_nulls > 50);
+}
+
+TEST_CASE_TEMPLATE("per-channel control: channel trackers report every channel's decomposition and residual ratio pdfs",
+                   A, absorption::Event, absorption::Weight) {
+    // Under the per-channel grid control and the per-channel tree control (the test trees' layout).
+    const auto medium = chromatic_grid<Rgb>(3);
+    check_channel_control_pdfs<A>(medium, ChannelGridControl<DenseGridMedium<Rgb>>(medium, kTestGridRes));
+    check_channel_control_pdfs<A>(
+        medium, ChannelTreeControl<DenseGridMedium<Rgb>>(medium, TreeLayout{medium.bounds(), kTestTreeCoarse, {2, 0, 0}, 0.f, 0.f}));
 }
 
 TEST_CASE("per-channel control on a homogeneous chromatic medium: no lookups, exact transmittance") {

@@ -1145,7 +1145,7 @@ void run_unusable(Input& in, FuzzRng& rng, const M& medium, const std::array<int
 /// The trackers under a control (THEORY 5.10) on the input's medium, with a local generator (no
 /// bytes read, so the corpus keeps its meaning): GridControl at the medium's resolution, a
 /// TreeControl of its voxels (coarse 2^3 split wherever the bound varies), a ChannelGridControl
-/// (per channel) and GlobalControl at 0 (today's trackers) and at half the extinction bound (above the density where
+/// and a ChannelTreeControl (per channel) and GlobalControl at 0 (today's trackers) and at half the extinction bound (above the density where
 /// the medium is thin: negative residuals). Decomposition tracking (track_delta, VertexKernels::track),
 /// residual ratio tracking (track_ratio, VertexKernels::shadow, transmittance_residual_ratio) and
 /// ray marching under the grid majorant: statuses Ok, Aborted or NonFinite, estimates and null
@@ -1158,12 +1158,14 @@ void run_controls(const M& medium, const std::array<int, 3>& res, const Lambda& 
     if (!(medium.max_extinction() * glm::length(b.hi - b.lo) <= kBudget)) return;
     std::optional<GridControl<M>> grid;
     std::optional<ChannelGridControl<M>> channel_grid;
+    std::optional<ChannelTreeControl<M>> channel_tree;
     std::optional<TreeControl<M>> tree;
     std::optional<GridMajorant<M>> gmaj;
     std::optional<GlobalControl<M>> zero, half;
     try {
         grid.emplace(medium, res);
         channel_grid.emplace(medium, res);
+        channel_tree.emplace(medium, TreeLayout{b, {2, 2, 2}, {2, 2, 0}, 0.f, 0.f});
         tree.emplace(medium, TreeLayout{b, {2, 2, 2}, {2, 2, 0}, 0.f, 0.f});
         gmaj.emplace(medium, res);
         zero.emplace(medium, constant_coefficient<S>(0.f));
@@ -1224,21 +1226,26 @@ void run_controls(const M& medium, const std::array<int, 3>& res, const Lambda& 
         drive(*tree, true);
         drive(*zero, true);
         drive(*half, false);
-        // The per-channel grid control (each channel's own control and residual): the channel
-        // trackers with every sampling channel, and transmittance_residual_ratio.
-        for (int c = 0; c < S::channels; ++c) {
-            ChannelPathState<S> cst;
-            const auto cd = track_channels_delta<channels::SpectralMis, absorption::Weight>(
-                medium, *channel_grid, ray, tmax, lambda, c, cst, true, rng, counter);
-            NSP_FUZZ_CHECK(ok(flight_status(cd.end)) && all_finite(cst.f) && all_finite(cst.uni) && all_finite(cst.nee));
-            NSP_FUZZ_CHECK((cst.uni >= 0.f).all() && (cst.nee >= 0.f).all());
-            const auto cr = track_channels_ratio<channels::SpectralMis, absorption::Event>(
-                medium, *channel_grid, ray, tmax, lambda, c, S::Spectrum::Ones(), true, rng, counter);
-            NSP_FUZZ_CHECK(ok(flight_status(cr.end)) && all_finite(cr.f) && all_finite(cr.nee) && all_finite(cr.uni));
-            NSP_FUZZ_CHECK((cr.uni >= 0.f).all() && (cr.nee >= 0.f).all());
-        }
-        const auto crr = transmittance_residual_ratio(medium, *channel_grid, ray, tmax, lambda, rng, counter, 4096);
-        NSP_FUZZ_CHECK(ok(crr.status) && all_finite(crr.value));
+        // The per-channel grid and tree controls (each channel's own control and residual): the
+        // channel trackers with every sampling channel, and transmittance_residual_ratio.
+        auto drive_channels = [&](const auto& control) {
+            for (int c = 0; c < S::channels; ++c) {
+                ChannelPathState<S> cst;
+                const auto cd = track_channels_delta<channels::SpectralMis, absorption::Weight>(
+                    medium, control, ray, tmax, lambda, c, cst, true, rng, counter);
+                NSP_FUZZ_CHECK(ok(flight_status(cd.end)) && all_finite(cst.f) && all_finite(cst.uni) &&
+                               all_finite(cst.nee));
+                NSP_FUZZ_CHECK((cst.uni >= 0.f).all() && (cst.nee >= 0.f).all());
+                const auto cr = track_channels_ratio<channels::SpectralMis, absorption::Event>(
+                    medium, control, ray, tmax, lambda, c, S::Spectrum::Ones(), true, rng, counter);
+                NSP_FUZZ_CHECK(ok(flight_status(cr.end)) && all_finite(cr.f) && all_finite(cr.nee) && all_finite(cr.uni));
+                NSP_FUZZ_CHECK((cr.uni >= 0.f).all() && (cr.nee >= 0.f).all());
+            }
+            const auto crr = transmittance_residual_ratio(medium, control, ray, tmax, lambda, rng, counter, 4096);
+            NSP_FUZZ_CHECK(ok(crr.status) && all_finite(crr.value));
+        };
+        drive_channels(*channel_grid);
+        drive_channels(*channel_tree);
         const auto rm = transmittance_ray_marching(medium, *gmaj, ray, tmax, lambda, rng, counter);
         NSP_FUZZ_CHECK(ok(rm.status) && all_finite(rm.value));
     }

@@ -16,9 +16,9 @@
 // GridControl stores per cell the density's lower bound beside its upper bound (two floats per
 // cell; a medium without a lower-bound query, LowerBoundedMedium, gets a control of 0 and pays
 // for none). TreeControl does the same on TreeMajorant's cells (the same layout, walked by the
-// same hierarchical DDA), ChannelGridControl gives each channel of GridControl's cells its own
-// majorant and control (the per-channel trackers take it with own pdfs), and GlobalControl is one
-// constant control and majorant over the medium's box.
+// same hierarchical DDA), ChannelGridControl and ChannelTreeControl give each channel of those
+// cells its own majorant and control (the per-channel trackers take them with own pdfs), and
+// GlobalControl is one constant control and majorant over the medium's box.
 #pragma once
 
 #include <algorithm>
@@ -287,36 +287,39 @@ public:
     using detail::BasicGridControl<M, true>::BasicGridControl;
 };
 
-/// A tree of controls and majorants (THEORY 5.10): TreeMajorant's cells, each that is not split
-/// keeping the medium's density lower bound over it beside its upper bound (LowerBoundedMedium; 0
-/// for a medium without one), so that on a cell's stretch the control is d_min u_c and the majorant
-/// d_max max_c u_c, as GridControl's. The layout is the majorant's (the same cost model, which
-/// prices the full majorant's lookups, decides the splits), so a TreeControl and a TreeMajorant
-/// over one layout walk the same cells. Two floats per cell of every level.
-template <CellBoundedMedium M>
-class TreeControl {
+namespace detail {
+/// TreeControl (kChannels false) and ChannelTreeControl (true): the same cells, walked alike; the
+/// majorant is grey (d_max max_c u_c) or per channel (d_max u_c).
+template <CellBoundedMedium M, bool kChannels>
+class BasicTreeControl {
+    static constexpr const char* kName = kChannels ? "ChannelTreeControl" : "TreeControl";
+
 public:
     using Spectral = typename M::Spectral;
     using Spectrum = typename Spectral::Spectrum;
 
     /// The adaptive layout over the medium's bounds (as TreeMajorant's default).
-    explicit TreeControl(const M& medium) : TreeControl(medium, detail::adaptive_layout(medium)) {}
+    explicit BasicTreeControl(const M& medium) : BasicTreeControl(medium, detail::adaptive_layout(medium)) {}
     /// Throws InvalidArgument as TreeMajorant does, and on a lower bound that is not finite, is
     /// negative or exceeds the cell's upper bound.
-    TreeControl(const M& medium, const TreeLayout& layout)
-        : tree_(medium, layout, 1.f, "TreeControl", true), unit_(detail::CellBounds<M>(medium, "TreeControl").unit()),
+    BasicTreeControl(const M& medium, const TreeLayout& layout)
+        : tree_(medium, layout, 1.f, kName, true), unit_(detail::CellBounds<M>(medium, kName).unit()),
           unit_max_(max_value(unit_)) {}
+
+    /// A stretch's segment: grey or per-channel majorant.
+    using Segment = ControlSegment<Spectrum, std::conditional_t<kChannels, Spectrum, float>>;
 
     class Iterator {
     public:
         Iterator(const detail::MajorantTree<M>* tree, const Ray& r, float tmin, float tmax, const Spectrum& unit,
                  float unit_max) noexcept
             : walk_(tree, r, tmin, tmax, 1.f), unit_(unit), unit_max_(unit_max) {}
-        std::optional<ControlSegment<Spectrum>> next() noexcept {
+        std::optional<Segment> next() noexcept {
             const auto s = walk_.next();
             if (!s) return std::nullopt;
             const float hi = s->sigma_maj, lo = walk_.lower();
-            return ControlSegment<Spectrum>{s->t0, s->t1, hi * unit_max_, unit_ * lo, (hi - lo) * unit_max_};
+            if constexpr (kChannels) return Segment{s->t0, s->t1, unit_ * hi, unit_ * lo, (hi - lo) * unit_max_};
+            else return Segment{s->t0, s->t1, hi * unit_max_, unit_ * lo, (hi - lo) * unit_max_};
         }
         std::uint32_t steps() const noexcept { return walk_.steps(); }
 
@@ -330,9 +333,11 @@ public:
         return {&tree_, r, tmin, tmax, Spectral::sample(unit_, l), unit_max_};
     }
 
-    /// The majorant at point p (its finest cell's; 0 outside the medium's bounds).
-    float value_at(const Vec3& p, const typename Spectral::Wavelengths&) const noexcept {
-        return tree_.at_point(p) * unit_max_;
+    /// The majorant at point p (its finest cell's; 0 outside the medium's bounds): grey, or per
+    /// channel for ChannelTreeControl.
+    auto value_at(const Vec3& p, const typename Spectral::Wavelengths& l) const noexcept {
+        if constexpr (kChannels) return Spectrum(Spectral::sample(unit_, l) * tree_.at_point(p));
+        else return (void)l, tree_.at_point(p) * unit_max_;
     }
     /// The control at point p, per channel (its finest cell's, 0 outside the bounds): the
     /// sigma_ctl of the segment `iterate` gives there.
@@ -351,6 +356,29 @@ private:
     detail::MajorantTree<M> tree_;
     typename Spectral::Coefficient unit_;
     float unit_max_;
+};
+}  // namespace detail
+
+/// A tree of controls and majorants (THEORY 5.10): TreeMajorant's cells, each that is not split
+/// keeping the medium's density lower bound over it beside its upper bound (LowerBoundedMedium; 0
+/// for a medium without one), so that on a cell's stretch the control is d_min u_c and the majorant
+/// d_max max_c u_c, as GridControl's. The layout is the majorant's (the same cost model, which
+/// prices the full majorant's lookups, decides the splits), so a TreeControl and a TreeMajorant
+/// over one layout walk the same cells. Two floats per cell of every level. Throws as TreeMajorant
+/// does, and on a lower bound that is not finite, is negative or exceeds the cell's upper bound.
+template <CellBoundedMedium M>
+class TreeControl : public detail::BasicTreeControl<M, false> {
+public:
+    using detail::BasicTreeControl<M, false>::BasicTreeControl;
+};
+
+/// TreeControl's cells with ChannelTreeMajorant's per-channel majorant (THEORY 5.10 with 5.3), as
+/// ChannelGridControl is GridControl's: channel c's majorant d_max u_c and control d_min u_c, for
+/// the per-channel trackers with own pdfs. Throws as TreeControl.
+template <CellBoundedMedium M>
+class ChannelTreeControl : public detail::BasicTreeControl<M, true> {
+public:
+    using detail::BasicTreeControl<M, true>::BasicTreeControl;
 };
 
 }  // namespace nsp
