@@ -121,15 +121,11 @@ TEST_CASE("per-channel control: emitting absorber = quadrature") {
     // residual collision with every channel's own pdfs, the segment technique and NEE toward the
     // volume (their nulls by each channel's residual ratio tracking); 20000 paths, with and without
     // the segment technique.
+    // EmittingAbsorber (references.hpp), Rgb, on an exponential medium.
     using S = Rgb;
-    using M = ExponentialMedium<S>;
-    using EM = Emissive<M>;
-    const Box box{Vec3(-1.f), Vec3(1.f)};
-    const M base = make_medium<M>(box, 0.9f, spec<S>(0.8f, 0.3f, 2.f), grey<S>(0.f));
-    const EM medium(base, make_emission(Box{Vec3(-1.f, -0.8f, -1.2f), Vec3(0.9f, 1.f, 1.f)}, {5, 3, 4}, 1.f, 77),
-                    spec<S>(2.f, 1.f, 0.5f), {6, 5, 4});
-    const Ray ray{Vec3(-3.f, 0.25f, -0.3f), glm::normalize(Vec3(1.f, -0.05f, 0.12f))};
-    const auto ref = emitting_absorber_reference(base, medium, ray);
+    const EmittingAbsorber<ExponentialMedium<S>> setup;
+    using EM = EmittingAbsorber<ExponentialMedium<S>>::Medium;
+    const auto& [box, base, medium, ray, ref] = setup;
     const auto scene = Scene(medium, ChannelGridControl<EM>(medium, 8), IsotropicPhase{}, Lights<S>{});
     EstimatorOptions off;
     off.emission_along_segments = false;

@@ -199,13 +199,8 @@ template <class C, class ForEach>
 void check_emitting_absorber(int seed0, ForEach&& for_each_estimator) {
     using S = typename C::Spectral;
     using M = typename C::Medium;
-    using EM = Emissive<M>;
-    const Box box{Vec3(-1.f), Vec3(1.f)};
-    const M base = make_medium<M>(box, 0.9f, spec<S>(0.8f, 0.4f, 1.5f), grey<S>(0.f));
-    const EM medium(base, make_emission(Box{Vec3(-1.f, -0.8f, -1.2f), Vec3(0.9f, 1.f, 1.f)}, {5, 3, 4}, 1.f, 77),
-                    spec<S>(2.f, 1.f, 0.5f), {6, 5, 4});
-    const Ray ray{Vec3(-3.f, 0.25f, -0.3f), glm::normalize(Vec3(1.f, -0.05f, 0.12f))};
-    const auto ref = emitting_absorber_reference(base, medium, ray);
+    const EmittingAbsorber<M> setup;
+    const auto& [box, base, medium, ray, ref] = setup;
     auto run = [&](const auto& control, const std::string& name, int first_seed) {
         const auto scene = Scene(medium, control, IsotropicPhase{}, Lights<S>{});
         EstimatorOptions off;  // the collision estimator alone on the camera ray

@@ -328,13 +328,13 @@ struct ChannelDeltaCollision {
 
     /// Under a per-channel majorant's control, the loop's call at every collision before its
     /// coefficients become the route's (see the struct's comment).
-    void before_event(float, const Coefficients<S>& k, const Spec& mu, const Spec& ctl, const Spec& tau_c, bool)
+    void before_event(const Coefficients<S>& k, const Spec& mu, const Spec& ctl, const Spec& tau_c)
         requires kChannelControl
     {
         kept.k = k;
         kept.mu = mu;
         kept.ctl = ctl;
-        kept.ec = (tau_c > 0.f).any() ? Spec((-tau_c).exp()) : Spec(Spec::Ones());  // no control since the last collision: 1
+        kept.ec = detail::channel_control_transmittance(tau_c);
         kept.tau_c = tau_c[c];
     }
     void control_tail(const Spec& tau_c) noexcept
@@ -632,16 +632,16 @@ struct ChannelRatioCollision {
     /// residual nulls (R times its length) for an estimate that rounds to 0.
     void control_depth(double tau) noexcept { control_floor = std::exp(tau); }
 
-    /// Under a per-channel majorant's control, exp(-tau_c,c) of the step to the next collision.
-    /// and the lookup's mu_t, the majorant and the control there.
+    /// Under a per-channel majorant's control: exp(-tau_c,c) of the step to the collision, the
+    /// lookup's mu_t, the majorant and the control there, and the tail's control depth.
     struct KeptChannels {
         Spec ec, t, mu, ctl, tail;
     };
     [[no_unique_address]] std::conditional_t<kChannelControl, KeptChannels, detail::Empty> kept{};
-    void before_event(float, const Coefficients<S>& k, const Spec& mu, const Spec& ctl, const Spec& tau_c, bool) noexcept
+    void before_event(const Coefficients<S>& k, const Spec& mu, const Spec& ctl, const Spec& tau_c) noexcept
         requires kChannelControl
     {
-        kept.ec = (tau_c > 0.f).any() ? Spec((-tau_c).exp()) : Spec(Spec::Ones());
+        kept.ec = detail::channel_control_transmittance(tau_c);
         kept.t = k.sigma_t();
         kept.mu = mu;
         kept.ctl = ctl;

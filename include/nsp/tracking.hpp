@@ -230,6 +230,12 @@ template <class Spec>
 Spec channel_controls(const Spec& ctl, const Spec& mu_bar) noexcept {
     return ctl.max(0.f).min(mu_bar.max(0.f));
 }
+/// exp(-tau_c) per channel of a per-channel control's depths `tau_c` over a step: the probability
+/// of no control collision there (1 where no channel had a control, without evaluating exp).
+template <class Spec>
+Spec channel_control_transmittance(const Spec& tau_c) noexcept {
+    return (tau_c > 0.f).any() ? Spec((-tau_c).exp()) : Spec(Spec::Ones());
+}
 
 /// Scales coefficients `k` (after the bound policy) to extinction mu_t,c - `ctl` in every channel,
 /// albedo kept (ControlUse): where mu_t,c = 0 the residual -ctl is all absorption. mu_s is scaled
@@ -387,7 +393,7 @@ FlightEnd<MajorantValue<Maj, M>> free_flight(const M& medium, const Maj& majoran
     // from the last collision (control_tail); `tau_tail` is then the residual's.
     if constexpr (channel_ctl)
         static_assert(requires(const Coefficients<typename M::Spectral>& k, const V& v) {
-            on_collision.before_event(0.f, k, v, v, v, false);
+            on_collision.before_event(k, v, v, v);
             on_collision.control_tail(v);
         }, "nsp: this collision policy does not take a per-channel majorant's control (ChannelGridControl)");
     if (!usable_ray(ray) || tmin != tmin || tmax != tmax) [[unlikely]] {  // NaN != NaN
@@ -539,7 +545,7 @@ FlightEnd<MajorantValue<Maj, M>> free_flight(const M& medium, const Maj& majoran
             if constexpr (channel_ctl) {
                 // Every channel's lookup, majorant, control and control depth since the last
                 // collision, then the route's coefficients (a control collision's under Collide).
-                on_collision.before_event(t, coeff, seg->sigma_maj, ctl_v, tau_c, control_first);
+                on_collision.before_event(coeff, seg->sigma_maj, ctl_v, tau_c);
                 tau_c.setZero();
                 if (control_first) detail::to_control(coeff, ctl_v);
                 else detail::to_residual(coeff, ctl_v, res_v);

@@ -96,6 +96,22 @@ struct PointLightSingleScatter {
     std::array<double, 3> ref = single_scatter_reference(medium, ray, light, 2.f);
 };
 
+/// The emitting absorber of the control suites: medium M over [-1, 1]^3 at density 0.9 with mu_a
+/// (0.8, 0.4, 1.5) per unit density and no scattering, emitting over most of the box (a random
+/// grid of L_e, mean 1, times (2, 1, 0.5)), and its radiance along `ray` by quadrature:
+/// L_c = int T_c mu_a,c L_e,c dt (emitting_absorber_reference).
+template <class M>
+struct EmittingAbsorber {
+    using S = typename M::Spectral;
+    using Medium = Emissive<M>;
+    Box box{Vec3(-1.f), Vec3(1.f)};
+    M base = make_medium<M>(box, 0.9f, spec<S>(0.8f, 0.4f, 1.5f), grey<S>(0.f));
+    Medium medium{base, make_emission(Box{Vec3(-1.f, -0.8f, -1.2f), Vec3(0.9f, 1.f, 1.f)}, {5, 3, 4}, 1.f, 77),
+                  spec<S>(2.f, 1.f, 0.5f), {6, 5, 4}};
+    Ray ray{Vec3(-3.f, 0.25f, -0.3f), glm::normalize(Vec3(1.f, -0.05f, 0.12f))};
+    std::array<double, 3> ref = emitting_absorber_reference(base, medium, ray);
+};
+
 /// The chromatic emissive furnace of the control suites: an exponential medium over [-1, 1]^3
 /// (density 1 at the centre, mu_a (0.5, 0.3, 0.8), mu_s (0.6, 0.9, 0.3) per unit density) emitting
 /// L_e = (0.7, 0.4, 1.1) everywhere, under an environment of the same radiance: L = L_e along `ray`
